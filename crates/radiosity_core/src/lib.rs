@@ -1,0 +1,23 @@
+//! Vocabulary of the `radiosity` renderer: linear colour ([`Rgb`]), validated scenes
+//! ([`Scene`], [`Material`], [`Object`]), and meshing into shooting patches and receiving
+//! elements ([`Mesh`], [`MeshParams`]).
+//!
+//! Units: positions in scene units (any length unit, used consistently), radiosity and
+//! emission in W per unit², power in W.
+#![warn(missing_docs)]
+#![forbid(unsafe_code)]
+
+mod canonical;
+mod color;
+mod mesh;
+mod scene;
+
+pub use canonical::{furnace_box, furnace_sphere, two_plates, unit_cube_floor_light};
+pub use color::Rgb;
+pub use mesh::{Element, MAX_ELEMENTS, Mesh, MeshError, MeshParams, Patch, Surface};
+pub use scene::{
+    Camera, Facing, Material, Object, Polygon, Scene, SceneError, Shape, SolverSettings, Sphere, box_faces,
+};
+
+/// Re-export of the vector maths used in the public API.
+pub use glam;

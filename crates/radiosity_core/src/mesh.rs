@@ -1,0 +1,595 @@
+//! Meshing: every surface is cut into patches (the shooters) and patches into elements (the
+//! receivers), after Cohen, Greenberg, Immel & Brock 1986, "An efficient radiosity approach for
+//! realistic image synthesis" (substructuring).
+//!
+//! Vertices are shared between the elements of one surface (so smooth shading interpolates
+//! within it) and never across surfaces (so light never leaks round a corner). Lattice points
+//! are computed with one formula per surface, so shared points are bit-identical and are
+//! merged exactly, never by a distance tolerance.
+
+use std::collections::HashMap;
+use std::ops::Range;
+
+use glam::DVec3;
+use thiserror::Error;
+
+use crate::Material;
+use crate::scene::{Facing, Polygon, Scene, SceneError, Shape, Sphere};
+
+/// Subdivision of surfaces (the source document's "discrétisation", S10).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MeshParams {
+    /// Longest patch edge, scene units, > 0. Patches shoot; smaller is more accurate and
+    /// slower (more shots).
+    pub patch_size: f64,
+    /// Longest element edge, scene units, > 0; clamped to `patch_size`. Elements receive;
+    /// smaller gives sharper shadows and smoother shading.
+    pub element_size: f64,
+}
+
+impl MeshParams {
+    /// Validated parameters.
+    ///
+    /// # Errors
+    /// [`SceneError::BadMeshSize`] when a size is not a finite number > 0.
+    pub fn try_new(patch_size: f64, element_size: f64) -> Result<Self, SceneError> {
+        for (key, value) in [("patch_size", patch_size), ("element_size", element_size)] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(SceneError::BadMeshSize { key, value });
+            }
+        }
+        Ok(Self { patch_size, element_size: element_size.min(patch_size) })
+    }
+
+    /// Default subdivision for a scene whose bounding-box diagonal is `diagonal`: patches of
+    /// 1/8 and elements of 1/32 of it.
+    pub fn for_extent(diagonal: f64) -> Self {
+        let d = if diagonal.is_finite() && diagonal > 0.0 { diagonal } else { 1.0 };
+        Self { patch_size: d / 8.0, element_size: d / 32.0 }
+    }
+
+    /// The same parameters with both sizes multiplied by `factor` (e.g. 0.5 for a finer mesh).
+    pub fn scaled(self, factor: f64) -> Self {
+        Self { patch_size: self.patch_size * factor, element_size: self.element_size * factor }
+    }
+}
+
+/// Why a scene could not be meshed.
+#[derive(Clone, Debug, Error, PartialEq)]
+pub enum MeshError {
+    /// The subdivision would create more elements than the limit.
+    #[error(
+        "the mesh would have more than {limit} elements (patch_size {patch_size}, element_size {element_size}); use a larger element_size"
+    )]
+    TooManyElements {
+        /// The limit.
+        limit: usize,
+        /// Patch size asked for.
+        patch_size: f64,
+        /// Element size asked for.
+        element_size: f64,
+    },
+}
+
+/// Most elements a mesh may have; beyond this memory and time explode, so it is an error
+/// rather than a hang.
+pub const MAX_ELEMENTS: usize = 20_000_000;
+
+/// A receiving element: a planar convex triangle or quad.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Element {
+    /// Indices into [`Mesh::positions`], counter-clockwise; only the first `vertex_count`.
+    pub vertices: [u32; 4],
+    /// 3 or 4.
+    pub vertex_count: u8,
+    /// The patch this element belongs to.
+    pub patch: u32,
+    /// Centroid.
+    pub centre: DVec3,
+    /// Unit normal of the lit side.
+    pub normal: DVec3,
+    /// Area, scene units².
+    pub area: f64,
+}
+
+impl Element {
+    /// The vertex indices in use.
+    pub fn vertex_indices(&self) -> &[u32] {
+        &self.vertices[..self.vertex_count as usize]
+    }
+}
+
+/// A shooting patch: a planar convex triangle or quad made of contiguous elements.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Patch {
+    /// Corner positions, counter-clockwise; only the first `corner_count`.
+    pub corners: [DVec3; 4],
+    /// 3 or 4.
+    pub corner_count: u8,
+    /// Unit normal of the lit side.
+    pub normal: DVec3,
+    /// Centroid.
+    pub centre: DVec3,
+    /// Area (sum of its elements' areas), scene units².
+    pub area: f64,
+    /// Its elements, a range into [`Mesh::elements`].
+    pub elements: Range<u32>,
+    /// The surface it belongs to.
+    pub surface: u32,
+}
+
+impl Patch {
+    /// The corners in use.
+    pub fn corners(&self) -> &[DVec3] {
+        &self.corners[..self.corner_count as usize]
+    }
+}
+
+/// One input polygon or one sphere: the unit within which vertices are shared.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Surface {
+    /// Index into [`Mesh::object_names`].
+    pub object: u32,
+    /// Index into [`Mesh::materials`].
+    pub material: u32,
+    /// Its patches, a range into [`Mesh::patches`].
+    pub patches: Range<u32>,
+}
+
+/// The meshed scene: surfaces → patches → elements, plus the coarse occluder triangles that
+/// visibility rays test against.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    /// Vertex positions (shared within a surface only).
+    pub positions: Vec<DVec3>,
+    /// Per-vertex shading normals (the sphere's true normal on spheres).
+    pub shading_normals: Vec<DVec3>,
+    /// Receiving elements, grouped by patch.
+    pub elements: Vec<Element>,
+    /// Shooting patches, grouped by surface.
+    pub patches: Vec<Patch>,
+    /// Surfaces.
+    pub surfaces: Vec<Surface>,
+    /// Object names, in scene order.
+    pub object_names: Vec<String>,
+    /// Materials, in scene order.
+    pub materials: Vec<Material>,
+    /// The scene's geometry as triangles (input polygons fan-triangulated, sphere facets), for
+    /// visibility: far fewer than the element triangles, hence faster rays.
+    pub occluders: Vec<[DVec3; 3]>,
+}
+
+/// Geometry of one surface before it joins the mesh: local vertices, elements labelled by a
+/// local patch number, and patch corner lists.
+#[derive(Default)]
+struct SurfaceBuilder {
+    positions: Vec<DVec3>,
+    normals: Vec<DVec3>,
+    index: HashMap<[u64; 3], u32>,
+    elements: Vec<(Vec<u32>, usize)>,
+    patches: Vec<Vec<DVec3>>,
+}
+
+impl SurfaceBuilder {
+    fn vertex(&mut self, p: DVec3, n: DVec3) -> u32 {
+        let key = [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+        *self.index.entry(key).or_insert_with(|| {
+            self.positions.push(p);
+            self.normals.push(n);
+            (self.positions.len() - 1) as u32
+        })
+    }
+}
+
+fn divisions(length: f64, size: f64) -> usize {
+    ((length / size) * (1.0 - 1e-9)).ceil().max(1.0) as usize
+}
+
+fn polygon_area_normal(pts: &[DVec3]) -> (f64, DVec3, DVec3) {
+    let mut n = DVec3::ZERO;
+    for (i, &a) in pts.iter().enumerate() {
+        n += a.cross(pts[(i + 1) % pts.len()]);
+    }
+    let area = 0.5 * n.length();
+    // Area-weighted centroid via a fan from the first vertex.
+    let mut c = DVec3::ZERO;
+    let mut total = 0.0;
+    for i in 1..pts.len() - 1 {
+        let a = 0.5 * (pts[i] - pts[0]).cross(pts[i + 1] - pts[0]).length();
+        c += (pts[0] + pts[i] + pts[i + 1]) / 3.0 * a;
+        total += a;
+    }
+    let centre = if total > 0.0 { c / total } else { pts.iter().copied().sum::<DVec3>() / pts.len() as f64 };
+    (area, n.normalize_or_zero(), centre)
+}
+
+/// A convex planar quad: one bilinear lattice whose lines at every `ne` step are patch edges.
+fn mesh_quad(b: &mut SurfaceBuilder, c: [DVec3; 4], normal: DVec3, params: &MeshParams) {
+    let len_u = c[0].distance(c[1]).max(c[3].distance(c[2]));
+    let len_v = c[0].distance(c[3]).max(c[1].distance(c[2]));
+    let (npu, npv) = (divisions(len_u, params.patch_size), divisions(len_v, params.patch_size));
+    let neu = divisions(len_u / npu as f64, params.element_size);
+    let nev = divisions(len_v / npv as f64, params.element_size);
+    let (nu, nv) = (npu * neu, npv * nev);
+    let at = |i: usize, j: usize| {
+        let (u, v) = (i as f64 / nu as f64, j as f64 / nv as f64);
+        c[0] * ((1.0 - u) * (1.0 - v)) + c[1] * (u * (1.0 - v)) + c[2] * (u * v) + c[3] * ((1.0 - u) * v)
+    };
+    let base = b.patches.len();
+    for pj in 0..npv {
+        for pi in 0..npu {
+            let (i0, j0, i1, j1) = (pi * neu, pj * nev, (pi + 1) * neu, (pj + 1) * nev);
+            b.patches.push(vec![at(i0, j0), at(i1, j0), at(i1, j1), at(i0, j1)]);
+        }
+    }
+    for j in 0..nv {
+        for i in 0..nu {
+            let q = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
+            let v = q.map(|p| b.vertex(p, normal)).to_vec();
+            b.elements.push((v, base + (j / nev) * npu + i / neu));
+        }
+    }
+}
+
+/// A triangle: one barycentric lattice with `np * ne` steps per edge; its lines at every `ne`
+/// step (in all three directions) are patch edges, so each element lies in exactly one patch.
+fn mesh_triangle(b: &mut SurfaceBuilder, t: [DVec3; 3], normal: DVec3, np: usize, ne: usize) {
+    let n = np * ne;
+    let at = |i: usize, j: usize| {
+        t[0] + (t[1] - t[0]) * (i as f64 / n as f64) + (t[2] - t[0]) * (j as f64 / n as f64)
+    };
+    let coarse = |i: usize, j: usize| at(i * ne, j * ne);
+    let mut patch_of: HashMap<(usize, usize, bool), usize> = HashMap::new();
+    let mut label = |b: &mut SurfaceBuilder, x3: usize, y3: usize| {
+        // Centroid in lattice units times 3, to stay in integers.
+        let (pp, qq) = (x3 / (3 * ne), y3 / (3 * ne));
+        let up = (x3 - 3 * ne * pp) + (y3 - 3 * ne * qq) < 3 * ne;
+        *patch_of.entry((pp, qq, up)).or_insert_with(|| {
+            let corners = if up {
+                vec![coarse(pp, qq), coarse(pp + 1, qq), coarse(pp, qq + 1)]
+            } else {
+                vec![coarse(pp + 1, qq), coarse(pp + 1, qq + 1), coarse(pp, qq + 1)]
+            };
+            b.patches.push(corners);
+            b.patches.len() - 1
+        })
+    };
+    for j in 0..n {
+        for i in 0..n - j {
+            let up = [(i, j), (i + 1, j), (i, j + 1)];
+            let p = label(b, 3 * i + 1, 3 * j + 1);
+            let v = up.map(|(a, c)| b.vertex(at(a, c), normal)).to_vec();
+            b.elements.push((v, p));
+            if i + j + 2 <= n {
+                let down = [(i + 1, j), (i + 1, j + 1), (i, j + 1)];
+                let p = label(b, 3 * i + 2, 3 * j + 2);
+                let v = down.map(|(a, c)| b.vertex(at(a, c), normal)).to_vec();
+                b.elements.push((v, p));
+            }
+        }
+    }
+}
+
+fn mesh_polygon(b: &mut SurfaceBuilder, poly: &Polygon, params: &MeshParams) {
+    let v = poly.vertices();
+    if v.len() == 4 {
+        mesh_quad(b, [v[0], v[1], v[2], v[3]], poly.normal(), params);
+        return;
+    }
+    // Fan triangles share the lattice step count so that points on shared diagonals are
+    // computed by the same formula and merge exactly.
+    let fans: Vec<[DVec3; 3]> = (1..v.len() - 1).map(|i| [v[0], v[i], v[i + 1]]).collect();
+    let longest = |t: &[DVec3; 3]| t[0].distance(t[1]).max(t[1].distance(t[2])).max(t[2].distance(t[0]));
+    let np = fans.iter().map(|t| divisions(longest(t), params.patch_size)).max().unwrap_or(1);
+    let ne = fans.iter().map(|t| divisions(longest(t) / np as f64, params.element_size)).max().unwrap_or(1);
+    for t in fans {
+        mesh_triangle(b, t, poly.normal(), np, ne);
+    }
+}
+
+/// A latitude/longitude tessellation; every facet is one patch and one element (a curved
+/// surface has no planar patch bigger than a facet).
+fn mesh_sphere(b: &mut SurfaceBuilder, s: &Sphere, params: &MeshParams) {
+    use std::f64::consts::PI;
+    let n_lat = divisions(PI * s.radius, params.element_size).max(6);
+    let n_lon = divisions(2.0 * PI * s.radius, params.element_size).max(2 * n_lat).max(12);
+    let sign = if s.facing == Facing::Inward { -1.0 } else { 1.0 };
+    let dir = |k: usize, m: usize| {
+        let (theta, phi) = (PI * k as f64 / n_lat as f64, 2.0 * PI * (m % n_lon) as f64 / n_lon as f64);
+        if k == 0 {
+            DVec3::Y
+        } else if k == n_lat {
+            -DVec3::Y
+        } else {
+            DVec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin())
+        }
+    };
+    for k in 0..n_lat {
+        for m in 0..n_lon {
+            let mut ring = vec![dir(k, m), dir(k, m + 1), dir(k + 1, m + 1), dir(k + 1, m)];
+            ring.dedup();
+            if ring.first() == ring.last() && ring.len() > 3 {
+                ring.pop();
+            }
+            let mut pts: Vec<DVec3> = ring.iter().map(|d| s.center + *d * s.radius).collect();
+            let (_, n, c) = polygon_area_normal(&pts);
+            let mut dirs = ring;
+            if n.dot(c - s.center) * sign < 0.0 {
+                pts.reverse();
+                dirs.reverse();
+            }
+            let verts = pts.iter().zip(&dirs).map(|(p, d)| b.vertex(*p, *d * sign)).collect();
+            b.patches.push(pts);
+            b.elements.push((verts, b.patches.len() - 1));
+        }
+    }
+}
+
+fn estimate_polygon_elements(poly: &Polygon, params: &MeshParams) -> usize {
+    let v = poly.vertices();
+    let diameter = v.iter().flat_map(|a| v.iter().map(move |b| a.distance(*b))).fold(0.0, f64::max);
+    let per_edge = divisions(diameter, params.element_size) as f64;
+    // A fan of k-2 triangles with n² elements each bounds every case.
+    (per_edge * per_edge * (v.len() - 2) as f64).min(usize::MAX as f64) as usize
+}
+
+impl Mesh {
+    /// Meshes `scene` with `params`.
+    ///
+    /// # Errors
+    /// [`MeshError::TooManyElements`] when the subdivision would exceed [`MAX_ELEMENTS`].
+    pub fn build(scene: &Scene, params: &MeshParams) -> Result<Mesh, MeshError> {
+        let too_many = || MeshError::TooManyElements {
+            limit: MAX_ELEMENTS,
+            patch_size: params.patch_size,
+            element_size: params.element_size,
+        };
+        let mut estimate = 0usize;
+        for o in &scene.objects {
+            estimate = estimate.saturating_add(match &o.shape {
+                Shape::Polygons(ps) => ps.iter().map(|p| estimate_polygon_elements(p, params)).sum(),
+                Shape::Sphere(s) => {
+                    let k = divisions(std::f64::consts::PI * s.radius, params.element_size).max(6) as f64;
+                    (k * k * 4.0).min(usize::MAX as f64) as usize
+                }
+            });
+            if estimate > MAX_ELEMENTS {
+                return Err(too_many());
+            }
+        }
+        let mut mesh = Mesh {
+            object_names: scene.objects.iter().map(|o| o.name.clone()).collect(),
+            materials: scene.materials.clone(),
+            ..Mesh::default()
+        };
+        for (oi, o) in scene.objects.iter().enumerate() {
+            match &o.shape {
+                Shape::Polygons(ps) => {
+                    for p in ps {
+                        let mut b = SurfaceBuilder::default();
+                        mesh_polygon(&mut b, p, params);
+                        mesh.push_surface(b, oi, o.material);
+                        let v = p.vertices();
+                        mesh.occluders.extend((1..v.len() - 1).map(|i| [v[0], v[i], v[i + 1]]));
+                    }
+                }
+                Shape::Sphere(s) => {
+                    let mut b = SurfaceBuilder::default();
+                    mesh_sphere(&mut b, s, params);
+                    for pts in &b.patches {
+                        mesh.occluders.extend((1..pts.len() - 1).map(|i| [pts[0], pts[i], pts[i + 1]]));
+                    }
+                    mesh.push_surface(b, oi, o.material);
+                }
+            }
+        }
+        Ok(mesh)
+    }
+
+    fn push_surface(&mut self, b: SurfaceBuilder, object: usize, material: usize) {
+        let surface = self.surfaces.len() as u32;
+        let vbase = self.positions.len() as u32;
+        self.positions.extend(&b.positions);
+        self.shading_normals.extend(&b.normals);
+        let first_patch = self.patches.len() as u32;
+        let mut by_patch: Vec<Vec<usize>> = vec![Vec::new(); b.patches.len()];
+        for (e, (_, p)) in b.elements.iter().enumerate() {
+            by_patch[*p].push(e);
+        }
+        for (p, corners) in b.patches.iter().enumerate() {
+            let start = self.elements.len() as u32;
+            let mut area = 0.0;
+            for &e in &by_patch[p] {
+                let local = &b.elements[e].0;
+                let pts: Vec<DVec3> = local.iter().map(|&i| b.positions[i as usize]).collect();
+                let (a, n, c) = polygon_area_normal(&pts);
+                let mut vertices = [0u32; 4];
+                for (k, &i) in local.iter().enumerate() {
+                    vertices[k] = vbase + i;
+                }
+                area += a;
+                self.elements.push(Element {
+                    vertices,
+                    vertex_count: local.len() as u8,
+                    patch: self.patches.len() as u32,
+                    centre: c,
+                    normal: n,
+                    area: a,
+                });
+            }
+            let (_, n, c) = polygon_area_normal(corners);
+            let mut cs = [DVec3::ZERO; 4];
+            cs[..corners.len()].copy_from_slice(corners);
+            self.patches.push(Patch {
+                corners: cs,
+                corner_count: corners.len() as u8,
+                normal: n,
+                centre: c,
+                area,
+                elements: start..self.elements.len() as u32,
+                surface,
+            });
+        }
+        self.surfaces.push(Surface {
+            object: object as u32,
+            material: material as u32,
+            patches: first_patch..self.patches.len() as u32,
+        });
+    }
+
+    /// The material of element `e`.
+    pub fn element_material(&self, e: usize) -> &Material {
+        let patch = &self.patches[self.elements[e].patch as usize];
+        &self.materials[self.surfaces[patch.surface as usize].material as usize]
+    }
+
+    /// The object index of element `e`.
+    pub fn element_object(&self, e: usize) -> usize {
+        let patch = &self.patches[self.elements[e].patch as usize];
+        self.surfaces[patch.surface as usize].object as usize
+    }
+
+    /// Corner positions of element `e`.
+    pub fn element_corners(&self, e: usize) -> impl Iterator<Item = DVec3> + '_ {
+        self.elements[e].vertex_indices().iter().map(|&i| self.positions[i as usize])
+    }
+
+    /// Element triangles for drawing and ray casting: `(element, [v0, v1, v2])` with vertex
+    /// indices into [`Mesh::positions`]; a quad gives two triangles sharing its first vertex.
+    pub fn element_triangles(&self) -> impl Iterator<Item = (u32, [u32; 3])> + '_ {
+        self.elements.iter().enumerate().flat_map(|(e, el)| {
+            let v = el.vertices;
+            let first = std::iter::once((e as u32, [v[0], v[1], v[2]]));
+            let second = (el.vertex_count == 4).then_some((e as u32, [v[0], v[2], v[3]]));
+            first.chain(second)
+        })
+    }
+
+    /// Total area, scene units².
+    pub fn total_area(&self) -> f64 {
+        self.elements.iter().map(|e| e.area).sum()
+    }
+
+    /// Axis-aligned bounds of all vertices.
+    pub fn bounds(&self) -> (DVec3, DVec3) {
+        self.positions
+            .iter()
+            .fold((DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)), |(lo, hi), p| {
+                (lo.min(*p), hi.max(*p))
+            })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Object, box_faces};
+    use crate::{Material, Rgb};
+
+    fn scene_of(shape: Shape) -> Scene {
+        let m = Material::try_new("m", Rgb::splat(0.5), Rgb::ONE).unwrap();
+        Scene::try_new("t", None, vec![m], vec![Object { name: "o".into(), material: 0, shape }]).unwrap()
+    }
+
+    fn check_mesh(mesh: &Mesh, expected_area: f64, params: &MeshParams) {
+        let area: f64 = mesh.elements.iter().map(|e| e.area).sum();
+        assert!((area - expected_area).abs() < 1e-9 * expected_area, "area {area} vs {expected_area}");
+        for p in &mesh.patches {
+            let sum: f64 = mesh.elements[p.elements.start as usize..p.elements.end as usize]
+                .iter()
+                .map(|e| e.area)
+                .sum();
+            assert!((sum - p.area).abs() < 1e-9 * p.area);
+            for e in p.elements.clone() {
+                let el = &mesh.elements[e as usize];
+                assert!(el.normal.dot(p.normal) > 0.999);
+                let pts: Vec<DVec3> = mesh.element_corners(e as usize).collect();
+                for k in 0..pts.len() {
+                    assert!(pts[k].distance(pts[(k + 1) % pts.len()]) <= params.element_size * (1.0 + 1e-9));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn quad_is_cut_into_patches_and_elements_with_shared_vertices() {
+        let q =
+            Polygon::try_new(vec![DVec3::ZERO, DVec3::X * 4.0, DVec3::new(4.0, 2.0, 0.0), DVec3::Y * 2.0])
+                .unwrap();
+        let params = MeshParams::try_new(2.0, 0.5).unwrap();
+        let mesh = Mesh::build(&scene_of(Shape::Polygons(vec![q])), &params).unwrap();
+        assert_eq!(mesh.patches.len(), 2);
+        assert_eq!(mesh.elements.len(), 32);
+        assert_eq!(mesh.positions.len(), 9 * 5);
+        check_mesh(&mesh, 8.0, &params);
+    }
+
+    #[test]
+    fn triangles_and_pentagons_are_cut_with_exact_shared_vertices() {
+        let pent: Vec<DVec3> = (0..5)
+            .map(|k| {
+                let a = std::f64::consts::TAU * k as f64 / 5.0;
+                DVec3::new(a.cos(), a.sin(), 0.0)
+            })
+            .collect();
+        let poly = Polygon::try_new(pent).unwrap();
+        let area = poly.area();
+        let params = MeshParams::try_new(0.7, 0.2).unwrap();
+        let mesh = Mesh::build(&scene_of(Shape::Polygons(vec![poly])), &params).unwrap();
+        check_mesh(&mesh, area, &params);
+        // Euler: a triangulated disc has V - E + F = 1; with exact merging V = F/2 + boundary/2 + 1.
+        let f = mesh.elements.len();
+        let mut edges = std::collections::HashSet::new();
+        for e in &mesh.elements {
+            let v = e.vertex_indices();
+            for k in 0..v.len() {
+                let (a, b) = (v[k], v[(k + 1) % v.len()]);
+                edges.insert((a.min(b), a.max(b)));
+            }
+        }
+        assert_eq!(mesh.positions.len() as i64 - edges.len() as i64 + f as i64, 1);
+    }
+
+    #[test]
+    fn box_surfaces_do_not_share_vertices() {
+        let faces = box_faces(DVec3::ZERO, DVec3::ONE, Facing::Inward, 0.0).unwrap();
+        let mesh =
+            Mesh::build(&scene_of(Shape::Polygons(faces)), &MeshParams::try_new(0.5, 0.25).unwrap()).unwrap();
+        assert_eq!(mesh.surfaces.len(), 6);
+        assert_eq!(mesh.positions.len(), 6 * 25);
+        assert_eq!(mesh.occluders.len(), 12);
+    }
+
+    #[test]
+    fn sphere_facets_face_the_right_way() {
+        for facing in [Facing::Outward, Facing::Inward] {
+            let s = Sphere::try_new(DVec3::new(1.0, 2.0, 3.0), 2.0, facing).unwrap();
+            let mesh =
+                Mesh::build(&scene_of(Shape::Sphere(s)), &MeshParams::try_new(1.0, 0.5).unwrap()).unwrap();
+            let sign = if facing == Facing::Inward { -1.0 } else { 1.0 };
+            for e in &mesh.elements {
+                assert!(e.normal.dot(e.centre - s.center) * sign > 0.0);
+            }
+            for (p, n) in mesh.positions.iter().zip(&mesh.shading_normals) {
+                assert!(((*p - s.center).normalize() * sign - *n).length() < 1e-9);
+            }
+            // Closed: every edge is shared by exactly two facets.
+            let mut count = HashMap::new();
+            for e in &mesh.elements {
+                let v = e.vertex_indices();
+                for k in 0..v.len() {
+                    let (a, b) = (v[k], v[(k + 1) % v.len()]);
+                    *count.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+                }
+            }
+            assert!(count.values().all(|&c| c == 2));
+        }
+    }
+
+    #[test]
+    fn absurd_subdivision_is_an_error_not_a_hang() {
+        let faces = box_faces(DVec3::ZERO, DVec3::ONE, Facing::Inward, 0.0).unwrap();
+        let r = Mesh::build(&scene_of(Shape::Polygons(faces)), &MeshParams::try_new(1.0, 1e-5).unwrap());
+        assert!(matches!(r, Err(MeshError::TooManyElements { .. })));
+    }
+}

@@ -1,0 +1,562 @@
+//! Validated scene description: materials, objects (polygons, boxes, spheres), camera.
+//!
+//! Constructors here validate one piece at a time (`Material::try_new`, `Polygon::try_new`,
+//! `Sphere::try_new`, `Scene::try_new`) so that a file loader can attach a file/line location
+//! to each error it gets back.
+
+use glam::DVec3;
+use thiserror::Error;
+
+use crate::Rgb;
+
+/// Why a material, a piece of geometry or a whole scene is not acceptable.
+#[derive(Clone, Debug, Error, PartialEq)]
+pub enum SceneError {
+    /// A reflectance channel is outside [0, 1) or not finite.
+    #[error(
+        "reflectance of material '{material}' must be in [0, 1) in every channel, got {value:?} (ρ ≥ 1 never converges: energy is never lost)"
+    )]
+    ReflectanceOutOfRange {
+        /// Material name.
+        material: String,
+        /// The offending `[r, g, b]`.
+        value: [f64; 3],
+    },
+    /// An emission channel is negative or not finite.
+    #[error("emission of material '{material}' must be finite and ≥ 0 in every channel, got {value:?}")]
+    EmissionOutOfRange {
+        /// Material name.
+        material: String,
+        /// The offending `[r, g, b]`.
+        value: [f64; 3],
+    },
+    /// A coordinate is NaN or infinite.
+    #[error("coordinates must be finite numbers, got {value:?}")]
+    NonFiniteCoordinate {
+        /// The offending point.
+        value: [f64; 3],
+    },
+    /// A polygon has fewer than three vertices.
+    #[error("a polygon needs at least 3 vertices, got {count}")]
+    TooFewVertices {
+        /// Number of vertices given.
+        count: usize,
+    },
+    /// A polygon's area is zero (collinear or repeated vertices).
+    #[error("polygon is degenerate: its area is {area:e}, its vertices are collinear or repeated")]
+    DegeneratePolygon {
+        /// Area found.
+        area: f64,
+    },
+    /// A polygon's vertices do not lie in one plane.
+    #[error(
+        "polygon is not planar: a vertex is {distance:e} off the polygon's plane (tolerance {tolerance:e}); split it into triangles"
+    )]
+    NonPlanarPolygon {
+        /// Largest distance of a vertex from the best-fit plane.
+        distance: f64,
+        /// Tolerance used.
+        tolerance: f64,
+    },
+    /// A polygon is not convex.
+    #[error("polygon is not convex at vertex {vertex}; split it into convex polygons")]
+    NonConvexPolygon {
+        /// Index of the offending vertex.
+        vertex: usize,
+    },
+    /// A sphere radius is not a positive finite number.
+    #[error("sphere radius must be a finite number > 0, got {radius}")]
+    BadRadius {
+        /// Radius given.
+        radius: f64,
+    },
+    /// A box has min ≥ max on some axis.
+    #[error("box min must be below max on every axis, got min {min:?} max {max:?}")]
+    EmptyBox {
+        /// Minimum corner.
+        min: [f64; 3],
+        /// Maximum corner.
+        max: [f64; 3],
+    },
+    /// An object names a material that does not exist.
+    #[error("object '{object}' uses material '{material}', which is not defined (defined: {known})")]
+    UnknownMaterial {
+        /// Object name.
+        object: String,
+        /// Material name asked for.
+        material: String,
+        /// Comma-separated list of the defined materials.
+        known: String,
+    },
+    /// Two materials share a name.
+    #[error("material '{name}' is defined twice")]
+    DuplicateMaterial {
+        /// The repeated name.
+        name: String,
+    },
+    /// Nothing in the scene emits light.
+    #[error("the scene has no light: no object uses a material with emission > 0")]
+    NoEmitter,
+    /// The scene has no objects at all.
+    #[error("the scene has no objects")]
+    NoObjects,
+    /// A mesh size parameter is not a positive finite number.
+    #[error("{key} must be a finite number > 0, got {value}")]
+    BadMeshSize {
+        /// `patch_size` or `element_size`.
+        key: &'static str,
+        /// Value given.
+        value: f64,
+    },
+    /// A camera is degenerate.
+    #[error("camera is degenerate: {reason}")]
+    BadCamera {
+        /// What is wrong.
+        reason: String,
+    },
+}
+
+/// A diffuse (Lambertian) material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    /// Unique name.
+    pub name: String,
+    /// Diffuse reflectance ρ per channel, each in [0, 1).
+    pub reflectance: Rgb,
+    /// Emitted radiosity (exitance) E per channel, W/m² (scene units² for area), each ≥ 0.
+    pub emission: Rgb,
+}
+
+impl Material {
+    /// A validated material.
+    ///
+    /// # Errors
+    /// [`SceneError::ReflectanceOutOfRange`] when a channel of ρ is not in [0, 1) (ρ = 1 is the
+    /// source document's "never stops" case), [`SceneError::EmissionOutOfRange`] when emission is
+    /// negative or not finite.
+    pub fn try_new(name: &str, reflectance: Rgb, emission: Rgb) -> Result<Self, SceneError> {
+        let rho = reflectance.to_array();
+        if !rho.iter().all(|&v| v.is_finite() && (0.0..1.0).contains(&v)) {
+            return Err(SceneError::ReflectanceOutOfRange { material: name.to_owned(), value: rho });
+        }
+        let e = emission.to_array();
+        if !e.iter().all(|&v| v.is_finite() && v >= 0.0) {
+            return Err(SceneError::EmissionOutOfRange { material: name.to_owned(), value: e });
+        }
+        Ok(Self { name: name.to_owned(), reflectance, emission })
+    }
+
+    /// True when the material emits in some channel.
+    pub fn is_emitter(&self) -> bool {
+        self.emission.max_channel() > 0.0
+    }
+}
+
+fn check_finite(p: DVec3) -> Result<(), SceneError> {
+    if p.is_finite() { Ok(()) } else { Err(SceneError::NonFiniteCoordinate { value: p.to_array() }) }
+}
+
+/// A planar convex polygon, counter-clockwise seen from its lit (front) side.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Polygon {
+    vertices: Vec<DVec3>,
+    normal: DVec3,
+    area: f64,
+}
+
+impl Polygon {
+    /// A validated polygon.
+    ///
+    /// Planarity tolerance is 1e-4 of the polygon's diameter; that keeps measured data such as
+    /// the Cornell box (whose non-planar red wall is given as two triangles) exact.
+    ///
+    /// # Errors
+    /// Too few vertices, non-finite coordinates, zero area, non-planar or non-convex.
+    pub fn try_new(vertices: Vec<DVec3>) -> Result<Self, SceneError> {
+        if vertices.len() < 3 {
+            return Err(SceneError::TooFewVertices { count: vertices.len() });
+        }
+        for &v in &vertices {
+            check_finite(v)?;
+        }
+        // Newell's method: robust normal and area for any planar polygon.
+        let mut n = DVec3::ZERO;
+        for (i, &a) in vertices.iter().enumerate() {
+            let b = vertices[(i + 1) % vertices.len()];
+            n += a.cross(b);
+        }
+        let area = 0.5 * n.length();
+        let diameter =
+            vertices.iter().flat_map(|a| vertices.iter().map(move |b| a.distance(*b))).fold(0.0, f64::max);
+        if !(area > 1e-12 * diameter * diameter) || diameter == 0.0 {
+            return Err(SceneError::DegeneratePolygon { area });
+        }
+        let normal = n / n.length();
+        let centre = vertices.iter().copied().sum::<DVec3>() / vertices.len() as f64;
+        let tolerance = 1e-4 * diameter;
+        let distance = vertices.iter().map(|v| (*v - centre).dot(normal).abs()).fold(0.0, f64::max);
+        if distance > tolerance {
+            return Err(SceneError::NonPlanarPolygon { distance, tolerance });
+        }
+        let k = vertices.len();
+        for i in 0..k {
+            let a = vertices[(i + k - 1) % k];
+            let b = vertices[i];
+            let c = vertices[(i + 1) % k];
+            // A slightly negative turn is allowed for collinear points given with round-off.
+            if (b - a).cross(c - b).dot(normal) < -1e-9 * diameter * diameter {
+                return Err(SceneError::NonConvexPolygon { vertex: i });
+            }
+        }
+        Ok(Self { vertices, normal, area })
+    }
+
+    /// The vertices, counter-clockwise around [`Polygon::normal`].
+    pub fn vertices(&self) -> &[DVec3] {
+        &self.vertices
+    }
+
+    /// Unit normal of the lit side.
+    pub fn normal(&self) -> DVec3 {
+        self.normal
+    }
+
+    /// Area in scene units².
+    pub fn area(&self) -> f64 {
+        self.area
+    }
+
+    /// The same polygon with its vertices transformed by `f` (must keep it planar and convex,
+    /// e.g. a rigid motion or a uniform scale).
+    ///
+    /// # Errors
+    /// As [`Polygon::try_new`] for the transformed vertices.
+    pub fn try_map(&self, f: impl Fn(DVec3) -> DVec3) -> Result<Self, SceneError> {
+        Self::try_new(self.vertices.iter().map(|&v| f(v)).collect())
+    }
+}
+
+/// Which way the surface normals of a closed shape point.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Facing {
+    /// Lit from outside (a block, a ball).
+    #[default]
+    Outward,
+    /// Lit from inside (a room, a dome).
+    Inward,
+}
+
+/// A sphere, tessellated when the scene is meshed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sphere {
+    /// Centre, scene units.
+    pub center: DVec3,
+    /// Radius, scene units, > 0.
+    pub radius: f64,
+    /// Normals outward (a ball) or inward (a dome).
+    pub facing: Facing,
+}
+
+impl Sphere {
+    /// A validated sphere.
+    ///
+    /// # Errors
+    /// [`SceneError::BadRadius`] when radius ≤ 0 or not finite; non-finite centre.
+    pub fn try_new(center: DVec3, radius: f64, facing: Facing) -> Result<Self, SceneError> {
+        check_finite(center)?;
+        if !(radius.is_finite() && radius > 0.0) {
+            return Err(SceneError::BadRadius { radius });
+        }
+        Ok(Self { center, radius, facing })
+    }
+}
+
+/// The six faces of an axis-aligned box, optionally rotated about the vertical (y) axis
+/// through its centre.
+///
+/// # Errors
+/// [`SceneError::EmptyBox`] when `min` is not below `max` on every axis; non-finite input.
+pub fn box_faces(
+    min: DVec3,
+    max: DVec3,
+    facing: Facing,
+    rotate_y_deg: f64,
+) -> Result<Vec<Polygon>, SceneError> {
+    check_finite(min)?;
+    check_finite(max)?;
+    if !(min.x < max.x && min.y < max.y && min.z < max.z) || !rotate_y_deg.is_finite() {
+        return Err(SceneError::EmptyBox { min: min.to_array(), max: max.to_array() });
+    }
+    let c =
+        |x: usize, y: usize, z: usize| DVec3::new([min.x, max.x][x], [min.y, max.y][y], [min.z, max.z][z]);
+    // Outward-facing faces, counter-clockwise seen from outside.
+    let faces = [
+        [c(0, 0, 0), c(1, 0, 0), c(1, 0, 1), c(0, 0, 1)], // bottom (-y)
+        [c(0, 1, 0), c(0, 1, 1), c(1, 1, 1), c(1, 1, 0)], // top (+y)
+        [c(0, 0, 0), c(0, 1, 0), c(1, 1, 0), c(1, 0, 0)], // -z
+        [c(0, 0, 1), c(1, 0, 1), c(1, 1, 1), c(0, 1, 1)], // +z
+        [c(0, 0, 0), c(0, 0, 1), c(0, 1, 1), c(0, 1, 0)], // -x
+        [c(1, 0, 0), c(1, 1, 0), c(1, 1, 1), c(1, 0, 1)], // +x
+    ];
+    let centre = (min + max) * 0.5;
+    let rot = glam::DQuat::from_rotation_y(rotate_y_deg.to_radians());
+    faces
+        .iter()
+        .map(|f| {
+            let mut v: Vec<DVec3> = f.iter().map(|&p| centre + rot * (p - centre)).collect();
+            if facing == Facing::Inward {
+                v.reverse();
+            }
+            Polygon::try_new(v)
+        })
+        .collect()
+}
+
+/// The geometry of one object.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Shape {
+    /// One or more planar convex polygons (`polygon`, `polygons`, `box`, meshes).
+    Polygons(Vec<Polygon>),
+    /// A sphere.
+    Sphere(Sphere),
+}
+
+/// A named object with one material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Object {
+    /// Name, as reported per object in results.
+    pub name: String,
+    /// Index into [`Scene::materials`].
+    pub material: usize,
+    /// Geometry.
+    pub shape: Shape,
+}
+
+/// A pinhole camera.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    /// Eye position.
+    pub position: DVec3,
+    /// Point looked at.
+    pub look_at: DVec3,
+    /// Up direction (need not be orthogonal to the view direction).
+    pub up: DVec3,
+    /// Vertical field of view in degrees, in (0, 180).
+    pub fov_y_deg: f64,
+}
+
+impl Camera {
+    /// A validated camera.
+    ///
+    /// # Errors
+    /// [`SceneError::BadCamera`] when position equals look_at, up is parallel to the view
+    /// direction, the field of view is outside (0, 180) or a value is not finite.
+    pub fn try_new(position: DVec3, look_at: DVec3, up: DVec3, fov_y_deg: f64) -> Result<Self, SceneError> {
+        let bad = |reason: &str| Err(SceneError::BadCamera { reason: reason.to_owned() });
+        if !(position.is_finite() && look_at.is_finite() && up.is_finite() && fov_y_deg.is_finite()) {
+            return bad("a value is not finite");
+        }
+        let dir = look_at - position;
+        if dir.length() == 0.0 {
+            return bad("position and look_at are the same point");
+        }
+        if dir.normalize().cross(up).length() < 1e-6 * up.length() || up.length() == 0.0 {
+            return bad("up is zero or parallel to the viewing direction");
+        }
+        if !(fov_y_deg > 0.0 && fov_y_deg < 180.0) {
+            return bad("fov_y_deg must be in (0, 180)");
+        }
+        Ok(Self { position, look_at, up, fov_y_deg })
+    }
+
+    /// A camera that frames the box `[min, max]` from the -z side, looking at its centre.
+    pub fn framing(min: DVec3, max: DVec3) -> Self {
+        let centre = (min + max) * 0.5;
+        let radius = ((max - min).length() * 0.5).max(1e-9);
+        let fov_y_deg = 45.0_f64;
+        let distance = radius / (fov_y_deg.to_radians() * 0.5).sin();
+        Self { position: centre - DVec3::Z * distance, look_at: centre, up: DVec3::Y, fov_y_deg }
+    }
+}
+
+/// Stop settings a scene file may carry for the solver (all optional; the solver has defaults).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SolverSettings {
+    /// Stop when unshot power / emitted power falls to this.
+    pub unshot_threshold: Option<f64>,
+    /// Stop after this many shots.
+    pub max_shots: Option<u64>,
+    /// Stop after this many seconds.
+    pub time_limit: Option<f64>,
+}
+
+/// A validated scene: every material is in range, every object's material exists, and
+/// something emits.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    /// Display name.
+    pub name: String,
+    /// Camera given by the scene, if any.
+    pub camera: Option<Camera>,
+    /// Materials, referenced by index from objects.
+    pub materials: Vec<Material>,
+    /// Objects.
+    pub objects: Vec<Object>,
+    /// Subdivision given by the scene, if any (`None`: derived from the scene size).
+    pub mesh: Option<crate::MeshParams>,
+    /// Stop settings given by the scene.
+    pub solver: SolverSettings,
+}
+
+impl Scene {
+    /// A validated scene.
+    ///
+    /// # Errors
+    /// [`SceneError::NoObjects`], [`SceneError::NoEmitter`], [`SceneError::DuplicateMaterial`],
+    /// or an object whose material index is out of range (reported as
+    /// [`SceneError::UnknownMaterial`]).
+    pub fn try_new(
+        name: &str,
+        camera: Option<Camera>,
+        materials: Vec<Material>,
+        objects: Vec<Object>,
+    ) -> Result<Self, SceneError> {
+        for (i, m) in materials.iter().enumerate() {
+            if materials[..i].iter().any(|o| o.name == m.name) {
+                return Err(SceneError::DuplicateMaterial { name: m.name.clone() });
+            }
+        }
+        if objects.is_empty() {
+            return Err(SceneError::NoObjects);
+        }
+        for o in &objects {
+            if o.material >= materials.len() {
+                return Err(SceneError::UnknownMaterial {
+                    object: o.name.clone(),
+                    material: format!("#{}", o.material),
+                    known: materials.iter().map(|m| m.name.as_str()).collect::<Vec<_>>().join(", "),
+                });
+            }
+        }
+        if !objects.iter().any(|o| materials[o.material].is_emitter()) {
+            return Err(SceneError::NoEmitter);
+        }
+        Ok(Self {
+            name: name.to_owned(),
+            camera,
+            materials,
+            objects,
+            mesh: None,
+            solver: SolverSettings::default(),
+        })
+    }
+
+    /// Axis-aligned bounds `(min, max)` of all geometry.
+    pub fn bounds(&self) -> (DVec3, DVec3) {
+        let mut lo = DVec3::splat(f64::INFINITY);
+        let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        for o in &self.objects {
+            match &o.shape {
+                Shape::Polygons(ps) => {
+                    for v in ps.iter().flat_map(|p| p.vertices()) {
+                        lo = lo.min(*v);
+                        hi = hi.max(*v);
+                    }
+                }
+                Shape::Sphere(s) => {
+                    lo = lo.min(s.center - DVec3::splat(s.radius));
+                    hi = hi.max(s.center + DVec3::splat(s.radius));
+                }
+            }
+        }
+        (lo, hi)
+    }
+
+    /// The scene's camera, or one framing the whole scene.
+    pub fn camera_or_framing(&self) -> Camera {
+        self.camera.unwrap_or_else(|| {
+            let (lo, hi) = self.bounds();
+            Camera::framing(lo, hi)
+        })
+    }
+
+    /// Mesh parameters of the scene, or [`crate::MeshParams::for_extent`] of its bounds.
+    pub fn mesh_params(&self) -> crate::MeshParams {
+        self.mesh.unwrap_or_else(|| {
+            let (lo, hi) = self.bounds();
+            crate::MeshParams::for_extent((hi - lo).length())
+        })
+    }
+
+    /// Multiplies every emission by `scale` (the seed document's light intensity, S11).
+    pub fn scale_emission(&mut self, scale: f64) {
+        for m in &mut self.materials {
+            m.emission *= scale;
+        }
+    }
+
+    /// Total emitted power per channel, Σ E·A over emitting objects (spheres use their exact
+    /// area 4πR²).
+    pub fn emitted_power(&self) -> Rgb {
+        self.objects
+            .iter()
+            .map(|o| {
+                let area = match &o.shape {
+                    Shape::Polygons(ps) => ps.iter().map(Polygon::area).sum(),
+                    Shape::Sphere(s) => 4.0 * std::f64::consts::PI * s.radius * s.radius,
+                };
+                self.materials[o.material].emission * area
+            })
+            .sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn polygon_normal_follows_counter_clockwise_order() {
+        let p = Polygon::try_new(vec![DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y]).unwrap();
+        assert!((p.normal() - DVec3::Z).length() < 1e-12);
+        assert!((p.area() - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn bad_polygons_are_rejected() {
+        let col = vec![DVec3::ZERO, DVec3::X, DVec3::X * 2.0];
+        assert!(matches!(Polygon::try_new(col), Err(SceneError::DegeneratePolygon { .. })));
+        let bent = vec![DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.3), DVec3::Y];
+        assert!(matches!(Polygon::try_new(bent), Err(SceneError::NonPlanarPolygon { .. })));
+        let dart = vec![
+            DVec3::ZERO,
+            DVec3::new(2.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.3, 0.0),
+            DVec3::new(1.0, 2.0, 0.0),
+        ];
+        assert!(matches!(Polygon::try_new(dart), Err(SceneError::NonConvexPolygon { .. })));
+        let nan = vec![DVec3::ZERO, DVec3::X, DVec3::new(f64::NAN, 0.0, 0.0)];
+        assert!(matches!(Polygon::try_new(nan), Err(SceneError::NonFiniteCoordinate { .. })));
+    }
+
+    #[test]
+    fn reflectance_one_is_rejected() {
+        let e = Material::try_new("w", Rgb::new(0.5, 1.0, 0.5), Rgb::ZERO).unwrap_err();
+        assert!(matches!(e, SceneError::ReflectanceOutOfRange { .. }));
+        assert!(e.to_string().contains("[0, 1)"));
+        assert!(Material::try_new("w", Rgb::splat(f64::NAN), Rgb::ZERO).is_err());
+    }
+
+    #[test]
+    fn inward_box_faces_point_inside() {
+        let faces = box_faces(DVec3::ZERO, DVec3::ONE, Facing::Inward, 0.0).unwrap();
+        let centre = DVec3::splat(0.5);
+        for f in &faces {
+            assert!((centre - f.vertices()[0]).dot(f.normal()) > 0.0);
+        }
+        let out = box_faces(DVec3::ZERO, DVec3::ONE, Facing::Outward, 30.0).unwrap();
+        for f in &out {
+            assert!((centre - f.vertices()[0]).dot(f.normal()) < 0.0);
+        }
+    }
+}
