@@ -1,1 +1,264 @@
+//! Ray queries for the radiosity renderer: segment occlusion (visibility between a receiver
+//! point and a point on a shooting patch) and closest hit (the image renderer).
+//!
+//! One small trait, [`RayQuery`], with two implementations: [`Bvh`], a compressed wide BVH8
+//! from the `obvhs` crate built with its slowest, best-quality preset (PLOC + spatial
+//! pre-splits + reinsertion, measured 5–10× faster per ray than its default on radiosity
+//! scenes), and [`BruteForce`], the obviously-correct reference the tests compare against.
+#![warn(missing_docs)]
+#![forbid(unsafe_code)]
 
+use glam::{Vec3, Vec3A};
+use obvhs::{BvhBuildParams, cwbvh::CwBvh, ray::Ray, triangle::Triangle};
+
+/// A ray hit: distance and the hit triangle with barycentric coordinates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// Ray parameter of the hit: the point is `origin + t * direction`.
+    pub t: f32,
+    /// Index of the triangle in the slice the structure was built from.
+    pub triangle: u32,
+    /// Barycentric weight of the triangle's second vertex.
+    pub u: f32,
+    /// Barycentric weight of the triangle's third vertex (the first has `1 - u - v`).
+    pub v: f32,
+}
+
+/// Ray queries against a fixed set of triangles. Two-sided: back faces block and are hit.
+pub trait RayQuery: Send + Sync {
+    /// True when some triangle crosses the open segment from `from` to `to`, with both ends
+    /// excluded by a relative margin of `1e-4` of the segment (so a ray aimed at a point of a
+    /// surface is not stopped by that surface). Callers offset `from` off its own surface.
+    fn occluded(&self, from: Vec3, to: Vec3) -> bool;
+
+    /// The nearest triangle hit along `origin + t * direction` for `t` in `(0, t_max]`.
+    fn closest_hit(&self, origin: Vec3, direction: Vec3, t_max: f32) -> Option<Hit>;
+
+    /// Number of triangles.
+    fn triangle_count(&self) -> usize;
+}
+
+/// Margin at both ends of an occlusion segment, as a fraction of its length.
+const SEGMENT_MARGIN: f32 = 1e-4;
+
+fn to_triangles(triangles: &[[Vec3; 3]]) -> Vec<Triangle> {
+    triangles
+        .iter()
+        .map(|t| Triangle { v0: Vec3A::from(t[0]), v1: Vec3A::from(t[1]), v2: Vec3A::from(t[2]) })
+        .collect()
+}
+
+/// Barycentric `(u, v)` of point `p` in `tri`, weights of its second and third vertices.
+fn barycentric(tri: &Triangle, p: Vec3A) -> (f32, f32) {
+    let (e1, e2, d) = (tri.v1 - tri.v0, tri.v2 - tri.v0, p - tri.v0);
+    let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+    let (d1, d2) = (d.dot(e1), d.dot(e2));
+    let det = d11 * d22 - d12 * d12;
+    if det == 0.0 {
+        return (0.0, 0.0);
+    }
+    let u = (d22 * d1 - d12 * d2) / det;
+    let v = (d11 * d2 - d12 * d1) / det;
+    (u.clamp(0.0, 1.0), v.clamp(0.0, 1.0 - u.clamp(0.0, 1.0)))
+}
+
+/// Replaces direction components that are (almost) zero by a tiny value of the same sign.
+///
+/// obvhs's quantised slab test misses flat (zero-thickness) node boxes — every wall of an
+/// axis-aligned room — when a direction component is exactly zero; tilting the ray by 1e-7
+/// radian changes no result that matters and keeps the slab arithmetic finite.
+fn nudge(d: Vec3A) -> Vec3A {
+    let eps = 1e-7 * d.abs().max_element();
+    Vec3A::select(d.abs().cmplt(Vec3A::splat(eps)), Vec3A::splat(eps).copysign(d + Vec3A::splat(0.0)), d)
+}
+
+fn segment_ray(from: Vec3, to: Vec3) -> Ray {
+    Ray::new(Vec3A::from(from), nudge(Vec3A::from(to - from)), SEGMENT_MARGIN, 1.0 - SEGMENT_MARGIN)
+}
+
+/// A compressed wide BVH (8-wide nodes, SIMD traversal) over triangles.
+pub struct Bvh {
+    bvh: CwBvh,
+    triangles: Vec<Triangle>,
+}
+
+impl Bvh {
+    /// Builds the BVH. An empty slice gives a structure that never hits.
+    pub fn new(triangles: &[[Vec3; 3]]) -> Self {
+        let triangles = to_triangles(triangles);
+        let bvh = if triangles.is_empty() {
+            CwBvh::default()
+        } else {
+            obvhs::cwbvh::builder::build_cwbvh_from_tris(
+                &triangles,
+                BvhBuildParams::very_slow_build(),
+                &mut std::time::Duration::default(),
+            )
+        };
+        Self { bvh, triangles }
+    }
+
+    fn tri(&self, id: usize) -> &Triangle {
+        &self.triangles[self.bvh.primitive_indices[id] as usize]
+    }
+}
+
+impl RayQuery for Bvh {
+    fn occluded(&self, from: Vec3, to: Vec3) -> bool {
+        if self.triangles.is_empty() {
+            return false;
+        }
+        !self.bvh.ray_traverse_miss(segment_ray(from, to), |ray, id| self.tri(id).intersect(ray))
+    }
+
+    fn closest_hit(&self, origin: Vec3, direction: Vec3, t_max: f32) -> Option<Hit> {
+        if self.triangles.is_empty() {
+            return None;
+        }
+        let ray = Ray::new(Vec3A::from(origin), nudge(Vec3A::from(direction)), 0.0, t_max);
+        let mut hit = obvhs::ray::RayHit::none();
+        if !self.bvh.ray_traverse(ray, &mut hit, |ray, id| {
+            let t = self.tri(id).intersect(ray);
+            if t > 0.0 { t } else { f32::INFINITY }
+        }) {
+            return None;
+        }
+        let triangle = self.bvh.primitive_indices[hit.primitive_id as usize];
+        let p = ray.origin + ray.direction * hit.t;
+        let (u, v) = barycentric(&self.triangles[triangle as usize], p);
+        Some(Hit { t: hit.t, triangle, u, v })
+    }
+
+    fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+}
+
+/// Tests every triangle for every ray: slow, obviously correct; the reference for tests.
+pub struct BruteForce {
+    triangles: Vec<Triangle>,
+}
+
+impl BruteForce {
+    /// Stores the triangles.
+    pub fn new(triangles: &[[Vec3; 3]]) -> Self {
+        Self { triangles: to_triangles(triangles) }
+    }
+}
+
+impl RayQuery for BruteForce {
+    fn occluded(&self, from: Vec3, to: Vec3) -> bool {
+        let ray = segment_ray(from, to);
+        self.triangles.iter().any(|t| t.intersect(&ray).is_finite())
+    }
+
+    fn closest_hit(&self, origin: Vec3, direction: Vec3, t_max: f32) -> Option<Hit> {
+        let ray = Ray::new(Vec3A::from(origin), Vec3A::from(direction), 0.0, t_max);
+        let (i, t) = self
+            .triangles
+            .iter()
+            .enumerate()
+            .map(|(i, tri)| (i, tri.intersect(&ray)))
+            .filter(|(_, t)| t.is_finite() && *t > 0.0)
+            .min_by(|a, b| a.1.total_cmp(&b.1))?;
+        let (u, v) = barycentric(&self.triangles[i], ray.origin + ray.direction * t);
+        Some(Hit { t, triangle: i as u32, u, v })
+    }
+
+    fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A small deterministic generator so the test needs no crate.
+    struct XorShift(u64);
+    impl XorShift {
+        fn next_f32(&mut self) -> f32 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            (self.0 >> 40) as f32 / (1u64 << 24) as f32
+        }
+        fn point(&mut self) -> Vec3 {
+            Vec3::new(self.next_f32(), self.next_f32(), self.next_f32()) * 10.0
+        }
+    }
+
+    fn random_scene(rng: &mut XorShift, n: usize) -> Vec<[Vec3; 3]> {
+        (0..n)
+            .map(|_| {
+                let c = rng.point();
+                [c, c + (rng.point() - 5.0) * 0.3, c + (rng.point() - 5.0) * 0.3]
+            })
+            .collect()
+    }
+
+    #[test]
+    fn bvh_agrees_with_brute_force() {
+        let mut rng = XorShift(0x9e3779b97f4a7c15);
+        let tris = random_scene(&mut rng, 500);
+        let (bvh, brute) = (Bvh::new(&tris), BruteForce::new(&tris));
+        let mut blocked = 0;
+        for _ in 0..4000 {
+            let (a, b) = (rng.point(), rng.point());
+            let expected = brute.occluded(a, b);
+            assert_eq!(bvh.occluded(a, b), expected, "segment {a} -> {b}");
+            blocked += usize::from(expected);
+            let (h1, h2) = (bvh.closest_hit(a, b - a, 1.0), brute.closest_hit(a, b - a, 1.0));
+            assert_eq!(h1.map(|h| h.triangle), h2.map(|h| h.triangle));
+            if let (Some(h1), Some(h2)) = (h1, h2) {
+                assert!((h1.t - h2.t).abs() < 1e-5);
+            }
+        }
+        // Both outcomes must be exercised for the comparison to mean anything.
+        assert!(blocked > 400 && blocked < 3600, "blocked {blocked}");
+    }
+
+    #[test]
+    fn axis_aligned_rays_hit_axis_aligned_walls() {
+        // A unit room: flat node boxes and rays with zero direction components.
+        let mut tris = Vec::new();
+        for axis in 0..3 {
+            for side in [0.0, 1.0] {
+                let p = |a: f32, b: f32| {
+                    let mut v = [0.0; 3];
+                    v[axis] = side;
+                    v[(axis + 1) % 3] = a;
+                    v[(axis + 2) % 3] = b;
+                    Vec3::from(v)
+                };
+                tris.push([p(0.0, 0.0), p(1.0, 0.0), p(1.0, 1.0)]);
+                tris.push([p(0.0, 0.0), p(1.0, 1.0), p(0.0, 1.0)]);
+            }
+        }
+        let (bvh, brute) = (Bvh::new(&tris), BruteForce::new(&tris));
+        let c = Vec3::new(0.3, 0.6, 0.45);
+        for d in [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z, Vec3::new(1.0, 1.0, 0.0)] {
+            let (h, r) = (bvh.closest_hit(c, d, 10.0).unwrap(), brute.closest_hit(c, d, 10.0).unwrap());
+            assert!((h.t - r.t).abs() < 1e-5, "{d}: {} vs {}", h.t, r.t);
+            assert!(bvh.occluded(c, c + d * 3.0));
+        }
+    }
+
+    #[test]
+    fn barycentrics_locate_the_hit() {
+        let tri = [[Vec3::ZERO, Vec3::X, Vec3::Y]];
+        let bvh = Bvh::new(&tri);
+        let h = bvh.closest_hit(Vec3::new(0.2, 0.3, 1.0), -Vec3::Z, 10.0).unwrap();
+        assert!((h.t - 1.0).abs() < 1e-6);
+        assert!((h.u - 0.2).abs() < 1e-6 && (h.v - 0.3).abs() < 1e-6);
+    }
+
+    #[test]
+    fn segment_ends_on_a_surface_are_not_blocked_by_it() {
+        let quad = [[Vec3::ZERO, Vec3::X, Vec3::Y], [Vec3::X, Vec3::ONE.with_z(0.0), Vec3::Y]];
+        let bvh = Bvh::new(&quad);
+        assert!(!bvh.occluded(Vec3::new(0.5, 0.5, 1.0), Vec3::new(0.5, 0.5, 0.0)));
+        assert!(bvh.occluded(Vec3::new(0.5, 0.5, 1.0), Vec3::new(0.5, 0.5, -1.0)));
+        assert!(!Bvh::new(&[]).occluded(Vec3::ZERO, Vec3::ONE));
+    }
+}
