@@ -1,0 +1,76 @@
+//! What a solve produces: radiosity per element and per vertex, and summaries per object.
+
+use radiosity_core::{Mesh, Rgb};
+
+/// A snapshot of the solution, linear radiosity in W/unit².
+#[derive(Clone, Debug, Default)]
+pub struct Solution {
+    /// Radiosity B of every element (with the ambient term when it is on).
+    pub element_radiosity: Vec<Rgb>,
+    /// Radiosity interpolated at every mesh vertex: the area-weighted mean of the elements
+    /// around it, all on one surface (vertices are never shared across surfaces).
+    pub vertex_radiosity: Vec<Rgb>,
+    /// Unshot radiosity ΔB of every element (what it still has to shoot).
+    pub element_unshot: Vec<Rgb>,
+    /// Shots done when the snapshot was taken.
+    pub shots: u64,
+    /// Unshot power / emitted power when the snapshot was taken.
+    pub unshot_fraction: f64,
+}
+
+/// Area-weighted result for one object.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ObjectRadiosity {
+    /// Object name.
+    pub name: String,
+    /// Total area, scene units².
+    pub area: f64,
+    /// Emitted power per channel, E·A.
+    pub emitted_power: Rgb,
+    /// Area-weighted mean radiosity per channel.
+    pub radiosity: Rgb,
+}
+
+impl Solution {
+    /// Per-object area-weighted mean radiosity, in scene object order.
+    pub fn object_radiosity(&self, mesh: &Mesh) -> Vec<ObjectRadiosity> {
+        let mut out: Vec<ObjectRadiosity> = mesh
+            .object_names
+            .iter()
+            .map(|n| ObjectRadiosity {
+                name: n.clone(),
+                area: 0.0,
+                emitted_power: Rgb::ZERO,
+                radiosity: Rgb::ZERO,
+            })
+            .collect();
+        for (e, el) in mesh.elements.iter().enumerate() {
+            let o = &mut out[mesh.element_object(e)];
+            o.area += el.area;
+            o.emitted_power += mesh.element_material(e).emission * el.area;
+            o.radiosity += self.element_radiosity[e] * el.area;
+        }
+        for o in &mut out {
+            if o.area > 0.0 {
+                o.radiosity = o.radiosity / o.area;
+            }
+        }
+        out
+    }
+}
+
+/// Area-weighted average of element values at each vertex.
+pub(crate) fn vertex_average(mesh: &Mesh, element_values: &[Rgb], vertex_area: &[f64]) -> Vec<Rgb> {
+    let mut v = vec![Rgb::ZERO; mesh.positions.len()];
+    for (el, value) in mesh.elements.iter().zip(element_values) {
+        for &i in el.vertex_indices() {
+            v[i as usize] += *value * el.area;
+        }
+    }
+    for (value, area) in v.iter_mut().zip(vertex_area) {
+        if *area > 0.0 {
+            *value = *value / *area;
+        }
+    }
+    v
+}

@@ -1,0 +1,168 @@
+//! The solver against closed forms (`shared/references/closed_forms.md`).
+
+use std::sync::Arc;
+
+use radiosity_accel::Bvh;
+use radiosity_core::{
+    Mesh, MeshParams, Rgb, Scene, furnace_box, furnace_sphere, two_plates, unit_cube_floor_light,
+};
+use radiosity_solver::{Overshoot, Solver, SolverParams, StepBudget, StopReason, occluder_triangles};
+
+fn solver_for(scene: &Scene, params: SolverParams) -> Solver {
+    let mesh = Arc::new(Mesh::build(scene, &scene.mesh_params()).unwrap());
+    let accel = Arc::new(Bvh::new(&occluder_triangles(&mesh)));
+    Solver::new(mesh, accel, params).unwrap()
+}
+
+fn converged(scene: &Scene, threshold: f64) -> Solver {
+    let mut s = solver_for(scene, SolverParams { unshot_threshold: threshold, ..SolverParams::default() });
+    let r = s.solve();
+    assert_eq!(r.stop_reason, Some(StopReason::Converged));
+    s
+}
+
+fn rel(a: f64, b: f64) -> f64 {
+    (a - b).abs() / b.abs()
+}
+
+/// Furnace: in a closed enclosure with uniform ρ and E, B = E/(1 − ρ) everywhere. The
+/// discrete solution reaches it exactly when every row of form factors sums to 1; what is
+/// left is the receiver quadrature error (amplified by 1/(1 − ρ)) and the unshot remainder
+/// (ρ = 0.9 leaves up to 1e-4·E/(1 − ρ) unshot at the 1e-5 threshold). 0.5 % covers both.
+#[test]
+fn furnace_box_reaches_e_over_one_minus_rho_everywhere() {
+    for rho in [0.5, 0.9] {
+        let s = converged(&furnace_box(rho, 1.0), 1e-5);
+        let expected = 1.0 / (1.0 - rho);
+        for (e, b) in s.solution().element_radiosity.iter().enumerate() {
+            for c in b.to_array() {
+                assert!(rel(c, expected) < 5e-3, "rho {rho} element {e}: {c} vs {expected}");
+            }
+        }
+    }
+}
+
+#[test]
+fn furnace_sphere_reaches_e_over_one_minus_rho_everywhere() {
+    for rho in [0.5, 0.9] {
+        let s = converged(&furnace_sphere(rho, 1.0), 1e-5);
+        let expected = 1.0 / (1.0 - rho);
+        for (e, b) in s.solution().element_radiosity.iter().enumerate() {
+            assert!(rel(b.g, expected) < 5e-3, "rho {rho} element {e}: {} vs {expected}", b.g);
+        }
+    }
+}
+
+/// Unit cube, floor E = 1, ρ = 0.5, one patch per face: the exact discrete solution with
+/// exact area-to-area form factors is floor 1.0909, others 0.1818 (±0.5 %).
+#[test]
+fn unit_cube_matches_exact_discrete_solution() {
+    let scene = unit_cube_floor_light(0.5);
+    let s = converged(&scene, 1e-7);
+    let sol = s.solution();
+    assert_eq!(sol.element_radiosity.len(), 6);
+    let objects = sol.object_radiosity(s.mesh());
+    for o in objects {
+        let expected = if o.name == "floor" { 1.0909 } else { 0.1818 };
+        assert!(rel(o.radiosity.r, expected) < 5e-3, "{}: {} vs {expected}", o.name, o.radiosity.r);
+    }
+}
+
+/// Two opposed unit plates one apart: with the receiver's reflection escaping (the emitter
+/// has ρ = 0), the receiver's mean radiosity is exactly ρ·E·F₁₂ (Howell C-11, 0.199825).
+#[test]
+fn two_plates_receiver_gets_rho_e_f() {
+    let s = converged(&two_plates(1.0, 1.0, 0.5, 1.0), 1e-6);
+    let o = s.solution().object_radiosity(s.mesh());
+    let expected = 0.5 * 1.0 * 0.199825;
+    assert!(rel(o[1].radiosity.r, expected) < 1e-2, "{} vs {expected}", o[1].radiosity.r);
+}
+
+/// Energy: emitted = absorbed + unshot + escaped after every shot, to round-off.
+#[test]
+fn energy_is_conserved_after_every_shot() {
+    for scene in [two_plates(1.0, 0.5, 0.7, 2.0), furnace_box(0.8, 1.0)] {
+        let mut s = solver_for(&scene, SolverParams::default());
+        for _ in 0..60 {
+            s.step(StepBudget::Shots(1));
+            let e = s.energy();
+            let total = e.absorbed + e.unshot + e.escaped;
+            for (a, b) in total.to_array().iter().zip(e.emitted.to_array()) {
+                assert!(rel(*a, b) < 1e-9, "{a} vs {b}");
+            }
+        }
+    }
+}
+
+/// Same seed, 1 or 2 threads: bit-identical solutions.
+#[test]
+fn one_and_two_threads_agree_exactly() {
+    let scene = two_plates(1.0, 0.3, 0.6, 1.0);
+    let run = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            let mut s = solver_for(&scene, SolverParams { max_shots: Some(40), ..SolverParams::default() });
+            s.solve();
+            s.solution().element_radiosity
+        })
+    };
+    assert_eq!(run(1), run(2));
+}
+
+/// Overshooting converges to the same answer, in fewer shots.
+#[test]
+fn overshooting_agrees_with_plain_shooting() {
+    let scene = furnace_box(0.8, 1.0);
+    let plain = converged(&scene, 1e-4);
+    let mut over = solver_for(
+        &scene,
+        SolverParams {
+            unshot_threshold: 1e-4,
+            overshoot: Overshoot::Relaxation(1.5),
+            ..SolverParams::default()
+        },
+    );
+    assert_eq!(over.solve().stop_reason, Some(StopReason::Converged));
+    let (a, b) = (plain.solution().element_radiosity, over.solution().element_radiosity);
+    for (x, y) in a.iter().zip(&b) {
+        assert!(rel(x.r, y.r) < 2e-3, "{} vs {}", x.r, y.r);
+    }
+}
+
+/// Visibility: a blocker between the plates casts a shadow; the receiver gets less.
+#[test]
+fn a_blocker_casts_a_shadow() {
+    let open = converged(&two_plates(1.0, 1.0, 0.5, 1.0), 1e-6);
+    let mut scene = two_plates(1.0, 1.0, 0.5, 1.0);
+    let blocker = radiosity_core::Polygon::try_new(vec![
+        glam::DVec3::new(0.25, 0.25, 0.5),
+        glam::DVec3::new(0.75, 0.25, 0.5),
+        glam::DVec3::new(0.75, 0.75, 0.5),
+        glam::DVec3::new(0.25, 0.75, 0.5),
+    ])
+    .unwrap();
+    scene.materials.push(radiosity_core::Material::try_new("black", Rgb::ZERO, Rgb::ZERO).unwrap());
+    scene.objects.push(radiosity_core::Object {
+        name: "blocker".into(),
+        material: 2,
+        shape: radiosity_core::Shape::Polygons(vec![blocker]),
+    });
+    scene.mesh = Some(MeshParams::try_new(0.25, 0.0625).unwrap());
+    let shaded = converged(&scene, 1e-6);
+    let a = open.solution().object_radiosity(open.mesh())[1].radiosity.r;
+    let b = shaded.solution().object_radiosity(shaded.mesh())[1].radiosity.r;
+    assert!(b < 0.8 * a, "shadowed {b} vs open {a}");
+}
+
+#[test]
+fn shot_and_time_limits_stop_the_solve() {
+    let mut s =
+        solver_for(&furnace_box(0.9, 1.0), SolverParams { max_shots: Some(7), ..SolverParams::default() });
+    let r = s.solve();
+    assert_eq!((r.total_shots, r.stop_reason), (7, Some(StopReason::ShotLimit)));
+    let mut s = solver_for(
+        &furnace_box(0.9, 1.0),
+        SolverParams { time_limit: Some(std::time::Duration::ZERO), ..SolverParams::default() },
+    );
+    assert_eq!(s.solve().stop_reason, Some(StopReason::TimeLimit));
+}
