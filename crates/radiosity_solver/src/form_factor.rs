@@ -77,8 +77,33 @@ pub fn point_to_point(p: DVec3, n: DVec3, c: DVec3, nc: DVec3, area: f64) -> f64
 }
 
 /// Calls `f(point, weight)` for the centroids of an `n × n` subdivision of a triangle or a
-/// convex quad, with weights (sub-area / area) summing to 1.
-pub fn for_each_subcell(poly: &[DVec3], n: u32, mut f: impl FnMut(DVec3, f64)) {
+/// convex quad, with weights (sub-area / area) summing to 1 (the midpoint rule).
+pub fn for_each_subcell(poly: &[DVec3], n: u32, f: impl FnMut(DVec3, f64)) {
+    for_each_point(poly, n, Rule::Midpoint, f);
+}
+
+/// A quadrature rule applied on each of the `n × n` cells of a receiver.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Rule {
+    /// One point per cell (its centre); error ~ (cell size / distance)².
+    Midpoint,
+    /// 2 × 2 Gauss–Legendre points on quad cells, Dunavant's 6-point degree-4 rule on
+    /// triangle cells (Dunavant 1985); error ~ (cell size / distance)⁴.
+    Gauss,
+}
+
+/// Gauss–Legendre 2-point nodes on [0, 1]: (1 ∓ 1/√3) / 2.
+const GL2: [f64; 2] = [0.211_324_865_405_187_1, 0.788_675_134_594_812_9];
+
+/// Dunavant's degree-4 rule: (barycentric a, b, b) and its permutations, weight.
+const DUNAVANT4: [(f64, f64, f64); 2] = [
+    (0.108_103_018_168_070, 0.445_948_490_915_965, 0.223_381_589_678_011),
+    (0.816_847_572_980_459, 0.091_576_213_509_771, 0.109_951_743_655_322),
+];
+
+/// Calls `f(point, weight)` for the quadrature points of `rule` on an `n × n` subdivision of
+/// a triangle or a convex planar quad; the weights sum to 1.
+pub fn for_each_point(poly: &[DVec3], n: u32, rule: Rule, mut f: impl FnMut(DVec3, f64)) {
     let nf = n as f64;
     if poly.len() == 4 {
         let at = |u: f64, v: f64| {
@@ -87,30 +112,76 @@ pub fn for_each_subcell(poly: &[DVec3], n: u32, mut f: impl FnMut(DVec3, f64)) {
                 + poly[2] * (u * v)
                 + poly[3] * ((1.0 - u) * v)
         };
-        let area = |a: DVec3, b: DVec3, c: DVec3, d: DVec3| 0.5 * (c - a).cross(d - b).length();
-        let total = area(poly[0], poly[1], poly[2], poly[3]);
+        // |∂P/∂u × ∂P/∂v| of the bilinear map, linear in (u, v) for a planar quad.
+        let jacobian = |u: f64, v: f64| {
+            let du = (poly[1] - poly[0]) * (1.0 - v) + (poly[2] - poly[3]) * v;
+            let dv = (poly[3] - poly[0]) * (1.0 - u) + (poly[2] - poly[1]) * u;
+            du.cross(dv).length()
+        };
+        let total = 0.5 * (poly[2] - poly[0]).cross(poly[3] - poly[1]).length();
+        let cell = 1.0 / (nf * nf * total);
         for j in 0..n {
             for i in 0..n {
-                let (u0, v0, u1, v1) =
-                    (i as f64 / nf, j as f64 / nf, (i + 1) as f64 / nf, (j + 1) as f64 / nf);
-                let (a, b, c, d) = (at(u0, v0), at(u1, v0), at(u1, v1), at(u0, v1));
-                // Midpoint of a bilinear cell; exact centroid for parallelograms.
-                f(at((u0 + u1) * 0.5, (v0 + v1) * 0.5), area(a, b, c, d) / total);
+                let (u0, v0) = (i as f64 / nf, j as f64 / nf);
+                match rule {
+                    Rule::Midpoint => {
+                        let (u, v) = (u0 + 0.5 / nf, v0 + 0.5 / nf);
+                        f(at(u, v), jacobian(u, v) * cell);
+                    }
+                    Rule::Gauss => {
+                        for gv in GL2 {
+                            for gu in GL2 {
+                                let (u, v) = (u0 + gu / nf, v0 + gv / nf);
+                                f(at(u, v), 0.25 * jacobian(u, v) * cell);
+                            }
+                        }
+                    }
+                }
             }
         }
     } else {
         let (a, e1, e2) = (poly[0], (poly[1] - poly[0]) / nf, (poly[2] - poly[0]) / nf);
         let w = 1.0 / (nf * nf);
+        // A sub-triangle with corners p, p + s, p + t (s, t possibly negated for the
+        // inverted cells).
+        let mut cell = |p: DVec3, s: DVec3, t: DVec3| match rule {
+            Rule::Midpoint => f(p + (s + t) / 3.0, w),
+            Rule::Gauss => {
+                for (x, y, wk) in DUNAVANT4 {
+                    for (b1, b2) in [(y, y), (x, y), (y, x)] {
+                        f(p + s * b1 + t * b2, w * wk);
+                    }
+                }
+            }
+        };
         for j in 0..n {
             for i in 0..n - j {
-                let (x, y) = (i as f64, j as f64);
-                f(a + e1 * (x + 1.0 / 3.0) + e2 * (y + 1.0 / 3.0), w);
+                let p = a + e1 * i as f64 + e2 * j as f64;
+                cell(p, e1, e2);
                 if i + j + 2 <= n {
-                    f(a + e1 * (x + 2.0 / 3.0) + e2 * (y + 2.0 / 3.0), w);
+                    cell(p + e1 + e2, -e1, -e2);
                 }
             }
         }
     }
+}
+
+/// Distance from `p` to a convex planar polygon with unit normal `n`.
+pub fn distance_to_polygon(p: DVec3, n: DVec3, poly: &[DVec3]) -> f64 {
+    let k = poly.len();
+    let height = n.dot(p - poly[0]);
+    let q = p - n * height;
+    let inside = (0..k).all(|i| (poly[(i + 1) % k] - poly[i]).cross(q - poly[i]).dot(n) >= 0.0);
+    if inside {
+        return height.abs();
+    }
+    (0..k)
+        .map(|i| {
+            let (a, b) = (poly[i], poly[(i + 1) % k]);
+            let t = ((p - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
+            p.distance(a + (b - a) * t)
+        })
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// Unoccluded area-to-area form factor `F(receiver → shooter)` by `n × n` midpoint quadrature
@@ -123,8 +194,20 @@ pub fn polygon_to_polygon(
     shooter_normal: DVec3,
     n: u32,
 ) -> f64 {
+    polygon_to_polygon_with(receiver, receiver_normal, shooter, shooter_normal, n, Rule::Midpoint)
+}
+
+/// As [`polygon_to_polygon`], with a choice of quadrature rule on each cell.
+pub fn polygon_to_polygon_with(
+    receiver: &[DVec3],
+    receiver_normal: DVec3,
+    shooter: &[DVec3],
+    shooter_normal: DVec3,
+    n: u32,
+    rule: Rule,
+) -> f64 {
     let mut f = 0.0;
-    for_each_subcell(receiver, n, |p, w| {
+    for_each_point(receiver, n, rule, |p, w| {
         if shooter_normal.dot(p - shooter[0]) > 0.0 {
             f += w * point_to_polygon(p, receiver_normal, shooter);
         }
@@ -234,6 +317,64 @@ mod tests {
             let expected = c14(1.0, w, h);
             assert!((f - expected).abs() < 1e-3 * expected, "C-14 w={w} h={h}: {f} vs {expected}");
         }
+    }
+
+    #[test]
+    fn gauss_cells_beat_midpoint_cells() {
+        // Same 2×2 cells (each as big as the gap): the Gauss rule's error (measured 4e-4) is
+        // far below the midpoint rule's.
+        let lower = square(0.0, 1.0, false);
+        let upper = square(1.0, 1.0, true);
+        let expected = c11(1.0, 1.0, 1.0);
+        let mid = polygon_to_polygon_with(&lower, DVec3::Z, &upper, -DVec3::Z, 2, Rule::Midpoint);
+        let gauss = polygon_to_polygon_with(&lower, DVec3::Z, &upper, -DVec3::Z, 2, Rule::Gauss);
+        assert!((gauss - expected).abs() < 1e-3 * expected, "{gauss} vs {expected}");
+        assert!((gauss - expected).abs() < 0.1 * (mid - expected).abs());
+        // Triangles: split the lower square in two and integrate each half.
+        let (t1, t2) = ([lower[0], lower[1], lower[2]], [lower[0], lower[2], lower[3]]);
+        let f = 0.5 * polygon_to_polygon_with(&t1, DVec3::Z, &upper, -DVec3::Z, 2, Rule::Gauss)
+            + 0.5 * polygon_to_polygon_with(&t2, DVec3::Z, &upper, -DVec3::Z, 2, Rule::Gauss);
+        assert!((f - expected).abs() < 1e-3 * expected, "{f} vs {expected}");
+    }
+
+    #[test]
+    fn quadrature_weights_sum_to_one() {
+        let trapezoid =
+            [DVec3::ZERO, DVec3::new(3.0, 0.0, 0.0), DVec3::new(2.0, 1.0, 0.0), DVec3::new(1.0, 1.0, 0.0)];
+        let tri = [DVec3::ZERO, DVec3::X, DVec3::new(0.2, 2.0, 0.0)];
+        for rule in [Rule::Midpoint, Rule::Gauss] {
+            for n in [1, 3] {
+                for poly in [&trapezoid[..], &tri[..]] {
+                    let (mut w, mut c) = (0.0, DVec3::ZERO);
+                    for_each_point(poly, n, rule, |p, wk| {
+                        w += wk;
+                        c += p * wk;
+                    });
+                    assert!((w - 1.0).abs() < 1e-12, "{rule:?} {n}: {w}");
+                    if rule == Rule::Gauss {
+                        // Degree ≥ 1 exact: the weighted mean point is the centroid.
+                        let area: f64 = (1..poly.len() - 1)
+                            .map(|i| 0.5 * (poly[i] - poly[0]).cross(poly[i + 1] - poly[0]).length())
+                            .sum();
+                        let centroid: DVec3 = (1..poly.len() - 1)
+                            .map(|i| {
+                                (poly[0] + poly[i] + poly[i + 1]) / 3.0
+                                    * (0.5 * (poly[i] - poly[0]).cross(poly[i + 1] - poly[0]).length())
+                            })
+                            .sum::<DVec3>()
+                            / area;
+                        assert!((c - centroid).length() < 1e-12);
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn distance_to_polygon_inside_and_outside() {
+        let sq = square(0.0, 1.0, false);
+        assert!((distance_to_polygon(DVec3::new(0.5, 0.5, 2.0), DVec3::Z, &sq) - 2.0).abs() < 1e-12);
+        assert!((distance_to_polygon(DVec3::new(2.0, 0.5, 0.0), DVec3::Z, &sq) - 1.0).abs() < 1e-12);
     }
 
     #[test]
