@@ -1,1 +1,44 @@
-fn main() {}
+//! `radiosity`: solve, render and view diffuse global illumination by progressive shooting.
+
+mod bench_cmd;
+mod info_cmd;
+mod prepare;
+mod solve_cmd;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// Progressive-refinement radiosity renderer (the shooting method).
+#[derive(Parser)]
+#[command(name = "radiosity", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Solve a scene headless and report per-object radiosity.
+    Solve(solve_cmd::SolveArgs),
+    /// Print counts, areas, emitted power and warnings for a scene.
+    Info(info_cmd::InfoArgs),
+    /// Run the fixed benchmark cases and print figures.
+    Bench(bench_cmd::BenchArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Solve(a) => solve_cmd::run(a),
+        Command::Info(a) => info_cmd::run(a),
+        Command::Bench(a) => bench_cmd::run(a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {}", prepare::one_line(&e));
+            ExitCode::from(prepare::exit_code(&e))
+        }
+    }
+}

@@ -1,0 +1,58 @@
+//! `radiosity info`: what a scene holds, before solving it.
+
+use anyhow::Result;
+use clap::Args;
+use radiosity_core::Rgb;
+
+use crate::prepare::{SolveOpts, prepare};
+
+/// Arguments of `radiosity info`.
+#[derive(Args)]
+pub struct InfoArgs {
+    /// Scene file (.toml) or built-in name.
+    pub scene: String,
+    #[command(flatten)]
+    pub solve: SolveOpts,
+}
+
+/// Runs `info`.
+pub fn run(a: InfoArgs) -> Result<()> {
+    let p = prepare(&a.scene, &a.solve)?;
+    let (scene, mesh) = (&p.scene, &p.mesh);
+    let (lo, hi) = mesh.bounds();
+    println!("scene      {}", scene.name);
+    println!("bounds     {:?} .. {:?}", lo.to_array(), hi.to_array());
+    println!("materials  {}", scene.materials.len());
+    println!("objects    {}", scene.objects.len());
+    println!("surfaces   {}", mesh.surfaces.len());
+    println!("patches    {}", mesh.patches.len());
+    println!("elements   {}", mesh.elements.len());
+    println!("occluders  {} triangles", mesh.occluders.len());
+    println!("area       {:.6e}", mesh.total_area());
+    let emitted: Rgb = (0..mesh.elements.len()).map(|e| mesh.element_material(e).emission * mesh.elements[e].area).sum();
+    println!("emitted    [{:.6e}, {:.6e}, {:.6e}] W", emitted.r, emitted.g, emitted.b);
+    let mut warnings = Vec::new();
+    for m in &scene.materials {
+        if m.reflectance.max_channel() > 0.95 {
+            warnings.push(format!(
+                "material '{}' reflects {:.3} in a channel: light bounces ~{:.0} times, convergence is slow",
+                m.name,
+                m.reflectance.max_channel(),
+                1.0 / (1.0 - m.reflectance.max_channel())
+            ));
+        }
+        if m.is_emitter() && m.reflectance.max_channel() > 0.0 {
+            warnings.push(format!("light material '{}' also reflects light (reflectance > 0)", m.name));
+        }
+    }
+    if mesh.elements.len() > 1_000_000 {
+        warnings.push(format!("{} elements: solving will be slow; raise element_size", mesh.elements.len()));
+    }
+    if scene.camera.is_none() {
+        warnings.push("no [camera]: views frame the whole scene".into());
+    }
+    for w in &warnings {
+        println!("warning    {w}");
+    }
+    Ok(())
+}

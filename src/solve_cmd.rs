@@ -1,0 +1,78 @@
+//! `radiosity solve`: headless solve, summary and JSON report.
+
+use anyhow::Result;
+use clap::Args;
+use serde_json::json;
+
+use crate::prepare::{Prepared, SolveOpts, prepare, run_solver, write_output};
+
+/// Arguments of `radiosity solve`.
+#[derive(Args)]
+pub struct SolveArgs {
+    /// Scene file (.toml) or built-in name (cornell, furnace, seed-room, two-plates).
+    pub scene: String,
+    /// Write the JSON report here (`-` for stdout).
+    #[arg(long)]
+    pub json: Option<String>,
+    /// Overwrite an existing report file.
+    #[arg(long)]
+    pub force: bool,
+    #[command(flatten)]
+    pub solve: SolveOpts,
+}
+
+/// Runs `solve`.
+pub fn run(a: SolveArgs) -> Result<()> {
+    let prepared = prepare(&a.scene, &a.solve)?;
+    if let Some(path) = &a.json
+        && path != "-"
+    {
+        crate::prepare::check_writable(std::path::Path::new(path), a.force)?;
+    }
+    let (solver, report) = run_solver(&prepared)?;
+    let Prepared { scene, mesh, .. } = &prepared;
+    let solution = solver.solution();
+    let objects = solution.object_radiosity(mesh);
+    let secs = report.elapsed.as_secs_f64();
+    let stop = report.stop_reason.map_or("running", |s| s.as_str());
+    // The source document's figures (S13): facets, iterations, time.
+    eprintln!(
+        "{}: {} patches, {} elements, {} shots, {:.3} s, {} rays ({:.2} M rays/s), unshot {:.4} %, {}",
+        scene.name,
+        mesh.patches.len(),
+        mesh.elements.len(),
+        report.total_shots,
+        secs,
+        report.rays,
+        report.rays as f64 / secs.max(1e-9) / 1e6,
+        report.unshot_fraction * 100.0,
+        stop
+    );
+    if a.json.as_deref() != Some("-") {
+        println!("{:<24} {:>12} {:>36} {:>36}", "object", "area", "emitted power [r g b]", "mean radiosity [r g b]");
+        for o in &objects {
+            let f = |c: radiosity_core::Rgb| format!("{:>11.4e} {:>11.4e} {:>11.4e}", c.r, c.g, c.b);
+            println!("{:<24} {:>12.4e} {:>36} {:>36}", o.name, o.area, f(o.emitted_power), f(o.radiosity));
+        }
+    }
+    if let Some(path) = &a.json {
+        let doc = json!({
+            "scene": scene.name,
+            "patches": mesh.patches.len(),
+            "elements": mesh.elements.len(),
+            "shots": report.total_shots,
+            "unshot_fraction": report.unshot_fraction,
+            "stop_reason": stop,
+            "seconds": secs,
+            "rays": report.rays,
+            "objects": objects.iter().map(|o| json!({
+                "name": o.name,
+                "area": o.area,
+                "emitted_power": o.emitted_power.to_array(),
+                "radiosity": o.radiosity.to_array(),
+            })).collect::<Vec<_>>(),
+        });
+        write_output(path, &serde_json::to_string_pretty(&doc)?, a.force)?;
+    }
+    Ok(())
+}

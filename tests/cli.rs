@@ -1,0 +1,121 @@
+//! The `radiosity` command end to end: reports, errors and exit codes.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn radiosity(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_radiosity")).args(args).output().expect("run radiosity")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn report(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// Two opposed unit plates one apart, solved through `solve --json`: the receiver's mean is
+/// ρ·E·F₁₂ with F₁₂ from Howell C-11 (0.199825); 1 % covers quadrature and the 1e-6 remainder.
+#[test]
+fn two_plates_report_matches_c11() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("r.json");
+    let o = radiosity(&["solve", "two-plates", "--unshot-threshold", "1e-6", "--json", json.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let r = report(&json);
+    for key in ["elements", "patches", "shots", "unshot_fraction", "stop_reason", "seconds", "rays", "objects"] {
+        assert!(r.get(key).is_some(), "report lacks {key}");
+    }
+    assert_eq!(r["stop_reason"], "converged");
+    let receiver = r["objects"].as_array().unwrap().iter().find(|o| o["name"] == "receiver").unwrap();
+    let b = receiver["radiosity"][0].as_f64().unwrap();
+    let expected = 0.5 * 1.0 * 0.199825;
+    assert!((b - expected).abs() < 0.01 * expected, "{b} vs {expected}");
+    // The summary line carries the source document's figures.
+    let err = stderr(&o);
+    assert!(err.contains("patches") && err.contains("elements") && err.contains("shots"), "{err}");
+}
+
+#[test]
+fn one_and_two_threads_give_the_same_report() {
+    let run = |threads: &str| {
+        let o = radiosity(&["solve", "cornell", "--max-shots", "30", "--threads", threads, "--json", "-"]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        v["objects"].clone()
+    };
+    assert_eq!(run("1"), run("2"));
+}
+
+#[test]
+fn malformed_scene_is_one_line_with_exit_code_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = [
+        ("rho.toml", "[[material]]\nname = \"w\"\nreflectance = [1.0, 0.5, 0.5]\nemission = [1, 1, 1]\n[[object]]\nname = \"o\"\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"w\"\n", "[0, 1)"),
+        ("syntax.toml", "[[material]\nname = 1\n", "syntax.toml:"),
+        ("unknown.toml", "colour = 3\n", "colour"),
+    ];
+    for (name, text, needle) in cases {
+        let path = dir.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        let o = radiosity(&["solve", path.to_str().unwrap()]);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{name}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{name}: {err}");
+        assert!(err.contains(needle) && err.contains(name), "{name}: {err}");
+        assert!(!err.contains("panicked"), "{name}: {err}");
+    }
+    let o = radiosity(&["solve", "no-such-scene"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}
+
+#[test]
+fn bad_options_are_input_errors() {
+    for args in [
+        &["solve", "furnace", "--element-size", "-1"][..],
+        &["solve", "furnace", "--unshot-threshold", "2"][..],
+        &["solve", "furnace", "--light-scale", "nan"][..],
+        &["solve", "furnace", "--threads", "0"][..],
+    ] {
+        let o = radiosity(args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+    }
+}
+
+#[test]
+fn an_existing_report_is_not_overwritten_without_force() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("r.json");
+    std::fs::write(&json, "precious").unwrap();
+    let o = radiosity(&["solve", "furnace", "--max-shots", "2", "--json", json.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(std::fs::read_to_string(&json).unwrap(), "precious");
+    let o = radiosity(&["solve", "furnace", "--max-shots", "2", "--json", json.to_str().unwrap(), "--force"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(report(&json)["shots"], 2);
+}
+
+#[test]
+fn light_scale_scales_radiosity() {
+    let mean = |scale: &str| {
+        let o = radiosity(&["solve", "furnace", "--light-scale", scale, "--json", "-"]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        v["objects"][0]["radiosity"][0].as_f64().unwrap()
+    };
+    let (one, five) = (mean("1"), mean("5"));
+    assert!((five / one - 5.0).abs() < 1e-9, "{one} {five}");
+    // The furnace: B = E/(1 − ρ) = 2 (ρ = 0.5, E = 1), 0.5 % as in the solver's tests.
+    assert!((one - 2.0).abs() < 0.01, "{one}");
+}
+
+#[test]
+fn info_prints_counts_and_power() {
+    let o = radiosity(&["info", "cornell"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    for key in ["patches", "elements", "emitted", "area"] {
+        assert!(out.contains(key), "{out}");
+    }
+}
