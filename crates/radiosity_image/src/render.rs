@@ -1,0 +1,514 @@
+//! The CPU renderer: ray casts a lit mesh from a pinhole camera into a picture of radiance.
+//!
+//! Every surface is Lambertian, so the radiance leaving a point towards the eye is
+//! L = B / π whatever the direction (B the radiosity, W/unit²), and a picture needs only one
+//! primary ray per sample — no further bounces: the radiosity solution already holds them.
+//!
+//! B at a hit point is either the element's own value ([`Shading::Flat`]) or interpolated from
+//! the solution's vertex radiosity ([`Shading::Smooth`], Gouraud-style as in Cohen et al.
+//! 1986): barycentric on triangles, bilinear on quads (inverse bilinear mapping, after Quílez,
+//! "Inverse bilinear interpolation", 2010). Both are linear along an edge between its two
+//! vertices, so neighbouring elements agree on their shared edge and the result is continuous
+//! across element edges; vertices are shared only within one surface, so nothing is blended
+//! round a corner.
+//!
+//! Samples: `samples_per_pixel` jittered positions per pixel, on a stratified √n × √n grid
+//! first, any rest uniformly in the pixel; the box-filtered mean is the pixel. Random numbers
+//! come from `(seed, pixel index)`, so any thread count gives the same picture.
+
+use std::f64::consts::PI;
+use std::sync::Arc;
+
+use glam::{DVec2, DVec3, Vec3};
+use radiosity_accel::{Bvh, RayQuery};
+use radiosity_core::{Camera, Mesh, Rgb};
+use radiosity_solver::Solution;
+use rayon::prelude::*;
+use thiserror::Error;
+
+use crate::HdrImage;
+
+/// How radiosity is taken at a hit point.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Shading {
+    /// Interpolated from the element's vertices: smooth within a surface, never across one.
+    #[default]
+    Smooth,
+    /// The element's own radiosity: shows the mesh, as the solver sees it.
+    Flat,
+}
+
+impl Shading {
+    /// The name on the command line: `smooth` or `flat`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Shading::Smooth => "smooth",
+            Shading::Flat => "flat",
+        }
+    }
+}
+
+/// Renderer settings; every field has a unit, a range and a default.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RenderParams {
+    /// Picture width in pixels, in 1..=16384. Default 640.
+    pub width: u32,
+    /// Picture height in pixels, in 1..=16384. Default 480.
+    pub height: u32,
+    /// Jittered samples per pixel, in 1..=4096. Default 16 (4 × 4 strata: clean edges).
+    pub samples_per_pixel: u32,
+    /// Radiosity at a hit point. Default [`Shading::Smooth`].
+    pub shading: Shading,
+    /// Seed of the jitter. Default 0.
+    pub seed: u64,
+}
+
+impl Default for RenderParams {
+    fn default() -> Self {
+        Self { width: 640, height: 480, samples_per_pixel: 16, shading: Shading::Smooth, seed: 0 }
+    }
+}
+
+impl RenderParams {
+    /// Largest width or height accepted.
+    pub const MAX_SIDE: u32 = 16384;
+    /// Largest number of samples per pixel accepted.
+    pub const MAX_SAMPLES: u32 = 4096;
+
+    /// Small and quick, for thumbnails and tests: 160 × 120, 4 samples per pixel.
+    pub fn preview() -> Self {
+        Self { width: 160, height: 120, samples_per_pixel: 4, ..Self::default() }
+    }
+
+    /// Large and clean, for figures: 1280 × 960, 64 samples per pixel.
+    pub fn high_quality() -> Self {
+        Self { width: 1280, height: 960, samples_per_pixel: 64, ..Self::default() }
+    }
+
+    /// Checks every field's range.
+    ///
+    /// # Errors
+    /// [`RenderError::BadParameter`] naming the first field out of range.
+    pub fn validate(&self) -> Result<(), RenderError> {
+        let check = |name: &'static str, value: u32, max: u32| {
+            if (1..=max).contains(&value) {
+                Ok(())
+            } else {
+                Err(RenderError::BadParameter {
+                    name,
+                    value: u64::from(value),
+                    expected: format!("1..={max}"),
+                })
+            }
+        };
+        check("width", self.width, Self::MAX_SIDE)?;
+        check("height", self.height, Self::MAX_SIDE)?;
+        check("samples_per_pixel", self.samples_per_pixel, Self::MAX_SAMPLES)
+    }
+}
+
+/// Why a picture cannot be rendered.
+#[derive(Clone, Debug, Error, PartialEq)]
+pub enum RenderError {
+    /// A parameter is out of range.
+    #[error("render parameter {name} = {value} is out of range: expected {expected}")]
+    BadParameter {
+        /// Field name.
+        name: &'static str,
+        /// Value given.
+        value: u64,
+        /// The accepted range.
+        expected: String,
+    },
+    /// The solution was computed for another mesh.
+    #[error(
+        "the solution does not fit the mesh: {solution_elements} element and {solution_vertices} vertex values for {mesh_elements} elements and {mesh_vertices} vertices"
+    )]
+    SolutionMismatch {
+        /// Element values in the solution.
+        solution_elements: usize,
+        /// Vertex values in the solution.
+        solution_vertices: usize,
+        /// Elements in the mesh.
+        mesh_elements: usize,
+        /// Vertices in the mesh.
+        mesh_vertices: usize,
+    },
+}
+
+/// What a single ray sees.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceHit {
+    /// The element hit, index into [`Mesh::elements`].
+    pub element: u32,
+    /// Its object, index into [`Mesh::object_names`].
+    pub object: u32,
+    /// Hit point, world space.
+    pub p_world: DVec3,
+    /// Distance along the (unit) ray direction, scene units.
+    pub distance: f64,
+    /// True when the ray meets the lit (front) side of the element.
+    pub front_facing: bool,
+    /// Radiance towards the eye, W·sr⁻¹/unit² per channel: B/π on the front side, 0 on the
+    /// back (radiosity surfaces are one-sided; nothing leaves their back).
+    pub radiance: Rgb,
+}
+
+/// A rendered picture and, per pixel, the object seen through its centre.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Rendering {
+    /// Linear radiance per pixel.
+    pub radiance: HdrImage,
+    /// Per pixel (top row first), the object hit by a ray through the pixel's centre, or
+    /// `None` where that ray leaves the scene.
+    pub object_ids: Vec<Option<u32>>,
+}
+
+/// Ray casts one lit mesh: holds a BVH over the element triangles (built once, reused for
+/// every picture and every snapshot of the solution).
+pub struct Renderer {
+    mesh: Arc<Mesh>,
+    accel: Bvh,
+    /// Element of every triangle given to the BVH.
+    triangle_element: Vec<u32>,
+}
+
+impl Renderer {
+    /// Builds the ray-query structure over the element triangles of `mesh` (the elements, not
+    /// the coarser occluders, so a hit names the element whose radiosity to use).
+    pub fn new(mesh: Arc<Mesh>) -> Self {
+        let (triangle_element, triangles): (Vec<u32>, Vec<[Vec3; 3]>) = mesh
+            .element_triangles()
+            .map(|(e, t)| (e, t.map(|i| mesh.positions[i as usize].as_vec3())))
+            .unzip();
+        let accel = Bvh::new(&triangles);
+        Self { mesh, accel, triangle_element }
+    }
+
+    /// The mesh being drawn.
+    pub fn mesh(&self) -> &Arc<Mesh> {
+        &self.mesh
+    }
+
+    fn check(&self, solution: &Solution) -> Result<(), RenderError> {
+        let m = &self.mesh;
+        if solution.element_radiosity.len() != m.elements.len()
+            || solution.vertex_radiosity.len() != m.positions.len()
+        {
+            return Err(RenderError::SolutionMismatch {
+                solution_elements: solution.element_radiosity.len(),
+                solution_vertices: solution.vertex_radiosity.len(),
+                mesh_elements: m.elements.len(),
+                mesh_vertices: m.positions.len(),
+            });
+        }
+        Ok(())
+    }
+
+    /// Traces one ray from `origin` along `direction` (any length > 0) and returns what it
+    /// sees, or `None` when it leaves the scene.
+    ///
+    /// # Errors
+    /// [`RenderError::SolutionMismatch`] when `solution` was computed for another mesh.
+    pub fn trace(
+        &self,
+        solution: &Solution,
+        origin: DVec3,
+        direction: DVec3,
+        shading: Shading,
+    ) -> Result<Option<SurfaceHit>, RenderError> {
+        self.check(solution)?;
+        Ok(self.trace_unchecked(solution, origin, direction.normalize(), shading))
+    }
+
+    /// `trace` for a solution already checked and a unit direction.
+    fn trace_unchecked(
+        &self,
+        solution: &Solution,
+        origin: DVec3,
+        dir: DVec3,
+        shading: Shading,
+    ) -> Option<SurfaceHit> {
+        let hit = self.accel.closest_hit(origin.as_vec3(), dir.as_vec3(), f32::MAX)?;
+        let e = self.triangle_element[hit.triangle as usize] as usize;
+        let el = &self.mesh.elements[e];
+        // Recompute the hit in double precision against the element's plane: the BVH works in
+        // single precision, and interpolation wants the point on the plane.
+        let denom = el.normal.dot(dir);
+        let distance =
+            if denom.abs() > 1e-12 { el.normal.dot(el.centre - origin) / denom } else { f64::from(hit.t) };
+        let p_world = origin + dir * distance;
+        let front_facing = denom < 0.0;
+        let radiance = if front_facing {
+            let b = match shading {
+                Shading::Flat => solution.element_radiosity[e],
+                Shading::Smooth => self.interpolate(solution, e, p_world),
+            };
+            b / PI
+        } else {
+            Rgb::ZERO
+        };
+        Some(SurfaceHit {
+            element: e as u32,
+            object: self.mesh.element_object(e) as u32,
+            p_world,
+            distance,
+            front_facing,
+            radiance,
+        })
+    }
+
+    /// Radiosity at `p` (on element `e`'s plane), interpolated from its vertices.
+    fn interpolate(&self, solution: &Solution, e: usize, p: DVec3) -> Rgb {
+        let el = &self.mesh.elements[e];
+        let idx = el.vertex_indices();
+        let pos = |k: usize| self.mesh.positions[idx[k] as usize];
+        let val = |k: usize| solution.vertex_radiosity[idx[k] as usize];
+        // Work in 2D on the element's plane, in units of the element's size, so that the
+        // tolerances below are relative.
+        let origin = pos(0);
+        let axis_u = (pos(1) - origin).normalize_or_zero();
+        let axis_v = el.normal.cross(axis_u);
+        let scale = 1.0 / el.area.sqrt().max(f64::MIN_POSITIVE);
+        let to_2d = |q: DVec3| DVec2::new((q - origin).dot(axis_u), (q - origin).dot(axis_v)) * scale;
+        let p2 = to_2d(p);
+        if idx.len() == 3 {
+            let w = barycentric(p2, to_2d(pos(1)), to_2d(pos(2)));
+            val(0) * w[0] + val(1) * w[1] + val(2) * w[2]
+        } else {
+            let (s, t) = inverse_bilinear(p2, DVec2::ZERO, to_2d(pos(1)), to_2d(pos(2)), to_2d(pos(3)));
+            val(0) * ((1.0 - s) * (1.0 - t))
+                + val(1) * (s * (1.0 - t))
+                + val(2) * (s * t)
+                + val(3) * ((1.0 - s) * t)
+        }
+    }
+
+    /// Renders `solution` seen from `camera`.
+    ///
+    /// # Errors
+    /// [`RenderError::BadParameter`] for out-of-range settings, [`RenderError::SolutionMismatch`]
+    /// when `solution` was computed for another mesh.
+    pub fn render(
+        &self,
+        solution: &Solution,
+        camera: &Camera,
+        params: &RenderParams,
+    ) -> Result<Rendering, RenderError> {
+        self.render_with_progress(solution, camera, params, &|| {})
+    }
+
+    /// As [`Renderer::render`], calling `row_done` (from any worker thread) after each row.
+    ///
+    /// # Errors
+    /// As [`Renderer::render`].
+    pub fn render_with_progress(
+        &self,
+        solution: &Solution,
+        camera: &Camera,
+        params: &RenderParams,
+        row_done: &(dyn Fn() + Sync),
+    ) -> Result<Rendering, RenderError> {
+        params.validate()?;
+        self.check(solution)?;
+        let (w, h) = (params.width as usize, params.height as usize);
+        let rays = CameraRays::new(camera, params.width, params.height);
+        let mut pixels = vec![Rgb::ZERO; w * h];
+        let mut object_ids = vec![None; w * h];
+        let n = params.samples_per_pixel;
+        let m = f64::from(n).sqrt().floor() as u32; // strata per side
+        pixels.par_chunks_mut(w).zip(object_ids.par_chunks_mut(w)).enumerate().for_each(|(y, (row, ids))| {
+            for x in 0..w {
+                let index = (y * w + x) as u64;
+                let mut rng = Rng::new(params.seed, index);
+                let mut sum = Rgb::ZERO;
+                for i in 0..n {
+                    let (jx, jy) = (rng.next_f64(), rng.next_f64());
+                    let (sx, sy) = if i < m * m {
+                        ((f64::from(i % m) + jx) / f64::from(m), (f64::from(i / m) + jy) / f64::from(m))
+                    } else {
+                        (jx, jy)
+                    };
+                    let dir = rays.direction(x as f64 + sx, y as f64 + sy);
+                    if let Some(hit) = self.trace_unchecked(solution, camera.position, dir, params.shading) {
+                        sum += hit.radiance;
+                    }
+                }
+                row[x] = sum / f64::from(n);
+                let centre = rays.direction(x as f64 + 0.5, y as f64 + 0.5);
+                ids[x] = self.accel.closest_hit(camera.position.as_vec3(), centre.as_vec3(), f32::MAX).map(
+                    |hit| {
+                        self.mesh.element_object(self.triangle_element[hit.triangle as usize] as usize) as u32
+                    },
+                );
+            }
+            row_done();
+        });
+        Ok(Rendering { radiance: HdrImage::from_pixels(params.width, params.height, pixels), object_ids })
+    }
+}
+
+/// Primary ray directions of a pinhole camera.
+struct CameraRays {
+    forward: DVec3,
+    right: DVec3,
+    up: DVec3,
+    /// tan(fov_y / 2): half the image plane's height at distance 1.
+    half_height: f64,
+    aspect: f64,
+    width: f64,
+    height: f64,
+}
+
+impl CameraRays {
+    fn new(camera: &Camera, width: u32, height: u32) -> Self {
+        let forward = (camera.look_at - camera.position).normalize();
+        // Right-handed: right = forward × up, so a camera looking down +z with +y up sees +x on
+        // its left (the Cornell box's red wall, at x ≈ 556, is on the left of its picture).
+        let right = forward.cross(camera.up).normalize();
+        let up = right.cross(forward);
+        Self {
+            forward,
+            right,
+            up,
+            half_height: (camera.fov_y_deg.to_radians() * 0.5).tan(),
+            aspect: f64::from(width) / f64::from(height),
+            width: f64::from(width),
+            height: f64::from(height),
+        }
+    }
+
+    /// Unit direction through the film point `(px, py)` in pixels, y down from the top edge.
+    fn direction(&self, px: f64, py: f64) -> DVec3 {
+        let sx = (2.0 * px / self.width - 1.0) * self.aspect * self.half_height;
+        let sy = (1.0 - 2.0 * py / self.height) * self.half_height;
+        (self.forward + self.right * sx + self.up * sy).normalize()
+    }
+}
+
+/// Barycentric weights of `p` in the triangle `(0, b, c)`, clamped into the triangle.
+fn barycentric(p: DVec2, b: DVec2, c: DVec2) -> [f64; 3] {
+    let det = b.perp_dot(c);
+    if det.abs() < 1e-300 {
+        return [1.0, 0.0, 0.0];
+    }
+    let u = p.perp_dot(c) / det;
+    let v = b.perp_dot(p) / det;
+    // A hit may sit a hair outside its triangle (single-precision BVH); clamping keeps the
+    // weights a convex combination.
+    let (u, v) = (u.clamp(0.0, 1.0), v.clamp(0.0, 1.0));
+    let s = u + v;
+    let (u, v) = if s > 1.0 { (u / s, v / s) } else { (u, v) };
+    [1.0 - u - v, u, v]
+}
+
+/// Bilinear coordinates `(s, t)` in [0, 1]² of `p` in the convex quad `a b c d`, where
+/// P(s, t) = a + (b − a)s + (d − a)t + (a − b + c − d)st (Quílez 2010). Coordinates are in
+/// units of the quad's size.
+fn inverse_bilinear(p: DVec2, a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> (f64, f64) {
+    let (e, f, g, h) = (b - a, d - a, a - b + c - d, p - a);
+    let k2 = g.perp_dot(f);
+    let k1 = e.perp_dot(f) + h.perp_dot(g);
+    let k0 = h.perp_dot(e);
+    // s from t, using whichever axis divides best.
+    let s_of = |t: f64| {
+        let den = e + g * t;
+        let num = h - f * t;
+        if den.x.abs() > den.y.abs() { num.x / den.x } else { num.y / den.y }
+    };
+    let t = if k2.abs() < 1e-9 {
+        // A parallelogram (or a trapezoid with these sides parallel): the equation is linear.
+        -k0 / k1
+    } else {
+        let disc = (k1 * k1 - 4.0 * k0 * k2).max(0.0).sqrt();
+        let t1 = (-k1 - disc) / (2.0 * k2);
+        let t2 = (-k1 + disc) / (2.0 * k2);
+        let inside = |t: f64| (-1e-6..=1.0 + 1e-6).contains(&t) && (-1e-6..=1.0 + 1e-6).contains(&s_of(t));
+        if inside(t1) || !inside(t2) { t1 } else { t2 }
+    };
+    let t = if t.is_finite() { t } else { 0.0 };
+    let s = s_of(t);
+    let s = if s.is_finite() { s } else { 0.0 };
+    (s.clamp(0.0, 1.0), t.clamp(0.0, 1.0))
+}
+
+/// SplitMix64 (Steele, Lea & Flood 2014): a tiny, statistically sound generator whose stream
+/// is keyed by `(seed, pixel)`, so the picture does not depend on thread scheduling.
+struct Rng(u64);
+
+impl Rng {
+    fn new(seed: u64, index: u64) -> Self {
+        let mut r = Rng(seed ^ 0x9e37_79b9_7f4a_7c15);
+        let k = r.next_u64();
+        Rng(k ^ index.wrapping_mul(0xd1b5_4a32_d192_ed03))
+    }
+
+    fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in [0, 1), 53 bits.
+    fn next_f64(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn inverse_bilinear_inverts_the_bilinear_map() {
+        let quads = [
+            [DVec2::ZERO, DVec2::new(1.0, 0.0), DVec2::new(1.0, 1.0), DVec2::new(0.0, 1.0)],
+            [DVec2::ZERO, DVec2::new(2.0, 0.0), DVec2::new(1.5, 1.0), DVec2::new(0.3, 0.8)],
+            [DVec2::ZERO, DVec2::new(0.0, 1.0), DVec2::new(-1.2, 1.1), DVec2::new(-1.0, 0.0)],
+        ];
+        for [a, b, c, d] in quads {
+            for i in 0..=10 {
+                for j in 0..=10 {
+                    let (s, t) = (f64::from(i) / 10.0, f64::from(j) / 10.0);
+                    let p = a + (b - a) * s + (d - a) * t + (a - b + c - d) * (s * t);
+                    let (s2, t2) = inverse_bilinear(p, a, b, c, d);
+                    assert!((s - s2).abs() < 1e-9 && (t - t2).abs() < 1e-9, "({s}, {t}) -> ({s2}, {t2})");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn barycentric_weights_sum_to_one_and_locate_points() {
+        let (b, c) = (DVec2::new(2.0, 0.0), DVec2::new(0.0, 1.0));
+        let w = barycentric(DVec2::new(0.5, 0.25), b, c);
+        assert!((w[1] - 0.25).abs() < 1e-12 && (w[2] - 0.25).abs() < 1e-12 && (w[0] - 0.5).abs() < 1e-12);
+        let w = barycentric(DVec2::new(5.0, 5.0), b, c);
+        assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-12 && w.iter().all(|x| *x >= 0.0));
+    }
+
+    #[test]
+    fn camera_puts_plus_x_on_the_left_when_looking_down_plus_z() {
+        let cam = Camera::try_new(DVec3::ZERO, DVec3::Z, DVec3::Y, 60.0).unwrap();
+        let rays = CameraRays::new(&cam, 100, 50);
+        assert!(rays.direction(0.0, 25.0).x > 0.0);
+        assert!(rays.direction(100.0, 25.0).x < 0.0);
+        assert!(rays.direction(50.0, 0.0).y > 0.0);
+        // The top edge is at half the vertical field of view.
+        let top = rays.direction(50.0, 0.0);
+        assert!((top.y.atan2(top.z).to_degrees() - 30.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn render_params_are_validated() {
+        assert!(RenderParams::default().validate().is_ok());
+        assert!(RenderParams::preview().validate().is_ok());
+        assert!(RenderParams::high_quality().validate().is_ok());
+        let bad = RenderParams { samples_per_pixel: 0, ..RenderParams::default() };
+        assert!(matches!(bad.validate(), Err(RenderError::BadParameter { name: "samples_per_pixel", .. })));
+        let bad = RenderParams { width: 0, ..RenderParams::default() };
+        assert!(bad.validate().is_err());
+    }
+}

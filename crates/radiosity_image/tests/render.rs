@@ -1,0 +1,200 @@
+//! The renderer against physics: a closed furnace, and how radiosity is interpolated near
+//! element edges and surface corners.
+
+mod common;
+
+use std::f64::consts::PI;
+use std::sync::Arc;
+
+use radiosity_core::glam::DVec3;
+use radiosity_core::{Camera, Material, MeshParams, Object, Polygon, Rgb, Scene, Shape, furnace_box};
+use radiosity_image::{RenderParams, Renderer, Shading};
+use radiosity_solver::SolverParams;
+
+/// Inside a closed box where every face emits E and reflects ρ, radiosity is B = E / (1 − ρ)
+/// everywhere, so every pixel seen from inside must show L = E / ((1 − ρ) π), whatever the
+/// direction, the shading mode or the element it falls on.
+///
+/// Tolerance 1 %: the solver stops with 0.1 % of the power unshot and its form factor rows
+/// sum to 1 within ~0.1 % (its own furnace test), so the solution is within ~0.2 % of B; the
+/// renderer must add no error of its own — a missing 1/π, a seam of missed rays, or blending
+/// across corners would each break 1 % by far.
+#[test]
+fn closed_furnace_shows_the_same_radiance_in_every_pixel() {
+    let (rho, emission) = (0.5, 1.0);
+    let scene = furnace_box(rho, emission);
+    let (mesh, solution) = common::solve(&scene, SolverParams::default());
+    let expected = emission / ((1.0 - rho) * PI);
+    let renderer = Renderer::new(mesh);
+    let centre = DVec3::splat(0.5);
+    // Looking at a face, along an edge and into a corner: every pixel sees some face.
+    let targets =
+        [DVec3::new(0.5, 0.5, 1.0), DVec3::new(1.0, 0.5, 1.0), DVec3::new(1.0, 1.0, 1.0), DVec3::ZERO];
+    for target in targets {
+        let camera = Camera::try_new(centre, target, DVec3::Y + DVec3::X * 0.1, 100.0).unwrap();
+        for shading in [Shading::Smooth, Shading::Flat] {
+            let params = RenderParams { width: 48, height: 40, samples_per_pixel: 4, shading, seed: 3 };
+            let picture = renderer.render(&solution, &camera, &params).unwrap();
+            for (i, p) in picture.radiance.pixels().iter().enumerate() {
+                for c in p.to_array() {
+                    let err = (c - expected).abs() / expected;
+                    assert!(
+                        err < 0.01,
+                        "{shading:?} towards {target}: pixel {i} has L = {c}, expected {expected}"
+                    );
+                }
+            }
+            assert!(picture.object_ids.iter().all(|id| *id == Some(0)));
+        }
+    }
+}
+
+fn polygon(points: &[[f64; 3]]) -> Polygon {
+    Polygon::try_new(points.iter().map(|p| DVec3::from_array(*p)).collect()).unwrap()
+}
+
+/// A bright emitting wall (x = 0, facing +x, E = 10, ρ = 0) and a dark receiving floor
+/// (z = 0, facing +z, ρ = 0.5) meeting along the y axis. The floor is a unit square, or a
+/// right triangle (meshed with triangular elements).
+fn corner_scene(triangle_floor: bool) -> Scene {
+    let bright = Material::try_new("bright", Rgb::ZERO, Rgb::splat(10.0)).unwrap();
+    let dark = Material::try_new("dark", Rgb::splat(0.5), Rgb::ZERO).unwrap();
+    let wall = polygon(&[[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 1.0, 1.0], [0.0, 0.0, 1.0]]);
+    let floor = if triangle_floor {
+        polygon(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    } else {
+        polygon(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]])
+    };
+    let mut scene = Scene::try_new(
+        "corner",
+        None,
+        vec![bright, dark],
+        vec![
+            Object { name: "bright_wall".into(), material: 0, shape: Shape::Polygons(vec![wall]) },
+            Object { name: "dark_floor".into(), material: 1, shape: Shape::Polygons(vec![floor]) },
+        ],
+    )
+    .unwrap();
+    scene.mesh = Some(MeshParams::try_new(0.5, 0.125).unwrap());
+    scene
+}
+
+/// Where the bright wall meets the dark floor, each side keeps its own values: the wall is
+/// exactly E/π up to the edge, and the floor near the edge stays within the range of the
+/// floor's own element and vertex values. Blending across the corner would pull the floor towards the
+/// wall's 10 (and the wall below it) over the last element.
+#[test]
+fn smooth_shading_does_not_blend_across_a_corner() {
+    for triangle_floor in [false, true] {
+        let scene = corner_scene(triangle_floor);
+        let (mesh, solution) = common::solve(&scene, SolverParams::default());
+        let renderer = Renderer::new(mesh.clone());
+        // Every value the floor itself holds: its elements' (flat) and its vertices' (smooth).
+        let floor_values: Vec<Rgb> = (0..mesh.elements.len())
+            .filter(|&e| mesh.element_object(e) == 1)
+            .flat_map(|e| {
+                let vertices = mesh.elements[e].vertex_indices().iter();
+                vertices
+                    .map(|&v| solution.vertex_radiosity[v as usize])
+                    .chain([solution.element_radiosity[e]])
+            })
+            .collect();
+        let floor_max = floor_values.iter().map(|b| b.g).fold(0.0, f64::max);
+        let floor_min = floor_values.iter().map(|b| b.g).fold(f64::INFINITY, f64::min);
+        assert!(floor_max < 6.0, "the floor is dark: max B {floor_max}");
+        let eye = DVec3::new(0.6, 0.45, 0.7);
+        for k in 1..40 {
+            let y = f64::from(k) / 80.0 + 0.013; // up to ~0.5, inside the triangle too
+            for eps in [1e-3, 1e-5] {
+                let on_wall = DVec3::new(0.0, y, eps);
+                let on_floor = DVec3::new(eps, y, 0.0);
+                for shading in [Shading::Smooth, Shading::Flat] {
+                    let w = renderer.trace(&solution, eye, on_wall - eye, shading).unwrap().unwrap();
+                    assert_eq!(w.object, 0);
+                    assert!(
+                        (w.radiance.g - 10.0 / PI).abs() < 1e-9,
+                        "{shading:?} wall at {on_wall}: {:?}",
+                        w.radiance
+                    );
+                    let f = renderer.trace(&solution, eye, on_floor - eye, shading).unwrap().unwrap();
+                    assert_eq!(f.object, 1);
+                    let b = f.radiance.g * PI;
+                    assert!(
+                        b <= floor_max + 1e-9 && b >= floor_min - 1e-9,
+                        "{shading:?} floor at {on_floor}: B = {b}, floor range [{floor_min}, {floor_max}]"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// Within one surface, smooth shading is continuous across every element edge (quads and
+/// triangles, patch boundaries included): on points 1e-6 either side of an edge the radiance
+/// differs by at most the interpolant's slope times 2e-6. Flat shading, by contrast, jumps —
+/// which shows the probe is sensitive.
+#[test]
+fn smooth_shading_is_continuous_across_element_edges() {
+    for triangle_floor in [false, true] {
+        let scene = corner_scene(triangle_floor);
+        let (mesh, solution) = common::solve(&scene, SolverParams::default());
+        let renderer = Renderer::new(mesh.clone());
+        let eye = DVec3::new(0.45, 0.4, 1.5);
+        let (mut smooth_jump, mut flat_jump, mut probes) = (0.0_f64, 0.0_f64, 0);
+        for e in (0..mesh.elements.len()).filter(|&e| mesh.element_object(e) == 1) {
+            let corners: Vec<DVec3> = mesh.element_corners(e).collect();
+            for k in 0..corners.len() {
+                let (a, b) = (corners[k], corners[(k + 1) % corners.len()]);
+                let q = a + (b - a) * 0.37;
+                let across = mesh.elements[e].normal.cross(b - a).normalize() * 1e-6;
+                let sides = |shading| {
+                    let h1 = renderer.trace(&solution, eye, q + across - eye, shading).unwrap()?;
+                    let h2 = renderer.trace(&solution, eye, q - across - eye, shading).unwrap()?;
+                    // Edges on the floor's boundary have nothing of the floor on one side.
+                    (h1.object == 1 && h2.object == 1 && h1.element != h2.element)
+                        .then(|| (h1.radiance - h2.radiance).abs().max_channel())
+                };
+                if let Some(d) = sides(Shading::Smooth) {
+                    smooth_jump = smooth_jump.max(d);
+                    flat_jump = flat_jump.max(sides(Shading::Flat).unwrap());
+                    probes += 1;
+                }
+            }
+        }
+        assert!(probes > 100, "{probes} interior edges probed");
+        // Radiance here is at most ~2; a slope of ~100/unit would give 2e-4.
+        assert!(smooth_jump < 1e-4, "smooth shading jumps by {smooth_jump} across an element edge");
+        assert!(flat_jump > 1e-2, "flat shading should show the elements (largest jump {flat_jump})");
+    }
+}
+
+/// Any number of threads gives the same picture, bit for bit.
+#[test]
+fn rendering_is_deterministic_across_thread_counts() {
+    let scene = corner_scene(false);
+    let (mesh, solution) = common::solve(&scene, SolverParams::preview());
+    let renderer = Renderer::new(mesh);
+    let camera =
+        Camera::try_new(DVec3::new(0.8, 0.5, 0.9), DVec3::new(0.0, 0.5, 0.0), DVec3::Y, 70.0).unwrap();
+    let params = RenderParams { width: 40, height: 30, samples_per_pixel: 5, ..RenderParams::default() };
+    let render_with = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| renderer.render(&solution, &camera, &params).unwrap())
+    };
+    let one = render_with(1);
+    assert_eq!(one, render_with(3));
+    // A different seed moves the jitter, so edge pixels change.
+    let other = renderer.render(&solution, &camera, &RenderParams { seed: 1, ..params }).unwrap();
+    assert_ne!(one.radiance, other.radiance);
+}
+
+/// A solution from another mesh is refused, not drawn with the wrong values.
+#[test]
+fn a_solution_for_another_mesh_is_an_error() {
+    let (mesh, _) = common::solve(&corner_scene(false), SolverParams::preview());
+    let (_, other) = common::solve(&corner_scene(true), SolverParams::preview());
+    let renderer = Renderer::new(Arc::clone(&mesh));
+    let camera = Camera::try_new(DVec3::ONE, DVec3::ZERO, DVec3::Y, 60.0).unwrap();
+    let err = renderer.render(&other, &camera, &RenderParams::preview()).unwrap_err();
+    assert!(err.to_string().contains("does not fit the mesh"), "{err}");
+}
