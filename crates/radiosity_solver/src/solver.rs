@@ -62,7 +62,7 @@ pub struct SolverParams {
     pub form_factor: FormFactorMethod,
     /// Visibility rays per receiving element and shot, ≥ 1. Default 4.
     pub visibility_rays: u32,
-    /// Largest receiver quadrature, Gauss cells per side, in 1..=256. Default 16.
+    /// Largest receiver quadrature, Gauss cells per side, in 1..=256. Default 8.
     pub max_quadrature: u32,
     /// Stop when unshot power / emitted power ≤ this, in (0, 1). Default 1e-3.
     pub unshot_threshold: f64,
@@ -83,7 +83,7 @@ impl Default for SolverParams {
         Self {
             form_factor: FormFactorMethod::Exact,
             visibility_rays: 4,
-            max_quadrature: 16,
+            max_quadrature: 8,
             unshot_threshold: 1e-3,
             max_shots: None,
             time_limit: None,
