@@ -26,8 +26,8 @@ pub struct BenchArgs {
     /// Overwrite an existing JSON file.
     #[arg(long)]
     pub force: bool,
-    /// Element size of the Cornell case, mm (35 gives ~10 k elements).
-    #[arg(long, default_value_t = 35.0)]
+    /// Element size of the Cornell case, mm (17 gives ~10 k elements).
+    #[arg(long, default_value_t = 17.0)]
     pub cornell_element_size: f64,
 }
 
