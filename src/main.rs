@@ -3,6 +3,7 @@
 mod bench_cmd;
 mod info_cmd;
 mod prepare;
+mod render_cmd;
 mod solve_cmd;
 
 use std::process::ExitCode;
@@ -25,6 +26,10 @@ enum Command {
     Info(info_cmd::InfoArgs),
     /// Run the fixed benchmark cases and print figures.
     Bench(bench_cmd::BenchArgs),
+    /// Solve a scene and ray cast it to a tone-mapped PNG (and linear EXR / PFM).
+    Render(render_cmd::RenderArgs),
+    /// Tone map a linear picture (.exr or .pfm) to PNG again, without solving.
+    Tonemap(render_cmd::TonemapArgs),
 }
 
 fn main() -> ExitCode {
@@ -33,6 +38,8 @@ fn main() -> ExitCode {
         Command::Solve(a) => solve_cmd::run(a),
         Command::Info(a) => info_cmd::run(a),
         Command::Bench(a) => bench_cmd::run(a),
+        Command::Render(a) => render_cmd::run(a),
+        Command::Tonemap(a) => render_cmd::run_tonemap(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

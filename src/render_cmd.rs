@@ -1,0 +1,228 @@
+//! `radiosity render`: solve, ray cast from a camera, tone map, write PNG (and linear EXR /
+//! PFM); `radiosity tonemap`: tone map a linear picture again without solving.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use clap::{Args, ValueEnum};
+use glam::DVec3;
+use indicatif::{ProgressBar, ProgressStyle};
+use radiosity_core::Camera;
+use radiosity_image::{
+    Exposure, HdrImage, RenderParams, Renderer, Shading, ToneOperator, ToneParams, read_hdr, tone_map_image,
+    write_exr, write_pfm, write_png,
+};
+
+use crate::prepare::{InputError, SolveOpts, check_writable, prepare, run_solver};
+
+/// Tone-mapping operator on the command line.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum TonemapArg {
+    /// Exposure, then clamp to [0, 1].
+    Linear,
+    /// Reinhard et al. 2002, L / (1 + L) on luminance.
+    Reinhard,
+    /// ACES filmic curve (Narkowicz 2015 fit).
+    Aces,
+}
+
+impl From<TonemapArg> for ToneOperator {
+    fn from(a: TonemapArg) -> Self {
+        match a {
+            TonemapArg::Linear => ToneOperator::Linear,
+            TonemapArg::Reinhard => ToneOperator::Reinhard,
+            TonemapArg::Aces => ToneOperator::Aces,
+        }
+    }
+}
+
+/// Shading on the command line.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum ShadingArg {
+    /// Radiosity interpolated from the vertices (within each surface only).
+    Smooth,
+    /// Each element's own radiosity: shows the mesh.
+    Flat,
+}
+
+/// Exposure and operator, shared by `render` and `tonemap`.
+#[derive(Args, Clone, Debug)]
+pub struct ToneOpts {
+    /// Exposure in stops (EV, e.g. -1.5), or `auto` to map the picture's log-average luminance
+    /// to middle grey. One exposure for the whole picture.
+    #[arg(long, default_value = "auto", allow_hyphen_values = true)]
+    pub exposure: Exposure,
+    /// Tone-mapping operator.
+    #[arg(long, value_enum, default_value_t = TonemapArg::Aces)]
+    pub tonemap: TonemapArg,
+}
+
+/// Arguments of `radiosity render`.
+#[derive(Args)]
+pub struct RenderArgs {
+    /// Scene file (.toml) or built-in name (cornell, furnace, seed-room, two-plates).
+    pub scene: String,
+    /// Tone-mapped 8-bit sRGB PNG to write.
+    #[arg(short = 'o', long = "output")]
+    pub output: Option<PathBuf>,
+    /// Linear radiance as 32-bit float OpenEXR.
+    #[arg(long)]
+    pub exr: Option<PathBuf>,
+    /// Linear radiance as PFM (bottom row first, little-endian).
+    #[arg(long)]
+    pub pfm: Option<PathBuf>,
+    /// Picture width in pixels.
+    #[arg(long, default_value_t = RenderParams::default().width)]
+    pub width: u32,
+    /// Picture height in pixels.
+    #[arg(long, default_value_t = RenderParams::default().height)]
+    pub height: u32,
+    /// Jittered samples per pixel (seeded by --seed).
+    #[arg(long, default_value_t = RenderParams::default().samples_per_pixel)]
+    pub spp: u32,
+    /// Radiosity at a hit point: interpolated from vertices, or per element.
+    #[arg(long, value_enum, default_value_t = ShadingArg::Smooth)]
+    pub shading: ShadingArg,
+    /// Eye position `x,y,z` (default: the scene's [camera], or one framing the scene).
+    #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
+    pub camera_position: Option<DVec3>,
+    /// Point looked at, `x,y,z`.
+    #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
+    pub look_at: Option<DVec3>,
+    /// Vertical field of view, degrees.
+    #[arg(long)]
+    pub fov: Option<f64>,
+    #[command(flatten)]
+    pub tone: ToneOpts,
+    /// Overwrite existing output files.
+    #[arg(long)]
+    pub force: bool,
+    #[command(flatten)]
+    pub solve: SolveOpts,
+}
+
+/// Arguments of `radiosity tonemap`.
+#[derive(Args)]
+pub struct TonemapArgs {
+    /// Linear picture to read (.exr or .pfm), e.g. from `render --exr`.
+    pub input: PathBuf,
+    /// Tone-mapped 8-bit sRGB PNG to write.
+    #[arg(short = 'o', long = "output")]
+    pub output: PathBuf,
+    #[command(flatten)]
+    pub tone: ToneOpts,
+    /// Overwrite an existing output file.
+    #[arg(long)]
+    pub force: bool,
+}
+
+fn parse_point(s: &str) -> Result<DVec3, String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    let numbers: Vec<f64> =
+        parts.iter().filter_map(|p| p.parse().ok()).filter(|v: &f64| v.is_finite()).collect();
+    if parts.len() != 3 || numbers.len() != 3 {
+        return Err(format!("expected three numbers x,y,z, got '{s}'"));
+    }
+    Ok(DVec3::new(numbers[0], numbers[1], numbers[2]))
+}
+
+fn input(msg: String) -> anyhow::Error {
+    InputError(msg).into()
+}
+
+/// A progress bar on stderr when it is a terminal, hidden otherwise.
+fn bar(len: u64, what: &str) -> ProgressBar {
+    if !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(len);
+    let template = format!("{{spinner}} {what} [{{bar:30}}] {{pos}}/{{len}} rows, ETA {{eta}}");
+    bar.set_style(ProgressStyle::with_template(&template).expect("valid template").progress_chars("=> "));
+    bar
+}
+
+/// Tone maps `radiance` with `tone` and writes it as PNG; returns the exposure used (EV).
+fn write_tonemapped(path: &Path, radiance: &HdrImage, tone: &ToneOpts) -> Result<f64> {
+    let ev = tone.exposure.ev_for(radiance);
+    let png = tone_map_image(radiance, &ToneParams::new(ev, tone.tonemap.into()));
+    write_png(path, &png).with_context(|| "cannot write the PNG")?;
+    Ok(ev)
+}
+
+/// Runs `render`.
+pub fn run(a: RenderArgs) -> Result<()> {
+    if a.output.is_none() && a.exr.is_none() && a.pfm.is_none() {
+        return Err(input("nothing to write: give -o out.png, --exr out.exr and/or --pfm out.pfm".into()));
+    }
+    let params = RenderParams {
+        width: a.width,
+        height: a.height,
+        samples_per_pixel: a.spp,
+        shading: match a.shading {
+            ShadingArg::Smooth => Shading::Smooth,
+            ShadingArg::Flat => Shading::Flat,
+        },
+        seed: a.solve.seed,
+    };
+    params.validate().map_err(|e| input(e.to_string()))?;
+    for path in [&a.output, &a.exr, &a.pfm].into_iter().flatten() {
+        check_writable(path, a.force)?;
+    }
+    let prepared = prepare(&a.scene, &a.solve)?;
+    let base = prepared.scene.camera_or_framing();
+    let camera = Camera::try_new(
+        a.camera_position.unwrap_or(base.position),
+        a.look_at.unwrap_or(base.look_at),
+        base.up,
+        a.fov.unwrap_or(base.fov_y_deg),
+    )
+    .context("camera options")?;
+
+    let (solver, report) = run_solver(&prepared)?;
+    let solution = solver.solution();
+    let start = Instant::now();
+    let renderer = Renderer::new(prepared.mesh.clone());
+    let progress = bar(u64::from(params.height), "rendering");
+    let rendering = renderer.render_with_progress(&solution, &camera, &params, &|| progress.inc(1))?;
+    progress.finish_and_clear();
+    let render_secs = start.elapsed().as_secs_f64();
+
+    eprintln!(
+        "{}: {} elements, {} shots, unshot {:.4} % ({}), solved in {:.2} s; rendered {}×{} at {} spp in {:.2} s",
+        prepared.scene.name,
+        prepared.mesh.elements.len(),
+        report.total_shots,
+        report.unshot_fraction * 100.0,
+        report.stop_reason.map_or("running", |s| s.as_str()),
+        report.elapsed.as_secs_f64(),
+        params.width,
+        params.height,
+        params.samples_per_pixel,
+        render_secs
+    );
+    if let Some(path) = &a.output {
+        let ev = write_tonemapped(path, &rendering.radiance, &a.tone)?;
+        eprintln!("wrote {} (exposure {ev:+.2} EV, {})", path.display(), ToneOperator::from(a.tone.tonemap));
+    }
+    if let Some(path) = &a.exr {
+        write_exr(path, &rendering.radiance).context("cannot write the EXR")?;
+        eprintln!("wrote {} (linear radiance)", path.display());
+    }
+    if let Some(path) = &a.pfm {
+        write_pfm(path, &rendering.radiance).context("cannot write the PFM")?;
+        eprintln!("wrote {} (linear radiance)", path.display());
+    }
+    Ok(())
+}
+
+/// Runs `tonemap`.
+pub fn run_tonemap(a: TonemapArgs) -> Result<()> {
+    check_writable(&a.output, a.force)?;
+    // A missing or malformed input is the user's to fix: exit code 2.
+    let radiance = read_hdr(&a.input).map_err(|e| input(e.to_string()))?;
+    let ev = write_tonemapped(&a.output, &radiance, &a.tone)?;
+    eprintln!("wrote {} (exposure {ev:+.2} EV, {})", a.output.display(), ToneOperator::from(a.tone.tonemap));
+    Ok(())
+}
