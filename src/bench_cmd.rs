@@ -45,8 +45,10 @@ fn solve_case(name: &str, mesh: Mesh, params: SolverParams) -> Result<serde_json
         r.unshot_fraction,
         r.stop_reason.map_or("running", |s| s.as_str())
     );
-    Ok(json!({"case": name, "patches": patches, "elements": elements, "shots": r.total_shots, "seconds": secs,
-        "rays": r.rays, "unshot_fraction": r.unshot_fraction}))
+    Ok(
+        json!({"case": name, "patches": patches, "elements": elements, "shots": r.total_shots, "seconds": secs,
+        "rays": r.rays, "unshot_fraction": r.unshot_fraction}),
+    )
 }
 
 /// Runs `bench`.
@@ -94,8 +96,10 @@ pub fn run(a: BenchArgs) -> Result<()> {
         all / one,
         100.0 * blocked as f64 / segments.len() as f64
     );
-    cases.push(json!({"case": "occlusion_rays", "triangles": bvh.triangle_count(), "rays_per_s_1_thread": one,
-        "rays_per_s_all_threads": all, "threads": threads}));
+    cases.push(
+        json!({"case": "occlusion_rays", "triangles": bvh.triangle_count(), "rays_per_s_1_thread": one,
+        "rays_per_s_all_threads": all, "threads": threads}),
+    );
 
     // (b) The source document's case: ~100 facets, 1000 shots (it took about a minute).
     let seed = radiosity_io::resolve_scene("seed-room")?;
@@ -117,11 +121,16 @@ pub fn run(a: BenchArgs) -> Result<()> {
     cases.push(v);
 
     // (c) Cornell at ~10 k elements to unshot 1e-3.
-    let m = Mesh::build(&cornell, &MeshParams::try_new(4.0 * a.cornell_element_size, a.cornell_element_size)?)?;
+    let m =
+        Mesh::build(&cornell, &MeshParams::try_new(4.0 * a.cornell_element_size, a.cornell_element_size)?)?;
     cases.push(solve_case("Cornell to unshot 1e-3", m, SolverParams::default())?);
 
     if let Some(path) = &a.json {
-        write_output(path, &serde_json::to_string_pretty(&json!({"threads": threads, "cases": cases}))?, a.force)?;
+        write_output(
+            path,
+            &serde_json::to_string_pretty(&json!({"threads": threads, "cases": cases}))?,
+            a.force,
+        )?;
     }
     Ok(())
 }

@@ -29,7 +29,8 @@ pub fn run(a: InfoArgs) -> Result<()> {
     println!("elements   {}", mesh.elements.len());
     println!("occluders  {} triangles", mesh.occluders.len());
     println!("area       {:.6e}", mesh.total_area());
-    let emitted: Rgb = (0..mesh.elements.len()).map(|e| mesh.element_material(e).emission * mesh.elements[e].area).sum();
+    let emitted: Rgb =
+        (0..mesh.elements.len()).map(|e| mesh.element_material(e).emission * mesh.elements[e].area).sum();
     println!("emitted    [{:.6e}, {:.6e}, {:.6e}] W", emitted.r, emitted.g, emitted.b);
     let mut warnings = Vec::new();
     for m in &scene.materials {

@@ -123,7 +123,11 @@ pub fn prepare(scene_arg: &str, o: &SolveOpts) -> Result<Prepared> {
     scene.scale_emission(o.light_scale);
     let base = scene.mesh_params();
     let patch = o.patch_size.unwrap_or(base.patch_size);
-    let element = o.element_size.unwrap_or(if o.patch_size.is_some() { patch.min(base.element_size) } else { base.element_size });
+    let element = o.element_size.unwrap_or(if o.patch_size.is_some() {
+        patch.min(base.element_size)
+    } else {
+        base.element_size
+    });
     let mesh_params = MeshParams::try_new(patch, element).map_err(|e| input(format!("mesh options: {e}")))?;
     let mesh = Arc::new(Mesh::build(&scene, &mesh_params)?);
     let accel = Arc::new(Bvh::new(&occluder_triangles(&mesh)));
@@ -158,7 +162,9 @@ pub fn run_solver(p: &Prepared) -> Result<(Solver, StepReport)> {
     let bar = if std::io::stderr().is_terminal() {
         let bar = ProgressBar::new(1000);
         bar.set_style(
-            ProgressStyle::with_template("{spinner} solving [{bar:30}] {msg}").expect("valid template").progress_chars("=> "),
+            ProgressStyle::with_template("{spinner} solving [{bar:30}] {msg}")
+                .expect("valid template")
+                .progress_chars("=> "),
         );
         bar
     } else {

@@ -49,7 +49,10 @@ pub fn run(a: SolveArgs) -> Result<()> {
         stop
     );
     if a.json.as_deref() != Some("-") {
-        println!("{:<24} {:>12} {:>36} {:>36}", "object", "area", "emitted power [r g b]", "mean radiosity [r g b]");
+        println!(
+            "{:<24} {:>12} {:>36} {:>36}",
+            "object", "area", "emitted power [r g b]", "mean radiosity [r g b]"
+        );
         for o in &objects {
             let f = |c: radiosity_core::Rgb| format!("{:>11.4e} {:>11.4e} {:>11.4e}", c.r, c.g, c.b);
             println!("{:<24} {:>12.4e} {:>36} {:>36}", o.name, o.area, f(o.emitted_power), f(o.radiosity));

@@ -21,10 +21,13 @@ fn report(path: &Path) -> serde_json::Value {
 fn two_plates_report_matches_c11() {
     let dir = tempfile::tempdir().unwrap();
     let json = dir.path().join("r.json");
-    let o = radiosity(&["solve", "two-plates", "--unshot-threshold", "1e-6", "--json", json.to_str().unwrap()]);
+    let o =
+        radiosity(&["solve", "two-plates", "--unshot-threshold", "1e-6", "--json", json.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
     let r = report(&json);
-    for key in ["elements", "patches", "shots", "unshot_fraction", "stop_reason", "seconds", "rays", "objects"] {
+    for key in
+        ["elements", "patches", "shots", "unshot_fraction", "stop_reason", "seconds", "rays", "objects"]
+    {
         assert!(r.get(key).is_some(), "report lacks {key}");
     }
     assert_eq!(r["stop_reason"], "converged");
@@ -52,7 +55,11 @@ fn one_and_two_threads_give_the_same_report() {
 fn malformed_scene_is_one_line_with_exit_code_2() {
     let dir = tempfile::tempdir().unwrap();
     let cases = [
-        ("rho.toml", "[[material]]\nname = \"w\"\nreflectance = [1.0, 0.5, 0.5]\nemission = [1, 1, 1]\n[[object]]\nname = \"o\"\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"w\"\n", "[0, 1)"),
+        (
+            "rho.toml",
+            "[[material]]\nname = \"w\"\nreflectance = [1.0, 0.5, 0.5]\nemission = [1, 1, 1]\n[[object]]\nname = \"o\"\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"w\"\n",
+            "[0, 1)",
+        ),
         ("syntax.toml", "[[material]\nname = 1\n", "syntax.toml:"),
         ("unknown.toml", "colour = 3\n", "colour"),
     ];

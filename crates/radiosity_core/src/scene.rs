@@ -188,7 +188,8 @@ impl Polygon {
         let area = 0.5 * n.length();
         let diameter =
             vertices.iter().flat_map(|a| vertices.iter().map(move |b| a.distance(*b))).fold(0.0, f64::max);
-        if !(area > 1e-12 * diameter * diameter) || diameter == 0.0 {
+        // NaN-safe: a NaN area must also be rejected, hence the explicit `is_nan`.
+        if area.is_nan() || area <= 1e-12 * diameter * diameter || diameter == 0.0 {
             return Err(SceneError::DegeneratePolygon { area });
         }
         let normal = n / n.length();
@@ -284,7 +285,7 @@ pub fn box_faces(
 ) -> Result<Vec<Polygon>, SceneError> {
     check_finite(min)?;
     check_finite(max)?;
-    if !(min.x < max.x && min.y < max.y && min.z < max.z) || !rotate_y_deg.is_finite() {
+    if !(min.x < max.x && min.y < max.y && min.z < max.z && rotate_y_deg.is_finite()) {
         return Err(SceneError::EmptyBox { min: min.to_array(), max: max.to_array() });
     }
     let c =
