@@ -126,3 +126,36 @@ fn info_prints_counts_and_power() {
         assert!(out.contains(key), "{out}");
     }
 }
+
+/// The furnace rendered from inside through `render --pfm`: every pixel holds the linear
+/// radiance L = E / ((1 − ρ) π) = 2/π; 1 % covers the 1e-3 unshot remainder and quadrature.
+#[test]
+fn render_furnace_pfm_holds_linear_radiance() {
+    let dir = tempfile::tempdir().unwrap();
+    let (pfm, png) = (dir.path().join("f.pfm"), dir.path().join("f.png"));
+    let o = radiosity(&[
+        "render",
+        "furnace",
+        "--pfm",
+        pfm.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+        "--width",
+        "24",
+        "--height",
+        "16",
+        "--camera-position",
+        "0.5,0.5,0.3",
+        "--look-at",
+        "0.9,0.7,1.0",
+        "--fov",
+        "70",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let img = radiosity_image::read_pfm(&pfm).unwrap();
+    let expected = 2.0 / std::f64::consts::PI;
+    for p in img.pixels() {
+        assert!((p.g - expected).abs() < 0.01 * expected, "{} vs {expected}", p.g);
+    }
+    assert!(png.exists());
+}
