@@ -5,6 +5,7 @@ mod info_cmd;
 mod prepare;
 mod render_cmd;
 mod solve_cmd;
+mod view_cmd;
 
 use std::process::ExitCode;
 
@@ -30,6 +31,8 @@ enum Command {
     Render(render_cmd::RenderArgs),
     /// Tone map a linear picture (.exr or .pfm) to PNG again, without solving.
     Tonemap(render_cmd::TonemapArgs),
+    /// Open a window that solves the scene live while you fly through it.
+    View(view_cmd::ViewArgs),
 }
 
 fn main() -> ExitCode {
@@ -40,6 +43,7 @@ fn main() -> ExitCode {
         Command::Bench(a) => bench_cmd::run(a),
         Command::Render(a) => render_cmd::run(a),
         Command::Tonemap(a) => render_cmd::run_tonemap(a),
+        Command::View(a) => view_cmd::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

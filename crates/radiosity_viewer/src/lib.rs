@@ -1,1 +1,158 @@
+//! Interactive viewer of the radiosity renderer: the solver runs on a worker thread while the
+//! window shows the newest solution, tone mapped on the GPU, and a fly-through camera walks
+//! through the scene as it converges.
+//!
+//! The parts that need no window are plain Rust and tested as such: [`camera`] (view and
+//! projection maths, movement, framing) and [`worker`] (the solve thread and its protocol).
+//! [`render`] draws into any [`RenderTarget`] it is given (the window's view, a screenshot, a
+//! headless test texture), and the eframe application ties them together.
+#![warn(missing_docs)]
+#![forbid(unsafe_code)]
 
+mod app;
+pub mod camera;
+pub mod render;
+pub mod worker;
+
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
+
+use radiosity_core::{MeshParams, Scene};
+use radiosity_solver::SolverParams;
+
+pub use app::{KEY_HINT, ViewState};
+pub use camera::{FlyCamera, MoveInput, SceneExtent};
+pub use render::{
+    COLOR_FORMAT, DisplayMode, FrameParams, RenderTarget, SCENE_WGSL, SceneRenderer, TONEMAP_WGSL, Wireframe,
+    headless_gpu,
+};
+pub use worker::{Progress, Snapshot, SolveJob, SolveWorker, Status, WorkerOptions, WorkerState};
+
+/// What `radiosity view` opens, and how.
+#[derive(Clone, Debug)]
+pub struct ViewerOptions {
+    /// The scene, before the light scale.
+    pub scene: Scene,
+    /// What the user typed to open it (path or built-in name), shown in the panel.
+    pub scene_label: String,
+    /// Factor on every emission, > 0.
+    pub light_scale: f64,
+    /// Subdivision; `None`: the scene's own ([`Scene::mesh_params`]).
+    pub mesh_params: Option<MeshParams>,
+    /// Solver settings.
+    pub solver_params: SolverParams,
+    /// Solver threads; `None`: all cores but one.
+    pub threads: Option<usize>,
+    /// Write the window's content to this PNG once the solve reaches `after_shots` (or stops,
+    /// without it), then exit.
+    pub screenshot: Option<PathBuf>,
+    /// Shots before the screenshot; the solve pauses there.
+    pub after_shots: Option<u64>,
+    /// Redraw every frame rather than only on change (shows the highest frame rate).
+    pub continuous: bool,
+    /// Initial window size, points.
+    pub window_size: [f32; 2],
+    /// Samples per pixel of the window (1 or 4); see [`default_samples`].
+    pub samples: u32,
+}
+
+impl ViewerOptions {
+    /// Options to view `scene` with its own settings.
+    pub fn new(scene: Scene, scene_label: &str) -> Self {
+        Self {
+            scene,
+            scene_label: scene_label.to_owned(),
+            light_scale: 1.0,
+            mesh_params: None,
+            solver_params: SolverParams::default(),
+            threads: None,
+            screenshot: None,
+            after_shots: None,
+            continuous: false,
+            window_size: [1200.0, 760.0],
+            samples: default_samples(),
+        }
+    }
+}
+
+/// Opens the viewer window and runs until it is closed (or, with a screenshot asked for,
+/// until the screenshot is written).
+///
+/// # Errors
+/// When no window or GPU adapter can be had (the message says to use Xvfb on a headless
+/// machine), or a scripted screenshot could not be taken or written.
+pub fn run(options: ViewerOptions) -> anyhow::Result<()> {
+    let title = format!("radiosity — {}", options.scene.name);
+    let native = eframe::NativeOptions {
+        viewport: eframe::egui::ViewportBuilder::default()
+            .with_title(&title)
+            .with_app_id("radiosity")
+            .with_inner_size(options.window_size)
+            .with_drag_and_drop(true),
+        renderer: eframe::Renderer::Wgpu,
+        // The 3D view is drawn inside egui's pass and needs its depth buffer (reversed z).
+        depth_buffer: 32,
+        multisampling: options.samples.clamp(1, 4) as u16,
+        // Dithering adds noise to every pixel, the 3D view included, for nothing: the view is
+        // already 8-bit sRGB.
+        dithering: false,
+        ..Default::default()
+    };
+    let outcome: app::Outcome = Arc::new(Mutex::new(None));
+    let app_outcome = outcome.clone();
+    eframe::run_native(
+        "radiosity",
+        native,
+        Box::new(move |cc| {
+            let app = app::ViewerApp::new(cc, options, app_outcome)?;
+            Ok(Box::new(app))
+        }),
+    )
+    .map_err(|e| {
+        let headless = std::env::var_os("DISPLAY").is_none() && std::env::var_os("WAYLAND_DISPLAY").is_none();
+        if headless {
+            anyhow::anyhow!(
+                "cannot open the viewer window: {e} (no display: run it under scripts/xvfb-run.sh)"
+            )
+        } else {
+            anyhow::anyhow!("cannot open the viewer window: {e}")
+        }
+    })?;
+    let result = outcome.lock().unwrap_or_else(|e| e.into_inner()).take();
+    result.unwrap_or(Ok(()))
+}
+
+/// Samples per pixel for the window: 4 (smooth edges) on a GPU, 1 on a CPU rasteriser
+/// (lavapipe, llvmpipe) where each sample costs CPU time. Asks wgpu for the adapter the window
+/// will most likely get; `RADIOSITY_MSAA=1` or `=4` overrides.
+pub fn default_samples() -> u32 {
+    if let Some(n) = std::env::var("RADIOSITY_MSAA").ok().and_then(|v| v.parse::<u32>().ok()) {
+        return if n >= 4 { 4 } else { 1 };
+    }
+    use eframe::wgpu;
+    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+    match pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions::default())) {
+        Ok(a) if a.get_info().device_type != wgpu::DeviceType::Cpu => 4,
+        _ => 1,
+    }
+}
+
+/// An error and its causes on one line, as the command prints them.
+pub fn one_line(e: &(dyn std::error::Error + 'static)) -> String {
+    let mut parts = vec![e.to_string()];
+    let mut source = e.source();
+    while let Some(s) = source {
+        let text = s.to_string();
+        // Wrappers often repeat their cause's text; print it once.
+        if !parts.last().is_some_and(|p| p.contains(&text)) {
+            parts.push(text);
+        }
+        source = s.source();
+    }
+    parts.join(": ")
+}
+
+/// Loads a scene file or built-in name, the error on one line as the command prints it.
+fn load_scene(arg: &str) -> Result<Scene, String> {
+    radiosity_io::resolve_scene(arg).map_err(|e| one_line(&e))
+}

@@ -1,0 +1,863 @@
+//! The window: an egui panel beside the 3D view, camera input, scene loading, screenshots.
+//!
+//! Every frame reads the newest snapshot the worker published (never waiting for it), uploads
+//! its colours when it is new, draws the mesh into an offscreen [`RenderTarget`] and shows that
+//! texture as an egui image. Slow work — loading a file, meshing, solving — happens on other
+//! threads, so the window stays responsive whatever the scene.
+
+use std::collections::VecDeque;
+use std::path::PathBuf;
+use std::sync::mpsc::{Receiver, TryRecvError};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use eframe::egui::{self, Color32, Key, Pos2, Rect, Sense, Vec2};
+use eframe::{egui_wgpu, wgpu};
+use radiosity_core::{MeshParams, Scene};
+use radiosity_image::ToneOperator;
+use radiosity_solver::Solution;
+
+use crate::ViewerOptions;
+use crate::camera::{FlyCamera, MoveInput, SceneExtent};
+use crate::render::{
+    DisplayMode, FrameParams, RenderTarget, SceneRenderer, Wireframe, false_colour, false_colour_range,
+};
+use crate::worker::{SolveJob, SolveWorker, Status, WorkerOptions, WorkerState};
+
+/// Mouse-look sensitivity, radians per point dragged.
+const LOOK_RADIANS_PER_POINT: f64 = 0.004;
+/// Wheel scroll (points) per speed notch.
+const POINTS_PER_NOTCH: f32 = 50.0;
+/// Longest frame time used for movement, so a frame after an idle pause does not jump.
+const MAX_MOVE_DT: f64 = 1.0 / 20.0;
+/// Clear colour of the 3D view (display values): a dark grey that neither red nor green
+/// walls nor black unlit surfaces can be confused with.
+const BACKGROUND: [f32; 4] = [0.11, 0.11, 0.12, 1.0];
+
+/// The key hint shown under the 3D view.
+pub const KEY_HINT: &str = "WASD/arrows move · Q/E or Ctrl/Space down/up · drag to look · wheel: speed · \
+                            Shift: run · R reset · F frame all · P screenshot";
+
+/// What the user chose to see: camera and display settings. Kept apart from runtime state
+/// (GPU buffers, keys held, the worker) so a restart or a re-mesh never loses it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ViewState {
+    /// The fly-through camera.
+    pub camera: FlyCamera,
+    /// Exposure follows the solution (log-average luminance to middle grey), as `render`'s
+    /// default `--exposure auto` does.
+    pub auto_exposure: bool,
+    /// Exposure in stops when not automatic.
+    pub exposure_ev: f64,
+    /// Tone-map operator.
+    pub operator: ToneOperator,
+    /// What the surfaces show.
+    pub mode: DisplayMode,
+    /// Subdivision lines.
+    pub wireframe: Wireframe,
+}
+
+/// Frames per second over the last second of drawn frames.
+#[derive(Default)]
+struct FpsCounter {
+    frames: VecDeque<Instant>,
+}
+
+impl FpsCounter {
+    fn tick(&mut self, now: Instant) {
+        self.frames.push_back(now);
+        while self.frames.front().is_some_and(|t| now.duration_since(*t) > Duration::from_secs(1)) {
+            self.frames.pop_front();
+        }
+    }
+
+    fn fps(&self) -> f64 {
+        match (self.frames.front(), self.frames.back()) {
+            (Some(a), Some(b)) if self.frames.len() > 1 => {
+                (self.frames.len() - 1) as f64 / b.duration_since(*a).as_secs_f64().max(1e-9)
+            }
+            _ => 0.0,
+        }
+    }
+}
+
+/// A screenshot asked for and not yet written.
+struct Capture {
+    path: PathBuf,
+    /// Whether the program ends once it is written (`--screenshot`).
+    then_exit: bool,
+    image: Arc<Mutex<Option<Arc<egui::ColorImage>>>>,
+    requested: bool,
+}
+
+/// Scene sizes the subdivision sliders work in.
+#[derive(Clone, Copy)]
+struct Subdivision {
+    light_scale: f64,
+    patch_size: f64,
+    element_size: f64,
+}
+
+/// Outcome of a scripted run, read by [`crate::run`] after the window closes.
+pub(crate) type Outcome = Arc<Mutex<Option<anyhow::Result<()>>>>;
+
+/// The eframe application.
+pub struct ViewerApp {
+    view: ViewState,
+    render_state: egui_wgpu::RenderState,
+    /// The view's size in pixels at the last frame (for P screenshots).
+    view_size: [u32; 2],
+    worker: SolveWorker,
+    /// The job last asked for; panel edits build on it.
+    job: SolveJob,
+    status: Status,
+    /// The snapshot whose colours are on the GPU.
+    shown: Option<Arc<crate::worker::Snapshot>>,
+    shown_mode: DisplayMode,
+    /// The scene the camera was set up for.
+    camera_scene: Option<Arc<Scene>>,
+    extent: SceneExtent,
+    log_range: (f64, f64),
+    solution_ev: f64,
+    subdivision: Subdivision,
+    open_text: String,
+    loading: Option<(String, Receiver<Result<Scene, String>>)>,
+    load_error: Option<String>,
+    message: Option<String>,
+    fps: FpsCounter,
+    continuous: bool,
+    capture: Option<Capture>,
+    /// `--screenshot` path, taken once the solve reaches `after_shots` (or stops).
+    scripted: Option<(PathBuf, Option<u64>)>,
+    outcome: Outcome,
+    last_frame: Option<Instant>,
+    /// When a scripted run reached its mark, and the frame rate while it was solving.
+    mark: Option<(Instant, f64)>,
+}
+
+/// With continuous redraw, how long a scripted run keeps drawing after its mark before the
+/// screenshot, to measure the frame rate with the solver idle.
+const FPS_MEASURE: Duration = Duration::from_secs(3);
+
+impl ViewerApp {
+    /// Sets up GPU resources and starts the solve worker.
+    ///
+    /// # Errors
+    /// When eframe runs without wgpu.
+    pub(crate) fn new(
+        cc: &eframe::CreationContext<'_>,
+        options: ViewerOptions,
+        outcome: Outcome,
+    ) -> anyhow::Result<Self> {
+        let render_state = cc
+            .wgpu_render_state
+            .clone()
+            .ok_or_else(|| anyhow::anyhow!("the viewer needs eframe's wgpu renderer"))?;
+        let info = render_state.adapter.get_info();
+        log::info!("drawing with {} ({:?}, {:?})", info.name, info.backend, info.device_type);
+        // The renderer draws inside egui's render pass, so it lives with egui's renderer and
+        // is made for egui's target format and sample count.
+        let renderer = SceneRenderer::new(&render_state.device, render_state.target_format, options.samples);
+        render_state.renderer.write().callback_resources.insert(renderer);
+        let scene = Arc::new(options.scene);
+        let mesh_params = options.mesh_params.unwrap_or_else(|| scene.mesh_params());
+        let job = SolveJob {
+            label: options.scene_label,
+            scene: scene.clone(),
+            light_scale: options.light_scale,
+            mesh_params,
+            solver_params: options.solver_params,
+        };
+        let ctx = cc.egui_ctx.clone();
+        let worker = SolveWorker::spawn(
+            job.clone(),
+            WorkerOptions {
+                threads: options.threads,
+                start_paused: false,
+                pause_at_shots: options.after_shots.filter(|_| options.screenshot.is_some()),
+                notify: Some(Arc::new(move || ctx.request_repaint())),
+            },
+        );
+        let (lo, hi) = scene.bounds();
+        let extent = SceneExtent::new(lo, hi);
+        let camera = FlyCamera::from_scene_camera(&scene.camera_or_framing(), &extent);
+        Ok(Self {
+            view: ViewState {
+                camera,
+                auto_exposure: true,
+                exposure_ev: 0.0,
+                operator: ToneOperator::Aces,
+                mode: DisplayMode::Smooth,
+                wireframe: Wireframe::Off,
+            },
+            render_state,
+            view_size: [1, 1],
+            status: worker.status(),
+            worker,
+            subdivision: Subdivision {
+                light_scale: job.light_scale,
+                patch_size: job.mesh_params.patch_size,
+                element_size: job.mesh_params.element_size,
+            },
+            open_text: String::new(),
+            job,
+            shown: None,
+            shown_mode: DisplayMode::Smooth,
+            camera_scene: Some(scene),
+            extent,
+            log_range: (-1.0, 0.0),
+            solution_ev: 0.0,
+            loading: None,
+            load_error: None,
+            message: None,
+            fps: FpsCounter::default(),
+            continuous: options.continuous,
+            capture: None,
+            scripted: options.screenshot.map(|p| (p, options.after_shots)),
+            outcome,
+            last_frame: None,
+            mark: None,
+        })
+    }
+
+    /// Starts a new job, keeping the paused/running state.
+    fn restart_with(&mut self, job: SolveJob) {
+        self.job = job.clone();
+        self.worker.restart(Some(job));
+    }
+
+    fn apply_subdivision(&mut self) {
+        let s = self.subdivision;
+        match MeshParams::try_new(s.patch_size, s.element_size) {
+            Ok(mesh_params) => {
+                let job = SolveJob { light_scale: s.light_scale, mesh_params, ..self.job.clone() };
+                self.restart_with(job);
+            }
+            Err(e) => self.message = Some(format!("subdivision: {e}")),
+        }
+    }
+
+    /// Loads a scene file (or built-in name) on a helper thread; the old scene stays until it
+    /// has loaded and meshed.
+    fn open(&mut self, ctx: &egui::Context, arg: String) {
+        let arg = arg.trim().to_owned();
+        if arg.is_empty() {
+            return;
+        }
+        let (tx, rx) = std::sync::mpsc::channel();
+        let ctx = ctx.clone();
+        let what = arg.clone();
+        std::thread::spawn(move || {
+            let result = crate::load_scene(&what);
+            let _ = tx.send(result);
+            ctx.request_repaint();
+        });
+        self.load_error = None;
+        self.loading = Some((arg, rx));
+    }
+
+    fn poll_loading(&mut self) {
+        let Some((arg, rx)) = &self.loading else { return };
+        match rx.try_recv() {
+            Ok(Ok(scene)) => {
+                let arg = arg.clone();
+                self.loading = None;
+                let scene = Arc::new(scene);
+                let mesh_params = scene.mesh_params();
+                self.subdivision = Subdivision {
+                    light_scale: 1.0,
+                    patch_size: mesh_params.patch_size,
+                    element_size: mesh_params.element_size,
+                };
+                let mut solver_params = self.job.solver_params.clone();
+                // The new scene's own stop settings replace the old scene's.
+                solver_params.max_shots = scene.solver.max_shots;
+                solver_params.time_limit = scene.solver.time_limit.map(Duration::from_secs_f64);
+                if let Some(t) = scene.solver.unshot_threshold {
+                    solver_params.unshot_threshold = t;
+                }
+                let job = SolveJob { label: arg, scene, light_scale: 1.0, mesh_params, solver_params };
+                self.restart_with(job);
+            }
+            Ok(Err(e)) => {
+                self.load_error = Some(e);
+                self.loading = None;
+            }
+            Err(TryRecvError::Empty) => {}
+            Err(TryRecvError::Disconnected) => {
+                self.load_error = Some(format!("{arg}: the loader stopped unexpectedly"));
+                self.loading = None;
+            }
+        }
+    }
+
+    /// Takes the newest snapshot to the GPU if it is new or the display mode changed.
+    fn sync_snapshot(&mut self) {
+        self.status = self.worker.status();
+        let Some(snap) = self.worker.latest() else { return };
+        let is_new = self.shown.as_ref().is_none_or(|s| !Arc::ptr_eq(s, &snap));
+        if !is_new && self.shown_mode == self.view.mode {
+            return;
+        }
+        {
+            let mut egui_renderer = self.render_state.renderer.write();
+            if let Some(renderer) = egui_renderer.callback_resources.get_mut::<SceneRenderer>() {
+                renderer.set_mesh(&self.render_state.device, &snap.mesh);
+                renderer.set_solution(&self.render_state.queue, &snap.solution, self.view.mode);
+            }
+        }
+        self.shown_mode = self.view.mode;
+        if self.view.mode.is_false_colour() {
+            self.log_range = false_colour_range(&snap.solution, self.view.mode);
+        }
+        self.solution_ev = log_average_ev(&snap.mesh, &snap.solution);
+        // A new scene (not a re-mesh of the same one) gets its own camera.
+        if self.camera_scene.as_ref().is_none_or(|s| !Arc::ptr_eq(s, &snap.job.scene)) {
+            let (lo, hi) = snap.mesh.bounds();
+            self.extent = SceneExtent::new(lo, hi);
+            self.view.camera =
+                FlyCamera::from_scene_camera(&snap.job.scene.camera_or_framing(), &self.extent);
+            self.camera_scene = Some(snap.job.scene.clone());
+        }
+        self.shown = Some(snap);
+    }
+
+    fn exposure_ev(&self) -> f64 {
+        if self.view.auto_exposure { self.solution_ev } else { self.view.exposure_ev }
+    }
+
+    /// Camera keys, drag and wheel. Returns whether the camera is moving (so frames continue).
+    fn handle_camera_input(&mut self, ctx: &egui::Context, response: &egui::Response, aspect: f64) -> bool {
+        let now = Instant::now();
+        let dt = self.last_frame.map_or(0.0, |t| now.duration_since(t).as_secs_f64()).min(MAX_MOVE_DT);
+        self.last_frame = Some(now);
+        let mut moving = false;
+        if response.dragged() {
+            let d = response.drag_delta();
+            self.view
+                .camera
+                .look(f64::from(d.x) * LOOK_RADIANS_PER_POINT, f64::from(d.y) * LOOK_RADIANS_PER_POINT);
+            moving = true;
+        }
+        if response.hovered() {
+            let scroll = ctx.input(|i| i.smooth_scroll_delta.y);
+            if scroll != 0.0 {
+                self.view.camera.scale_speed(f64::from(scroll / POINTS_PER_NOTCH), self.extent.speed_range());
+                moving = true;
+            }
+        }
+        if ctx.egui_wants_keyboard_input() {
+            return moving;
+        }
+        let (input, reset, frame_all, shot) = ctx.input(|i| {
+            let axis = |pos: &[Key], neg: &[Key]| {
+                let p = pos.iter().any(|k| i.key_down(*k));
+                let n = neg.iter().any(|k| i.key_down(*k));
+                f64::from(i8::from(p) - i8::from(n))
+            };
+            let up = f64::from(i8::from(i.key_down(Key::E) || i.key_down(Key::Space)))
+                - f64::from(i8::from(i.key_down(Key::Q) || i.modifiers.ctrl));
+            (
+                MoveInput {
+                    forward: axis(&[Key::W, Key::ArrowUp], &[Key::S, Key::ArrowDown]),
+                    right: axis(&[Key::D, Key::ArrowRight], &[Key::A, Key::ArrowLeft]),
+                    up,
+                    run: i.modifiers.shift,
+                },
+                i.key_pressed(Key::R),
+                i.key_pressed(Key::F),
+                i.key_pressed(Key::P),
+            )
+        });
+        if input.is_moving() {
+            self.view.camera.advance(input, dt);
+            moving = true;
+        }
+        if reset && let Some(scene) = &self.camera_scene {
+            self.view.camera = FlyCamera::from_scene_camera(&scene.camera_or_framing(), &self.extent);
+        }
+        if frame_all {
+            self.view.camera.frame(&self.extent, aspect);
+        }
+        if shot {
+            self.save_view_png();
+        }
+        moving
+    }
+
+    /// P: draws the 3D view (without the panel) offscreen at its on-screen size and writes
+    /// it as a PNG.
+    fn save_view_png(&mut self) {
+        let name = self.shown.as_ref().map_or("scene".to_owned(), |s| {
+            let safe: String =
+                s.job.scene.name.chars().map(|c| if c.is_alphanumeric() { c } else { '-' }).collect();
+            format!("{}-{}shots", safe.to_lowercase(), s.solution.shots)
+        });
+        let path = unique_path(&name);
+        let frame = self.frame_params(self.view_size);
+        let (device, queue) = (&self.render_state.device, &self.render_state.queue);
+        let egui_renderer = self.render_state.renderer.read();
+        let Some(renderer) = egui_renderer.callback_resources.get::<SceneRenderer>() else { return };
+        let target = RenderTarget::new(device, self.view_size, renderer.format(), renderer.samples());
+        renderer.draw(device, queue, &target, &frame);
+        let result = target
+            .read_rgba8(device, queue)
+            .and_then(|img| image::DynamicImage::ImageRgba8(img).to_rgb8().save(&path).map_err(Into::into));
+        drop(egui_renderer);
+        self.message = Some(match result {
+            Ok(()) => format!("wrote {}", path.display()),
+            Err(e) => format!("cannot write {}: {e}", path.display()),
+        });
+    }
+
+    /// The frame's settings for a view of `size_px` pixels.
+    fn frame_params(&self, size_px: [u32; 2]) -> FrameParams {
+        let aspect = f64::from(size_px[0].max(1)) / f64::from(size_px[1].max(1));
+        FrameParams {
+            clip_from_world: self.view.camera.clip_from_view(aspect) * self.view.camera.view_from_world(),
+            exposure_ev: self.exposure_ev(),
+            operator: self.view.operator,
+            mode: self.view.mode,
+            wireframe: self.view.wireframe,
+            log_range: self.log_range,
+            background: BACKGROUND,
+        }
+    }
+
+    /// Adds the 3D view to `ui` as a paint callback covering `rect`: the mesh is drawn
+    /// straight into egui's render pass.
+    fn draw_view(&mut self, ui: &egui::Ui, rect: Rect) {
+        let ppp = ui.ctx().pixels_per_point();
+        self.view_size =
+            [(rect.width() * ppp).round().max(1.0) as u32, (rect.height() * ppp).round().max(1.0) as u32];
+        let callback = ViewCallback { frame: self.frame_params(self.view_size), width_px: self.view_size[0] };
+        ui.painter().add(egui_wgpu::Callback::new_paint_callback(rect, callback));
+    }
+
+    fn panel(&mut self, ui: &mut egui::Ui) {
+        let ctx = ui.ctx().clone();
+        let p = self.status.progress.clone();
+        let scene_name =
+            self.shown.as_ref().map_or(self.job.scene.name.clone(), |s| s.job.scene.name.clone());
+        let label = self.shown.as_ref().map_or(self.job.label.clone(), |s| s.job.label.clone());
+        ui.heading(&scene_name);
+        if label != scene_name {
+            ui.weak(&label);
+        }
+        ui.add_space(4.0);
+
+        // Opening scenes.
+        ui.horizontal(|ui| {
+            let edit = ui.add(
+                egui::TextEdit::singleline(&mut self.open_text)
+                    .hint_text("scene file or built-in name")
+                    .desired_width(ui.available_width() - 60.0),
+            );
+            let enter = edit.lost_focus() && ui.input(|i| i.key_pressed(Key::Enter));
+            if ui.add_enabled(self.loading.is_none(), egui::Button::new("Open")).clicked() || enter {
+                let text = self.open_text.clone();
+                self.open(&ctx, text);
+            }
+        });
+        if let Some((arg, _)) = &self.loading {
+            ui.horizontal(|ui| {
+                ui.spinner();
+                ui.label(format!("loading {arg}…"));
+            });
+        } else {
+            ui.weak("or drop a scene file on the window");
+        }
+        if let Some(e) = self.load_error.as_ref().or(self.status.error.as_ref()) {
+            ui.colored_label(Color32::from_rgb(255, 110, 100), format!("error: {e}"));
+        }
+        ui.separator();
+
+        // Progress.
+        let state = match &self.status.state {
+            WorkerState::Meshing => "meshing…".to_owned(),
+            WorkerState::Running => "solving".to_owned(),
+            WorkerState::Paused => "paused".to_owned(),
+            WorkerState::Stopped(r) => format!("stopped: {}", r.as_str().replace('_', " ")),
+            WorkerState::Ended => "solver ended".to_owned(),
+        };
+        egui::Grid::new("stats").num_columns(2).spacing([12.0, 2.0]).show(ui, |ui| {
+            let mut row = |k: &str, v: String| {
+                ui.label(k);
+                ui.monospace(v);
+                ui.end_row();
+            };
+            row("state", state);
+            row("patches", p.patches.to_string());
+            row("elements", p.elements.to_string());
+            row("shots", p.shots.to_string());
+            row("unshot", format!("{:.4} %", p.unshot_fraction * 100.0));
+            row("rays/s", format!("{:.3} M", p.rays_per_second() / 1e6));
+            row("elapsed", format!("{:.1} s", p.elapsed.as_secs_f64()));
+            let eta = match (&self.status.state, p.eta()) {
+                (WorkerState::Stopped(_), _) => "done".to_owned(),
+                (_, Some(t)) => format!("{:.1} s", t.as_secs_f64()),
+                (_, None) => "–".to_owned(),
+            };
+            row("ETA", eta);
+            row("fps", format!("{:.0}", self.fps.fps()));
+        });
+        ui.add(egui::ProgressBar::new(p.done_fraction() as f32).desired_height(6.0));
+        ui.horizontal(|ui| {
+            let running = self.status.state == WorkerState::Running;
+            if running {
+                if ui.button("Pause").clicked() {
+                    self.worker.pause();
+                }
+            } else if ui.button("Resume").clicked() {
+                self.worker.resume();
+            }
+            if ui.button("Step").on_hover_text("shoot one more patch, then pause").clicked() {
+                self.worker.step_one();
+            }
+            if ui.button("Restart").clicked() {
+                self.worker.restart(None);
+            }
+        });
+        ui.separator();
+
+        // Display.
+        ui.label("display");
+        ui.horizontal_wrapped(|ui| {
+            for m in DisplayMode::ALL {
+                ui.selectable_value(&mut self.view.mode, m, m.label());
+            }
+        });
+        ui.horizontal(|ui| {
+            ui.label("wireframe");
+            for w in Wireframe::ALL {
+                ui.selectable_value(&mut self.view.wireframe, w, w.label());
+            }
+        });
+        ui.add_enabled_ui(!self.view.mode.is_false_colour(), |ui| {
+            ui.horizontal(|ui| {
+                ui.checkbox(&mut self.view.auto_exposure, "auto exposure");
+                if self.view.auto_exposure {
+                    self.view.exposure_ev = self.solution_ev;
+                }
+            });
+            ui.add_enabled(
+                !self.view.auto_exposure,
+                egui::Slider::new(&mut self.view.exposure_ev, -16.0..=16.0).step_by(0.1).text("EV"),
+            );
+            egui::ComboBox::from_label("tone map").selected_text(self.view.operator.as_str()).show_ui(
+                ui,
+                |ui| {
+                    for op in ToneOperator::ALL {
+                        ui.selectable_value(&mut self.view.operator, op, op.as_str());
+                    }
+                },
+            );
+        });
+        ui.separator();
+
+        // Scene parameters: light intensity (S11) and subdivision (S10) restart the solve.
+        ui.label("light and subdivision (restart the solve)");
+        let diagonal = self.extent.diagonal();
+        let mut apply = false;
+        let released = |r: &egui::Response| r.drag_stopped() || (r.changed() && !r.dragged());
+        let r = ui.add(
+            egui::Slider::new(&mut self.subdivision.light_scale, 0.01..=100.0)
+                .logarithmic(true)
+                .text("light ×"),
+        );
+        apply |= released(&r);
+        let size_range = diagonal / 1000.0..=diagonal / 2.0;
+        let r = ui.add(
+            egui::Slider::new(&mut self.subdivision.patch_size, size_range.clone())
+                .logarithmic(true)
+                .text("patch size"),
+        );
+        apply |= released(&r);
+        let r = ui.add(
+            egui::Slider::new(&mut self.subdivision.element_size, size_range)
+                .logarithmic(true)
+                .text("element size"),
+        );
+        apply |= released(&r);
+        if apply {
+            self.apply_subdivision();
+        }
+        ui.separator();
+
+        ui.horizontal(|ui| {
+            if ui.button("Screenshot (P)").clicked() {
+                self.save_view_png();
+            }
+            ui.checkbox(&mut self.continuous, "redraw continuously").on_hover_text(
+                "draw every frame, not only when something changes (shows the highest frame rate)",
+            );
+        });
+        if let Some(m) = &self.message {
+            ui.label(m);
+        }
+        ui.add_space(6.0);
+        ui.weak(format!("camera speed {:.3} units/s", self.view.camera.speed));
+    }
+
+    /// Draws the false-colour legend in the bottom-left corner of `rect`.
+    fn legend(&self, painter: &egui::Painter, rect: Rect) {
+        let (lo, hi) = self.log_range;
+        let bar = Rect::from_min_size(rect.left_bottom() + Vec2::new(16.0, -236.0), Vec2::new(18.0, 180.0));
+        let bg = bar.expand2(Vec2::new(10.0, 28.0)).with_max_x(bar.max.x + 104.0);
+        painter.rect_filled(bg, 4.0, Color32::from_black_alpha(170));
+        let steps = 48;
+        let mut mesh = egui::Mesh::default();
+        for k in 0..=steps {
+            let t = k as f32 / steps as f32;
+            let [r, g, b] = false_colour(f64::from(t)).map(|c| (c * 255.0).round() as u8);
+            let y = bar.bottom() - t * bar.height();
+            let c = Color32::from_rgb(r, g, b);
+            mesh.colored_vertex(Pos2::new(bar.left(), y), c);
+            mesh.colored_vertex(Pos2::new(bar.right(), y), c);
+            if k > 0 {
+                let i = (2 * k) as u32;
+                mesh.add_triangle(i - 2, i - 1, i);
+                mesh.add_triangle(i - 1, i + 1, i);
+            }
+        }
+        painter.add(egui::Shape::mesh(mesh));
+        let font = egui::FontId::proportional(11.0);
+        let title = match self.view.mode {
+            DisplayMode::Unshot => "unshot ΔB, W/unit²",
+            _ => "radiosity (Y), W/unit²",
+        };
+        painter.text(
+            bar.left_top() + Vec2::new(-2.0, -8.0),
+            egui::Align2::LEFT_BOTTOM,
+            title,
+            font.clone(),
+            Color32::WHITE,
+        );
+        for k in 0..=4 {
+            let t = k as f64 / 4.0;
+            let value = 10f64.powf(lo + t * (hi - lo));
+            let y = bar.bottom() - t as f32 * bar.height();
+            painter.text(
+                Pos2::new(bar.right() + 6.0, y),
+                egui::Align2::LEFT_CENTER,
+                format!("{value:.3e}"),
+                font.clone(),
+                Color32::WHITE,
+            );
+        }
+    }
+
+    /// `--screenshot`: once the solve reached its mark, asks for the window's pixels, writes
+    /// them, and closes the window.
+    fn scripted_capture(&mut self, ctx: &egui::Context) {
+        if let Some((path, after)) = &self.scripted
+            && self.capture.is_none()
+        {
+            let shown_shots = self.shown.as_ref().map_or(0, |s| s.solution.shots);
+            let done_status = match after {
+                Some(n) => self.status.progress.shots >= *n,
+                None => matches!(self.status.state, WorkerState::Stopped(_)),
+            } || matches!(self.status.state, WorkerState::Stopped(_));
+            let shown_current = self.shown.is_some() && shown_shots == self.status.progress.shots;
+            if self.status.error.is_some() && self.shown.is_none() {
+                let e = self.status.error.clone().unwrap_or_default();
+                self.finish(ctx, Err(anyhow::anyhow!(e)));
+                return;
+            }
+            let ready = done_status && shown_current && self.status.state != WorkerState::Meshing;
+            if ready && self.mark.is_none() {
+                self.mark = Some((Instant::now(), self.fps.fps()));
+            }
+            // With continuous redraw, keep drawing a while with the solver idle: the frame
+            // rate printed then is the window's own.
+            let measured = !self.continuous || self.mark.is_some_and(|(t, _)| t.elapsed() >= FPS_MEASURE);
+            if ready && measured {
+                self.capture = Some(Capture {
+                    path: path.clone(),
+                    then_exit: true,
+                    image: Arc::default(),
+                    requested: false,
+                });
+            }
+        }
+        let Some(capture) = &mut self.capture else { return };
+        if !capture.requested {
+            let slot = capture.image.clone();
+            let ctx2 = ctx.clone();
+            ctx.request_screenshot(move |img| {
+                *slot.lock().unwrap_or_else(|e| e.into_inner()) = Some(img);
+                ctx2.request_repaint();
+            });
+            capture.requested = true;
+            return;
+        }
+        let taken = capture.image.lock().unwrap_or_else(|e| e.into_inner()).take();
+        if let Some(img) = taken {
+            let path = capture.path.clone();
+            let then_exit = capture.then_exit;
+            self.capture = None;
+            let result = save_color_image(&img, &path);
+            if then_exit {
+                if result.is_ok() {
+                    let solving_fps = self.mark.map_or(0.0, |m| m.1);
+                    eprintln!(
+                        "wrote {} ({}×{} px, {} shots; {:.1} fps while solving{})",
+                        path.display(),
+                        img.size[0],
+                        img.size[1],
+                        self.status.progress.shots,
+                        solving_fps,
+                        if self.continuous {
+                            format!(", {:.1} fps idle", self.fps.fps())
+                        } else {
+                            String::new()
+                        }
+                    );
+                }
+                self.finish(ctx, result);
+            } else {
+                self.message = Some(match result {
+                    Ok(()) => format!("wrote {}", path.display()),
+                    Err(e) => format!("{e:#}"),
+                });
+            }
+        }
+    }
+
+    fn finish(&mut self, ctx: &egui::Context, result: anyhow::Result<()>) {
+        *self.outcome.lock().unwrap_or_else(|e| e.into_inner()) = Some(result);
+        self.scripted = None;
+        ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+    }
+}
+
+impl eframe::App for ViewerApp {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        let ctx = ui.ctx().clone();
+        self.fps.tick(Instant::now());
+        let dropped: Vec<PathBuf> =
+            ctx.input(|i| i.raw.dropped_files.iter().map(|f| f.path().to_path_buf()).collect());
+        if let Some(path) = dropped.into_iter().next() {
+            let text = path.display().to_string();
+            self.open_text = text.clone();
+            self.open(&ctx, text);
+        }
+        self.poll_loading();
+        self.sync_snapshot();
+
+        egui::Panel::right("radiosity_panel").default_size(300.0).min_size(240.0).show(ui, |ui| {
+            egui::ScrollArea::vertical().show(ui, |ui| self.panel(ui));
+        });
+        let mut moving = false;
+        egui::CentralPanel::no_frame().show(ui, |ui| {
+            let rect = ui.max_rect();
+            let response = ui.allocate_rect(rect, Sense::click_and_drag());
+            let aspect = f64::from(rect.width().max(1.0)) / f64::from(rect.height().max(1.0));
+            moving = self.handle_camera_input(&ctx, &response, aspect);
+            // The camera may have moved, so draw after the input.
+            self.draw_view(ui, rect);
+            if self.view.mode.is_false_colour() && self.shown.is_some() {
+                self.legend(ui.painter(), rect);
+            }
+            if self.shown.is_none() {
+                ui.painter().text(
+                    rect.center(),
+                    egui::Align2::CENTER_CENTER,
+                    "meshing…",
+                    egui::FontId::proportional(18.0),
+                    Color32::LIGHT_GRAY,
+                );
+            }
+            let hint_rect = Rect::from_min_max(Pos2::new(rect.left(), rect.bottom() - 22.0), rect.max);
+            ui.painter().rect_filled(hint_rect, 0.0, Color32::from_black_alpha(140));
+            ui.painter().text(
+                hint_rect.left_center() + Vec2::new(8.0, 0.0),
+                egui::Align2::LEFT_CENTER,
+                KEY_HINT,
+                egui::FontId::proportional(12.0),
+                Color32::from_gray(220),
+            );
+        });
+        self.scripted_capture(&ctx);
+        let busy = matches!(self.status.state, WorkerState::Meshing) || self.loading.is_some();
+        if moving || self.continuous || busy || self.capture.is_some() || self.scripted.is_some() {
+            ctx.request_repaint();
+        } else if self.status.state == WorkerState::Running {
+            // The worker's publications wake the window; this is a floor for the panel's
+            // clocks in case a shot takes long.
+            ctx.request_repaint_after(Duration::from_millis(250));
+        }
+    }
+}
+
+/// The 3D view's part of egui's frame.
+struct ViewCallback {
+    frame: FrameParams,
+    width_px: u32,
+}
+
+impl egui_wgpu::CallbackTrait for ViewCallback {
+    fn prepare(
+        &self,
+        _device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        _screen: &egui_wgpu::ScreenDescriptor,
+        _encoder: &mut wgpu::CommandEncoder,
+        resources: &mut egui_wgpu::CallbackResources,
+    ) -> Vec<wgpu::CommandBuffer> {
+        if let Some(renderer) = resources.get::<SceneRenderer>() {
+            renderer.prepare(queue, &self.frame, self.width_px);
+        }
+        Vec::new()
+    }
+
+    fn paint(
+        &self,
+        _info: egui::PaintCallbackInfo,
+        pass: &mut wgpu::RenderPass<'static>,
+        resources: &egui_wgpu::CallbackResources,
+    ) {
+        if let Some(renderer) = resources.get::<SceneRenderer>() {
+            renderer.paint(pass);
+        }
+    }
+}
+
+/// Writes an egui screenshot as an RGB PNG.
+fn save_color_image(img: &egui::ColorImage, path: &std::path::Path) -> anyhow::Result<()> {
+    let [w, h] = img.size;
+    let rgb: Vec<u8> = img.pixels.iter().flat_map(|c| [c.r(), c.g(), c.b()]).collect();
+    let buf = image::RgbImage::from_raw(w as u32, h as u32, rgb)
+        .ok_or_else(|| anyhow::anyhow!("screenshot has the wrong size"))?;
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("cannot create {}: {e}", dir.display()))?;
+    }
+    buf.save(path).map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))
+}
+
+/// `name.png`, or `name-2.png`, … if it exists: a screenshot never overwrites a file.
+fn unique_path(name: &str) -> PathBuf {
+    let first = PathBuf::from(format!("{name}.png"));
+    if !first.exists() {
+        return first;
+    }
+    (2..).map(|k| PathBuf::from(format!("{name}-{k}.png"))).find(|p| !p.exists()).unwrap_or(first)
+}
+
+/// The area-weighted log-average luminance of a solution's radiance, as an exposure in stops
+/// that maps it to middle grey — the viewer's stand-in for `render`'s per-pixel auto exposure.
+pub(crate) fn log_average_ev(mesh: &radiosity_core::Mesh, solution: &Solution) -> f64 {
+    let mut sum = 0.0;
+    let mut area = 0.0;
+    for (el, b) in mesh.elements.iter().zip(&solution.element_radiosity) {
+        let l = b.luminance() / std::f64::consts::PI;
+        if l > 0.0 && l.is_finite() {
+            sum += el.area * l.ln();
+            area += el.area;
+        }
+    }
+    if area <= 0.0 {
+        return 0.0;
+    }
+    (radiosity_image::AUTO_EXPOSURE_KEY / (sum / area).exp()).log2()
+}

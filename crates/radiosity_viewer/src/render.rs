@@ -1,0 +1,755 @@
+//! GPU drawing of the lit mesh with wgpu into whatever it is given: a render pass someone else
+//! began (the window's, through an egui paint callback), or a [`RenderTarget`] of its own (a
+//! screenshot of the view, a headless test). Both go through [`SceneRenderer::paint`].
+//!
+//! Drawing straight into the window's pass, rather than into a texture that egui then copies,
+//! saves a full-screen textured pass per frame: on a CPU rasteriser (lavapipe, llvmpipe) that
+//! copy cost as much as drawing the scene.
+//!
+//! The mesh is drawn as a non-indexed triangle list so every triangle corner can carry its
+//! own colour: the vertex radiosity for smooth shading (the same values and the same
+//! barycentric interpolation as the CPU renderer) or its element's value for flat shading.
+//! Colours stay linear to the fragment shader, which tone maps them (`tonemap.wgsl`).
+
+use std::sync::Arc;
+
+use eframe::wgpu;
+use glam::{DMat4, DVec3};
+use radiosity_core::{Mesh, Rgb};
+use radiosity_image::ToneOperator;
+use radiosity_solver::Solution;
+
+/// WGSL source of the tone-map functions (shared with the CPU/GPU agreement test).
+pub const TONEMAP_WGSL: &str = include_str!("shaders/tonemap.wgsl");
+/// WGSL source of the mesh shader, to be appended to [`TONEMAP_WGSL`].
+pub const SCENE_WGSL: &str = include_str!("shaders/scene.wgsl");
+
+/// Colour format of headless render targets. The shader writes sRGB-encoded values itself,
+/// exactly like the CPU path (on an sRGB format it writes linear values instead).
+pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+/// Depth format: 32-bit float for reversed z (see [`crate::camera`]).
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// The operator's id in the shader (`OP_*` in `tonemap.wgsl`).
+pub fn shader_operator(op: ToneOperator) -> u32 {
+    match op {
+        ToneOperator::Linear => 0,
+        ToneOperator::Reinhard => 1,
+        ToneOperator::Aces => 2,
+    }
+}
+
+/// What the surfaces show.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum DisplayMode {
+    /// Vertex radiosity interpolated across elements, tone mapped.
+    #[default]
+    Smooth,
+    /// Each element's own radiosity, tone mapped: shows the subdivision.
+    FlatElements,
+    /// False colour of log luminance of the (smooth) radiosity, with a legend.
+    FalseColour,
+    /// False colour of each element's unshot radiosity ΔB: where light still waits.
+    Unshot,
+}
+
+impl DisplayMode {
+    /// Every mode, in panel order.
+    pub const ALL: [DisplayMode; 4] =
+        [DisplayMode::Smooth, DisplayMode::FlatElements, DisplayMode::FalseColour, DisplayMode::Unshot];
+
+    /// Label in the panel.
+    pub fn label(self) -> &'static str {
+        match self {
+            DisplayMode::Smooth => "smooth",
+            DisplayMode::FlatElements => "flat elements",
+            DisplayMode::FalseColour => "false colour",
+            DisplayMode::Unshot => "unshot energy",
+        }
+    }
+
+    /// Whether the mode is drawn in false colour with a legend.
+    pub fn is_false_colour(self) -> bool {
+        matches!(self, DisplayMode::FalseColour | DisplayMode::Unshot)
+    }
+}
+
+/// Which subdivision lines are drawn over the surfaces.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Wireframe {
+    /// None.
+    #[default]
+    Off,
+    /// Patch outlines (the shooters).
+    Patches,
+    /// Element outlines, patch outlines on top.
+    Elements,
+}
+
+impl Wireframe {
+    /// Every choice, in panel order.
+    pub const ALL: [Wireframe; 3] = [Wireframe::Off, Wireframe::Patches, Wireframe::Elements];
+
+    /// Label in the panel.
+    pub fn label(self) -> &'static str {
+        match self {
+            Wireframe::Off => "off",
+            Wireframe::Patches => "patches",
+            Wireframe::Elements => "elements",
+        }
+    }
+
+    fn shader_bits(self) -> u32 {
+        match self {
+            Wireframe::Off => 0,
+            Wireframe::Patches => 2,
+            Wireframe::Elements => 3,
+        }
+    }
+}
+
+/// Everything a frame needs besides the mesh and its colours.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameParams {
+    /// World → clip transform (reversed z), double precision; see [`crate::FlyCamera`].
+    pub clip_from_world: DMat4,
+    /// Exposure in stops: radiance is multiplied by 2^EV before the operator.
+    pub exposure_ev: f64,
+    /// Tone-map operator.
+    pub operator: ToneOperator,
+    /// What the surfaces show.
+    pub mode: DisplayMode,
+    /// Subdivision lines.
+    pub wireframe: Wireframe,
+    /// False colour range, log10 of luminance, `(min, max)`.
+    pub log_range: (f64, f64),
+    /// Clear colour, display (sRGB-encoded) values.
+    pub background: [f32; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Uniforms {
+    clip_from_local: [[f32; 4]; 4],
+    background: [f32; 4],
+    exposure_scale: f32,
+    tone_op: u32,
+    mode: u32,
+    wire: u32,
+    log_min: f32,
+    log_max: f32,
+    wire_half_width: f32,
+    output_linear: u32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct StaticVertex {
+    position: [f32; 3],
+    edges: u32,
+}
+
+/// Colour and depth textures to draw into, with a multisampled colour buffer that resolves
+/// into the single-sampled one when more than one sample is asked for.
+pub struct RenderTarget {
+    size: [u32; 2],
+    format: wgpu::TextureFormat,
+    samples: u32,
+    colour: wgpu::Texture,
+    colour_view: wgpu::TextureView,
+    msaa_view: Option<wgpu::TextureView>,
+    depth_view: wgpu::TextureView,
+}
+
+impl RenderTarget {
+    /// Textures of `size` pixels (each at least 1) in `format` (8-bit RGBA or BGRA, plain or
+    /// sRGB) with `samples` samples per pixel (1 or 4).
+    pub fn new(device: &wgpu::Device, size: [u32; 2], format: wgpu::TextureFormat, samples: u32) -> Self {
+        let size = [size[0].max(1), size[1].max(1)];
+        let extent = wgpu::Extent3d { width: size[0], height: size[1], depth_or_array_layers: 1 };
+        let texture = |label, format, samples, usage| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: extent,
+                mip_level_count: 1,
+                sample_count: samples,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let colour = texture(
+            "radiosity view colour",
+            format,
+            1,
+            wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+        );
+        let msaa_view = (samples > 1).then(|| {
+            texture("radiosity view msaa", format, samples, wgpu::TextureUsages::RENDER_ATTACHMENT)
+                .create_view(&Default::default())
+        });
+        let depth =
+            texture("radiosity view depth", DEPTH_FORMAT, samples, wgpu::TextureUsages::RENDER_ATTACHMENT);
+        Self {
+            size,
+            format,
+            samples,
+            colour_view: colour.create_view(&Default::default()),
+            colour,
+            msaa_view,
+            depth_view: depth.create_view(&Default::default()),
+        }
+    }
+
+    /// Size in pixels.
+    pub fn size(&self) -> [u32; 2] {
+        self.size
+    }
+
+    /// Samples per pixel.
+    pub fn samples(&self) -> u32 {
+        self.samples
+    }
+
+    /// The resolved colour texture.
+    pub fn colour_view(&self) -> &wgpu::TextureView {
+        &self.colour_view
+    }
+
+    /// Copies the colour texture back to the CPU as RGBA with sRGB-encoded values; waits for
+    /// the GPU.
+    ///
+    /// # Errors
+    /// When the device is lost or the buffer cannot be mapped.
+    pub fn read_rgba8(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> anyhow::Result<image::RgbaImage> {
+        let [w, h] = self.size;
+        // Rows of a texture-to-buffer copy are padded to 256 bytes.
+        let row = (w * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("radiosity view readback"),
+            size: u64::from(row) * u64::from(h),
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        let mut encoder = device.create_command_encoder(&Default::default());
+        encoder.copy_texture_to_buffer(
+            self.colour.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(row),
+                    rows_per_image: Some(h),
+                },
+            },
+            wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+        );
+        queue.submit([encoder.finish()]);
+        let slice = buffer.slice(..);
+        let (tx, rx) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
+        device.poll(wgpu::PollType::wait_indefinitely())?;
+        rx.recv()??;
+        let data =
+            slice.get_mapped_range().map_err(|e| anyhow::anyhow!("cannot read the picture back: {e:?}"))?;
+        let bgra =
+            matches!(self.format, wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb);
+        let mut pixels = Vec::with_capacity((w * h * 4) as usize);
+        for y in 0..h as usize {
+            let start = y * row as usize;
+            for px in data[start..start + (w * 4) as usize].chunks_exact(4) {
+                if bgra {
+                    pixels.extend_from_slice(&[px[2], px[1], px[0], px[3]]);
+                } else {
+                    pixels.extend_from_slice(px);
+                }
+            }
+        }
+        drop(data);
+        buffer.unmap();
+        image::RgbaImage::from_raw(w, h, pixels).ok_or_else(|| anyhow::anyhow!("readback has the wrong size"))
+    }
+}
+
+/// A GPU device without a window, for offscreen pictures and tests. Any adapter will do,
+/// a CPU one (lavapipe, llvmpipe) included; `WGPU_BACKEND` and friends are honoured.
+///
+/// # Errors
+/// When no adapter or device can be had; the message names the drivers to install.
+pub fn headless_gpu() -> anyhow::Result<(wgpu::Device, wgpu::Queue, wgpu::AdapterInfo)> {
+    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+    let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions::default()))
+        .or_else(|_| {
+            pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+                force_fallback_adapter: true,
+                ..Default::default()
+            }))
+        })
+        .map_err(|e| {
+            anyhow::anyhow!(
+                "no GPU adapter: {e}; install a Vulkan or GL driver (./setup.sh installs Mesa's lavapipe and llvmpipe)"
+            )
+        })?;
+    let info = adapter.get_info();
+    let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+        label: Some("radiosity headless"),
+        required_limits: wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
+        ..Default::default()
+    }))
+    .map_err(|e| anyhow::anyhow!("cannot open {} ({:?}): {e}", info.name, info.backend))?;
+    Ok((device, queue, info))
+}
+
+/// The mesh on the GPU.
+struct Geometry {
+    mesh: Arc<Mesh>,
+    /// `(element, [v0, v1, v2])` of every drawn triangle, in buffer order.
+    triangles: Vec<(u32, [u32; 3])>,
+    /// Mesh-local origin: positions are stored relative to it.
+    origin: DVec3,
+    vertices: wgpu::Buffer,
+    colours: wgpu::Buffer,
+    /// Scratch for the colour upload, kept to avoid reallocating at every snapshot.
+    scratch: Vec<[f32; 3]>,
+}
+
+/// Draws a [`Mesh`] lit by a [`Solution`].
+pub struct SceneRenderer {
+    mesh_pipeline: wgpu::RenderPipeline,
+    background_pipeline: wgpu::RenderPipeline,
+    uniforms: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+    format: wgpu::TextureFormat,
+    samples: u32,
+    geometry: Option<Geometry>,
+}
+
+impl SceneRenderer {
+    /// Pipelines for colour targets in `format` (8-bit, plain or sRGB) with a
+    /// [`DEPTH_FORMAT`] depth buffer and `samples` samples per pixel.
+    pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat, samples: u32) -> Self {
+        let samples = samples.max(1);
+        let source = format!("{TONEMAP_WGSL}\n{SCENE_WGSL}");
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("radiosity scene shader"),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        });
+        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("radiosity scene uniforms"),
+            size: std::mem::size_of::<Uniforms>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("radiosity scene bind group layout"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            }],
+        });
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("radiosity scene bind group"),
+            layout: &layout,
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() }],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("radiosity scene pipeline layout"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = |label, vs, fs, buffers: &[Option<wgpu::VertexBufferLayout<'_>>], cull, compare| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(&pipeline_layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some(vs),
+                    compilation_options: Default::default(),
+                    buffers,
+                },
+                primitive: wgpu::PrimitiveState {
+                    topology: wgpu::PrimitiveTopology::TriangleList,
+                    front_face: wgpu::FrontFace::Ccw,
+                    cull_mode: cull,
+                    ..Default::default()
+                },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH_FORMAT,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(compare),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: wgpu::MultisampleState { count: samples, ..Default::default() },
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some(fs),
+                    compilation_options: Default::default(),
+                    targets: &[Some(format.into())],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let mesh_pipeline = pipeline(
+            "radiosity mesh pipeline",
+            "vs_main",
+            "fs_main",
+            &[
+                Some(wgpu::VertexBufferLayout {
+                    array_stride: std::mem::size_of::<StaticVertex>() as u64,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Uint32],
+                }),
+                Some(wgpu::VertexBufferLayout {
+                    array_stride: 12,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &wgpu::vertex_attr_array![2 => Float32x3],
+                }),
+            ],
+            // Surfaces are one-sided (lit from the side their normal points to): from outside a
+            // room you see into it, like a doll's house.
+            Some(wgpu::Face::Back),
+            // Reversed z: nearer is greater.
+            wgpu::CompareFunction::Greater,
+        );
+        let background_pipeline = pipeline(
+            "radiosity background pipeline",
+            "vs_background",
+            "fs_background",
+            &[],
+            None,
+            wgpu::CompareFunction::Always,
+        );
+        Self { mesh_pipeline, background_pipeline, uniforms, bind_group, format, samples, geometry: None }
+    }
+
+    /// The colour format the pipelines were made for.
+    pub fn format(&self) -> wgpu::TextureFormat {
+        self.format
+    }
+
+    /// Samples per pixel the pipeline was made for.
+    pub fn samples(&self) -> u32 {
+        self.samples
+    }
+
+    /// The mesh being drawn.
+    pub fn mesh(&self) -> Option<&Arc<Mesh>> {
+        self.geometry.as_ref().map(|g| &g.mesh)
+    }
+
+    /// Uploads `mesh` (if it is not the one already uploaded); colours start black.
+    pub fn set_mesh(&mut self, device: &wgpu::Device, mesh: &Arc<Mesh>) {
+        if self.geometry.as_ref().is_some_and(|g| Arc::ptr_eq(&g.mesh, mesh)) {
+            return;
+        }
+        let (lo, hi) = mesh.bounds();
+        let origin = if lo.is_finite() && hi.is_finite() { (lo + hi) * 0.5 } else { DVec3::ZERO };
+        let triangles = oriented_triangles(mesh);
+        let edges = edge_flags(mesh, &triangles);
+        let mut vertices = Vec::with_capacity(triangles.len() * 3);
+        for ((_, tri), flags) in triangles.iter().zip(&edges) {
+            for &v in tri {
+                let p = (mesh.positions[v as usize] - origin).as_vec3();
+                vertices.push(StaticVertex { position: p.to_array(), edges: *flags });
+            }
+        }
+        use wgpu::util::DeviceExt;
+        let vertex_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("radiosity mesh vertices"),
+            contents: bytemuck::cast_slice(&vertices),
+            usage: wgpu::BufferUsages::VERTEX,
+        });
+        let colours = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("radiosity mesh colours"),
+            size: (vertices.len().max(1) * 12) as u64,
+            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        self.geometry = Some(Geometry {
+            mesh: mesh.clone(),
+            triangles,
+            origin,
+            vertices: vertex_buffer,
+            colours,
+            scratch: Vec::new(),
+        });
+    }
+
+    /// Uploads the colours `mode` shows from `solution` (which must belong to the uploaded
+    /// mesh; a mismatched one is ignored).
+    pub fn set_solution(&mut self, queue: &wgpu::Queue, solution: &Solution, mode: DisplayMode) {
+        let Some(g) = self.geometry.as_mut() else { return };
+        let (n_vertices, n_elements) = (g.mesh.positions.len(), g.mesh.elements.len());
+        if solution.vertex_radiosity.len() != n_vertices
+            || solution.element_radiosity.len() != n_elements
+            || solution.element_unshot.len() != n_elements
+        {
+            return;
+        }
+        let f = |c: Rgb| [c.r as f32, c.g as f32, c.b as f32];
+        g.scratch.clear();
+        for &(e, tri) in &g.triangles {
+            match mode {
+                DisplayMode::Smooth | DisplayMode::FalseColour => {
+                    g.scratch.extend(tri.iter().map(|&v| f(solution.vertex_radiosity[v as usize])));
+                }
+                DisplayMode::FlatElements => g.scratch.extend([f(solution.element_radiosity[e as usize]); 3]),
+                DisplayMode::Unshot => g.scratch.extend([f(solution.element_unshot[e as usize].abs()); 3]),
+            }
+        }
+        queue.write_buffer(&g.colours, 0, bytemuck::cast_slice(&g.scratch));
+    }
+
+    /// Writes the frame's settings for the next [`Self::paint`]; `width_px` is the width of
+    /// the viewport in pixels (it sets the wireframe line width).
+    pub fn prepare(&self, queue: &wgpu::Queue, frame: &FrameParams, width_px: u32) {
+        let origin = self.geometry.as_ref().map_or(DVec3::ZERO, |g| g.origin);
+        let clip_from_local = frame.clip_from_world * DMat4::from_translation(origin);
+        let uniforms = Uniforms {
+            clip_from_local: clip_from_local.as_mat4().to_cols_array_2d(),
+            background: frame.background,
+            exposure_scale: (2f64.powf(frame.exposure_ev) / std::f64::consts::PI) as f32,
+            tone_op: shader_operator(frame.operator),
+            mode: u32::from(frame.mode.is_false_colour()),
+            wire: frame.wireframe.shader_bits(),
+            log_min: frame.log_range.0 as f32,
+            log_max: frame.log_range.1 as f32,
+            // Thin lines on small views, a little wider on big ones.
+            wire_half_width: (width_px as f32 / 2400.0).clamp(0.25, 0.8),
+            output_linear: u32::from(self.format.is_srgb()),
+        };
+        queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
+    }
+
+    /// Records the frame into `pass`, within the pass's current viewport: first the background
+    /// (which also resets depth there), then the mesh. The pass must target this renderer's
+    /// format and sample count with a [`DEPTH_FORMAT`] depth buffer.
+    pub fn paint(&self, pass: &mut wgpu::RenderPass<'_>) {
+        pass.set_bind_group(0, &self.bind_group, &[]);
+        pass.set_pipeline(&self.background_pipeline);
+        pass.draw(0..3, 0..1);
+        if let Some(g) = &self.geometry
+            && !g.triangles.is_empty()
+        {
+            pass.set_pipeline(&self.mesh_pipeline);
+            pass.set_vertex_buffer(0, g.vertices.slice(..));
+            pass.set_vertex_buffer(1, g.colours.slice(..));
+            pass.draw(0..(g.triangles.len() * 3) as u32, 0..1);
+        }
+    }
+
+    /// Draws a whole frame into `target` and submits it.
+    pub fn draw(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        target: &RenderTarget,
+        frame: &FrameParams,
+    ) {
+        debug_assert_eq!(
+            (target.format, target.samples),
+            (self.format, self.samples),
+            "target and pipelines differ"
+        );
+        self.prepare(queue, frame, target.size[0]);
+        let mut encoder =
+            device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("radiosity view") });
+        {
+            let (view, resolve_target) = match &target.msaa_view {
+                Some(msaa) => (msaa, Some(&target.colour_view)),
+                None => (&target.colour_view, None),
+            };
+            // Load-op clears are not needed (paint clears its viewport) but are cheap and make
+            // the target's content defined outside the viewport too.
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("radiosity view pass"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view,
+                    depth_slice: None,
+                    resolve_target,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &target.depth_view,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(0.0),
+                        store: wgpu::StoreOp::Discard,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            self.paint(&mut pass);
+        }
+        queue.submit([encoder.finish()]);
+    }
+}
+
+/// The mesh's element triangles, each wound counter-clockwise seen from the side its element
+/// faces, so back-face culling keeps the lit side whatever order the mesher used.
+pub fn oriented_triangles(mesh: &Mesh) -> Vec<(u32, [u32; 3])> {
+    mesh.element_triangles()
+        .map(|(e, [a, b, c])| {
+            let p = |i: u32| mesh.positions[i as usize];
+            let n = (p(b) - p(a)).cross(p(c) - p(a));
+            if n.dot(mesh.elements[e as usize].normal) < 0.0 { (e, [a, c, b]) } else { (e, [a, b, c]) }
+        })
+        .collect()
+}
+
+/// Wireframe flags of every triangle: for edge i (opposite corner i), bit 2i when it is an
+/// element edge (not a quad's diagonal) and bit 2i+1 when it is also on its patch's outline
+/// (no other element of the same patch shares it).
+pub fn edge_flags(mesh: &Mesh, triangles: &[(u32, [u32; 3])]) -> Vec<u32> {
+    use std::collections::HashMap;
+    let key = |a: u32, b: u32| (a.min(b), a.max(b));
+    // How many elements of each patch use each element edge.
+    let mut uses: HashMap<(u32, (u32, u32)), u32> = HashMap::new();
+    for el in &mesh.elements {
+        let v = el.vertex_indices();
+        for i in 0..v.len() {
+            *uses.entry((el.patch, key(v[i], v[(i + 1) % v.len()]))).or_default() += 1;
+        }
+    }
+    triangles
+        .iter()
+        .map(|&(e, tri)| {
+            let el = &mesh.elements[e as usize];
+            let v = el.vertex_indices();
+            let is_element_edge =
+                |a: u32, b: u32| (0..v.len()).any(|i| key(v[i], v[(i + 1) % v.len()]) == key(a, b));
+            let mut flags = 0;
+            for i in 0..3 {
+                let (a, b) = (tri[(i + 1) % 3], tri[(i + 2) % 3]);
+                if is_element_edge(a, b) {
+                    flags |= 1 << (2 * i);
+                    if uses.get(&(el.patch, key(a, b))) == Some(&1) {
+                        flags |= 2 << (2 * i);
+                    }
+                }
+            }
+            flags
+        })
+        .collect()
+}
+
+/// The false-colour range, log10 of luminance, of what `mode` shows: four decades below the
+/// brightest value (a dark corner must not squash the whole scale), or `(−1, 0)` when nothing
+/// is lit yet.
+pub fn false_colour_range(solution: &Solution, mode: DisplayMode) -> (f64, f64) {
+    let values: &[Rgb] = match mode {
+        DisplayMode::Unshot => &solution.element_unshot,
+        _ => &solution.vertex_radiosity,
+    };
+    let max = values.iter().map(|c| c.abs().luminance()).filter(|l| l.is_finite()).fold(0.0, f64::max);
+    if max <= 0.0 {
+        return (-1.0, 0.0);
+    }
+    let min = values
+        .iter()
+        .map(|c| c.abs().luminance())
+        .filter(|l| l.is_finite() && *l > 0.0)
+        .fold(max, f64::min)
+        .max(max * 1e-4);
+    let (lo, hi) = (min.log10(), max.log10());
+    if hi - lo < 1e-3 { (hi - 0.5, hi + 0.5) } else { (lo, hi) }
+}
+
+/// The Turbo false-colour ramp at t in [0, 1], display values in [0, 1]; the same polynomial
+/// as `false_colour` in `tonemap.wgsl` (for the legend drawn by egui).
+pub fn false_colour(t: f64) -> [f64; 3] {
+    let t = t.clamp(0.0, 1.0);
+    let v = [1.0, t, t * t, t * t * t, t.powi(4), t.powi(5)];
+    let dot = |k: [f64; 6]| v.iter().zip(k).map(|(a, b)| a * b).sum::<f64>().clamp(0.0, 1.0);
+    [
+        dot([0.13572138, 4.61539260, -42.66032258, 132.13108234, -152.94239396, 59.28637943]),
+        dot([0.09140261, 2.19418839, 4.84296658, -14.18503333, 4.27729857, 2.82956604]),
+        dot([0.10667330, 12.64194608, -60.58204836, 110.36276771, -89.90310912, 27.34824973]),
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use radiosity_core::{MeshParams, furnace_box};
+
+    fn furnace_mesh() -> Mesh {
+        let scene = furnace_box(0.5, 1.0);
+        Mesh::build(&scene, &MeshParams::try_new(0.5, 0.25).unwrap()).unwrap()
+    }
+
+    #[test]
+    fn triangles_face_their_elements() {
+        let mesh = furnace_mesh();
+        for (e, [a, b, c]) in oriented_triangles(&mesh) {
+            let p = |i: u32| mesh.positions[i as usize];
+            let n = (p(b) - p(a)).cross(p(c) - p(a));
+            assert!(n.dot(mesh.elements[e as usize].normal) > 0.0);
+        }
+    }
+
+    #[test]
+    fn edge_flags_mark_element_and_patch_outlines() {
+        let mesh = furnace_mesh();
+        let tris = oriented_triangles(&mesh);
+        let flags = edge_flags(&mesh, &tris);
+        let element_edges: u32 = flags.iter().map(|f| (f & 0b010101).count_ones()).sum();
+        let patch_edges: u32 = flags.iter().map(|f| (f & 0b101010).count_ones()).sum();
+        // Quads split in two: each triangle has two element edges and one diagonal.
+        let quads = mesh.elements.iter().filter(|e| e.vertex_count == 4).count() as u32;
+        let tris_only = mesh.elements.len() as u32 - quads;
+        assert_eq!(element_edges, quads * 4 + tris_only * 3);
+        // 2×2 elements per patch: each element has 2 of its 4 edges on the patch outline.
+        assert_eq!(patch_edges, quads * 2 + tris_only * 2, "{} quads", quads);
+        for f in flags {
+            for i in 0..3 {
+                let bits = (f >> (2 * i)) & 3;
+                assert_ne!(bits, 2, "a patch edge is always an element edge");
+            }
+        }
+    }
+
+    #[test]
+    fn false_colour_range_spans_four_decades_at_most() {
+        let s = Solution {
+            vertex_radiosity: vec![Rgb::splat(1e-9), Rgb::splat(0.5), Rgb::splat(100.0), Rgb::ZERO],
+            element_unshot: vec![Rgb::splat(-2.0), Rgb::ZERO],
+            ..Default::default()
+        };
+        let (lo, hi) = false_colour_range(&s, DisplayMode::FalseColour);
+        assert!((hi - 2.0).abs() < 1e-9 && (lo + 2.0).abs() < 1e-9, "{lo} {hi}");
+        let (lo, hi) = false_colour_range(&s, DisplayMode::Unshot);
+        assert!(lo < hi && (hi - 2f64.log10()).abs() < 0.51);
+        assert_eq!(false_colour_range(&Solution::default(), DisplayMode::Smooth), (-1.0, 0.0));
+    }
+
+    #[test]
+    fn false_colour_ramp_goes_from_blue_to_red() {
+        let dark = false_colour(0.0);
+        assert!(dark.iter().all(|c| *c < 0.2), "starts near black: {dark:?}");
+        let [r, _, b] = false_colour(0.15);
+        assert!(b > 0.9 && r < 0.3, "then blue");
+        let [_, g, _] = false_colour(0.5);
+        assert!(g > 0.9, "green in the middle");
+        let [r, g, b] = false_colour(0.9);
+        assert!(r > 0.7 && g < 0.2 && b < 0.1, "red at the top");
+    }
+}

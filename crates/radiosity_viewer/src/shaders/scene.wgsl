@@ -1,0 +1,113 @@
+// The lit mesh: a non-indexed triangle list, one colour per vertex of each triangle (vertex
+// radiosity for smooth shading, the element's value for flat shading), tone mapped per pixel
+// after interpolation, as the CPU renderer does. Needs tonemap.wgsl before it.
+
+struct Uniforms {
+    // Clip space from mesh-local space (world minus the mesh origin, so f32 keeps precision).
+    clip_from_local: mat4x4<f32>,
+    background: vec4<f32>,
+    // Radiosity → exposed radiance: 2^EV / π.
+    exposure_scale: f32,
+    tone_op: u32,
+    // 0: tone-mapped colour; 1: false colour of log10 luminance in [log_min, log_max].
+    mode: u32,
+    // Bit 0: element edges; bit 1: patch edges.
+    wire: u32,
+    log_min: f32,
+    log_max: f32,
+    // Half width of wireframe lines, pixels.
+    wire_half_width: f32,
+    // 1 when the target stores linear values (an sRGB format encodes on write).
+    output_linear: u32,
+};
+
+@group(0) @binding(0) var<uniform> u: Uniforms;
+
+struct VsIn {
+    @builtin(vertex_index) index: u32,
+    @location(0) position: vec3<f32>,
+    // Per triangle edge i (opposite corner i): bit 2i element edge, bit 2i+1 patch edge.
+    @location(1) edges: u32,
+    @location(2) colour: vec3<f32>,
+};
+
+struct VsOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) colour: vec3<f32>,
+    @location(1) bary: vec3<f32>,
+    @location(2) @interpolate(flat) edges: u32,
+};
+
+@vertex
+fn vs_main(in: VsIn) -> VsOut {
+    var out: VsOut;
+    out.clip = u.clip_from_local * vec4<f32>(in.position, 1.0);
+    out.colour = in.colour;
+    let corner = in.index % 3u;
+    out.bary = vec3<f32>(f32(corner == 0u), f32(corner == 1u), f32(corner == 2u));
+    out.edges = in.edges;
+    return out;
+}
+
+// Coverage of the nearest edge of the kinds in `mask` (2 bits per edge), from the pixel's
+// distance to it in pixels.
+fn edge_coverage(bary: vec3<f32>, edges: u32, mask: u32, half_width: f32) -> f32 {
+    let d = bary / max(fwidth(bary), vec3<f32>(1e-6));
+    var nearest = 1e9;
+    for (var i = 0u; i < 3u; i = i + 1u) {
+        if ((edges >> (2u * i)) & mask) != 0u {
+            nearest = min(nearest, d[i]);
+        }
+    }
+    return 1.0 - smoothstep(half_width, half_width + 1.0, nearest);
+}
+
+// Display value → what the target stores.
+fn output(display: vec3<f32>) -> vec4<f32> {
+    if u.output_linear == 1u {
+        let lo = display / 12.92;
+        let hi = pow((display + vec3<f32>(0.055)) / 1.055, vec3<f32>(2.4));
+        return vec4<f32>(select(hi, lo, display <= vec3<f32>(0.04045)), 1.0);
+    }
+    return vec4<f32>(display, 1.0);
+}
+
+// The background: one triangle over the whole viewport at the far plane (reversed z: 0),
+// written whatever the depth buffer holds. This clears colour and depth inside a render pass
+// that someone else began (egui's), where a load-op clear is not ours to choose.
+@vertex
+fn vs_background(@builtin(vertex_index) index: u32) -> @builtin(position) vec4<f32> {
+    let x = f32((index << 1u) & 2u) * 2.0 - 1.0;
+    let y = f32(index & 2u) * 2.0 - 1.0;
+    return vec4<f32>(x, y, 0.0, 1.0);
+}
+
+@fragment
+fn fs_background() -> @location(0) vec4<f32> {
+    return output(u.background.rgb);
+}
+
+@fragment
+fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
+    var rgb: vec3<f32>;
+    if u.mode == 1u {
+        let l = luminance(in.colour);
+        if l <= 0.0 {
+            rgb = vec3<f32>(0.0);
+        } else {
+            rgb = false_colour((log(l) / log(10.0) - u.log_min) / max(u.log_max - u.log_min, 1e-6));
+        }
+    } else {
+        rgb = tone_map(in.colour, u.exposure_scale, u.tone_op);
+    }
+    // The coverage term needs derivatives, so it is computed in uniform control flow.
+    let element_line = edge_coverage(in.bary, in.edges, 1u, u.wire_half_width);
+    let patch_line = edge_coverage(in.bary, in.edges, 2u, u.wire_half_width * 1.3);
+    if (u.wire & 1u) != 0u {
+        rgb = mix(rgb, vec3<f32>(0.05, 0.05, 0.05), element_line * 0.6);
+    }
+    if (u.wire & 2u) != 0u {
+        rgb = mix(rgb, vec3<f32>(1.0, 0.85, 0.2), patch_line * 0.85);
+    }
+    return output(rgb);
+}
