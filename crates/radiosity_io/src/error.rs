@@ -4,54 +4,47 @@ use std::path::PathBuf;
 
 use thiserror::Error;
 
-/// Why a scene could not be loaded. Its `Display` is one line.
+/// Why a scene could not be loaded. Its `Display` is always one line, starting with the file
+/// name, so a command-line tool can print it as it is.
 #[derive(Clone, Debug, Error, PartialEq)]
 pub enum LoadError {
-    /// Something at a known place in a scene file.
+    /// Something wrong at a known place in a scene file: TOML syntax, an unknown key, a
+    /// value of the wrong type, or a value the scene's validation rejects.
     #[error("{origin}:{line}:{column}: {key}: {message}")]
     At {
         /// File name (or other origin) of the text.
         origin: String,
         /// 1-based line.
         line: usize,
-        /// 1-based column.
+        /// 1-based column, in characters.
         column: usize,
         /// Key path, e.g. `material[1].reflectance`.
         key: String,
         /// What is wrong and what was expected.
         message: String,
     },
-    /// The file could not be read.
+    /// The file could not be read (missing, a directory, no permission, not UTF-8).
     #[error("{path}: cannot read the scene file: {reason}")]
     Unreadable {
-        /// The path.
+        /// The path as given.
         path: PathBuf,
         /// The system's reason.
         reason: String,
     },
-    /// Neither a file nor a built-in scene.
+    /// The argument is neither an existing file nor a built-in scene name.
     #[error("'{name}' is neither a scene file nor a built-in scene (built-ins: {known})")]
     UnknownScene {
         /// What was asked for.
         name: String,
-        /// The built-in names.
+        /// The built-in names, comma-separated.
         known: String,
     },
 }
 
 impl LoadError {
-    /// The process exit code for this error: 2, bad input.
+    /// The process exit code for this error: 2 (bad input), the same for every variant, so a
+    /// script can tell "your scene is wrong" from a crash or an internal error.
     pub fn exit_code(&self) -> u8 {
         2
     }
-}
-
-/// 1-based (line, column) of a byte offset in `text`.
-pub(crate) fn line_col(text: &str, offset: usize) -> (usize, usize) {
-    let offset = offset.min(text.len());
-    let before = &text.as_bytes()[..offset];
-    let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
-    let start = before.iter().rposition(|&b| b == b'\n').map_or(0, |p| p + 1);
-    let column = String::from_utf8_lossy(&before[start..]).chars().count() + 1;
-    (line, column)
 }

@@ -1,11 +1,30 @@
-//! Scene files in: the TOML scene format (see the README), loaded in two stages — plain serde
-//! data (`SceneDesc`, unknown keys rejected) then validation into a core [`Scene`] — with
-//! every error naming the file, line, column and key; and the built-in scenes.
+//! Scene files in, for the `radiosity` renderer: the TOML scene format (described in
+//! `docs/ARCHITECTURE.md` and `DESIGN.md`, "Scene file"), and the built-in scenes.
+//!
+//! Loading has two stages. First the text becomes plain serde data (`SceneDesc`, private)
+//! with unknown keys rejected; then that data becomes a core [`Scene`] through the core's
+//! validating constructors. Every error is a [`LoadError`] whose message is one line:
+//! `<file>:<line>:<column>: <key path>: <what is wrong and what was expected>`.
+//!
+//! ```
+//! let scene = radiosity_io::parse_scene(
+//!     "[[material]]\nname = \"lamp\"\nreflectance = [0, 0, 0]\nemission = [1, 1, 1]\n\
+//!      [[object]]\nname = \"tile\"\ntype = \"polygon\"\nmaterial = \"lamp\"\n\
+//!      vertices = [[0, 0, 0], [1, 0, 0], [1, 1, 0]]\n",
+//!     "tile.toml",
+//! )
+//! .unwrap();
+//! assert_eq!(scene.name, "tile");
+//! let e = radiosity_io::parse_scene("[mesh]\npatch_size = -1\nelement_size = 1\n", "bad.toml").unwrap_err();
+//! assert_eq!(e.to_string(), "bad.toml:2:14: mesh.patch_size: patch_size must be a finite number > 0, got -1");
+//! ```
 #![warn(missing_docs)]
 #![forbid(unsafe_code)]
 
 mod builtin;
+mod desc;
 mod error;
+mod locate;
 mod scene_file;
 
 pub use builtin::{BUILTIN_SCENES, builtin_scene, resolve_scene};

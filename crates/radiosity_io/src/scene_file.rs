@@ -1,258 +1,179 @@
-//! The TOML scene format: plain serde data with every validated value `Spanned`, then
-//! validation through the core's constructors with the span turned into file:line:column.
+//! Second stage of loading: [`SceneDesc`] → validated core [`Scene`].
+//!
+//! Validation itself lives in the core's constructors (`Material::try_new`,
+//! `Polygon::try_new`, `box_faces`, `Sphere::try_new`, `Camera::try_new`,
+//! `MeshParams::try_new`, `Scene::try_new`), so a scene built in code and one read from a file
+//! obey the same rules; this module only decides *where* in the file each error points: the
+//! offending value's span, down to the vertex for a non-finite or non-convex corner.
 
 use std::ops::Range;
 use std::path::Path;
 
 use radiosity_core::glam::DVec3;
 use radiosity_core::{
-    Camera, Facing, Material, MeshParams, Object, Polygon, Rgb, Scene, SceneError, Shape, Sphere, box_faces,
+    Camera, Facing, Material, MeshParams, Object, Polygon, Rgb, Scene, SceneError, Shape, SolverSettings,
+    Sphere, box_faces,
 };
-use serde::Deserialize;
 use toml::Spanned;
 
 use crate::LoadError;
-use crate::error::line_col;
+use crate::desc::{CameraDesc, Face, MaterialDesc, MeshDesc, ObjectDesc, SceneDesc, SolverDesc};
+use crate::locate::Locator;
 
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct SceneDesc {
-    name: Option<String>,
-    camera: Option<Spanned<CameraDesc>>,
-    #[serde(default)]
-    material: Vec<Spanned<MaterialDesc>>,
-    #[serde(default)]
-    object: Vec<Spanned<ObjectDesc>>,
-    mesh: Option<Spanned<MeshDesc>>,
-    solver: Option<Spanned<SolverDesc>>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct CameraDesc {
-    position: [f64; 3],
-    look_at: [f64; 3],
-    #[serde(default = "default_up")]
-    up: [f64; 3],
-    #[serde(default = "default_fov")]
-    fov_y_deg: f64,
-}
-
-fn default_up() -> [f64; 3] {
-    [0.0, 1.0, 0.0]
-}
-
-fn default_fov() -> f64 {
-    45.0
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct MaterialDesc {
-    name: Spanned<String>,
-    reflectance: Spanned<[f64; 3]>,
-    emission: Option<Spanned<[f64; 3]>>,
-}
-
-/// One `[[object]]`: a flat struct rather than a tagged enum, because serde's tagged enums
-/// buffer their content and lose the spans that errors need.
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct ObjectDesc {
-    name: Spanned<String>,
-    #[serde(rename = "type")]
-    kind: Spanned<String>,
-    material: Spanned<String>,
-    vertices: Option<Spanned<Vec<[f64; 3]>>>,
-    faces: Option<Spanned<Vec<Vec<[f64; 3]>>>>,
-    min: Option<Spanned<[f64; 3]>>,
-    max: Option<Spanned<[f64; 3]>>,
-    normals: Option<Spanned<String>>,
-    rotate_y_deg: Option<Spanned<f64>>,
-    center: Option<Spanned<[f64; 3]>>,
-    radius: Option<Spanned<f64>>,
-    file: Option<Spanned<String>>,
-    transform: Option<Spanned<toml::Value>>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct MeshDesc {
-    patch_size: Spanned<f64>,
-    element_size: Spanned<f64>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct SolverDesc {
-    unshot_threshold: Option<Spanned<f64>>,
-    max_shots: Option<Spanned<i64>>,
-    time_limit: Option<Spanned<f64>>,
-}
-
-/// Turns spans into located errors for one text.
-struct Locator<'a> {
-    origin: &'a str,
-    text: &'a str,
-}
-
-impl Locator<'_> {
-    fn at(&self, span: Range<usize>, key: impl Into<String>, message: impl Into<String>) -> LoadError {
-        let (line, column) = line_col(self.text, span.start);
-        LoadError::At {
-            origin: self.origin.to_owned(),
-            line,
-            column,
-            key: key.into(),
-            message: message.into(),
-        }
-    }
-}
+/// Camera `up` when the file gives none.
+const DEFAULT_UP: [f64; 3] = [0.0, 1.0, 0.0];
+/// Camera vertical field of view in degrees when the file gives none.
+const DEFAULT_FOV_Y_DEG: f64 = 45.0;
 
 fn v3(a: [f64; 3]) -> DVec3 {
     DVec3::from_array(a)
 }
 
+fn all_finite(a: &[f64; 3]) -> bool {
+    a.iter().all(|c| c.is_finite())
+}
+
 /// Loads and validates a scene file.
 ///
 /// # Errors
-/// [`LoadError::Unreadable`] when the file cannot be read; otherwise as [`parse_scene`].
+/// [`LoadError::Unreadable`] naming the file when it cannot be read as UTF-8 text; otherwise
+/// as [`parse_scene`], with the path as origin.
 pub fn load_scene(path: &Path) -> Result<Scene, LoadError> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| LoadError::Unreadable { path: path.to_owned(), reason: e.to_string() })?;
     parse_scene(&text, &path.display().to_string())
 }
 
-/// Parses and validates scene text; `origin` names it in errors (usually the file path).
+/// Parses and validates the text of a scene file; `origin` (usually the path) starts every
+/// error message.
+///
+/// The scene's name defaults to the file stem of `origin`; `[mesh]` sets [`Scene::mesh`] and
+/// `[solver]` sets [`Scene::solver`].
 ///
 /// # Errors
-/// [`LoadError::At`] naming line, column, key and what was expected, for TOML syntax,
-/// unknown keys, wrong types, and every validation rule of the core (reflectance in [0, 1),
-/// finite coordinates, planar convex non-degenerate polygons, radius > 0, a light, …).
+/// [`LoadError::At`], naming line, column, key path and what was expected, for TOML syntax
+/// errors, unknown keys, wrong types, and every validation rule: reflectance in [0, 1),
+/// emission finite and ≥ 0, unique materials, known material references, finite coordinates,
+/// planar convex non-degenerate polygons of 3+ vertices, radius > 0, box min < max, a usable
+/// camera, sizes > 0, `unshot_threshold` in (0, 1), `max_shots` ≥ 1, `time_limit` > 0, at
+/// least one object and at least one light. TOML's `nan` and `inf` are rejected wherever a
+/// number is validated.
 pub fn parse_scene(text: &str, origin: &str) -> Result<Scene, LoadError> {
     let loc = Locator { origin, text };
-    let desc: SceneDesc = toml::from_str(text).map_err(|e| {
-        let span = e.span().unwrap_or(0..0);
-        // toml's message can span several lines (it quotes the source); keep the first.
-        let message = e.message().lines().next().unwrap_or("invalid TOML").to_owned();
-        loc.at(span.clone(), key_at(text, span.start), message)
-    })?;
+    let desc: SceneDesc = toml::from_str(text).map_err(|e| loc.toml_error(&e))?;
 
-    let mut materials = Vec::new();
-    for (i, m) in desc.material.iter().enumerate() {
-        let m = m.get_ref();
-        let key = format!("material[{i}]");
-        let emission = m.emission.as_ref().map_or([0.0; 3], |e| *e.get_ref());
-        let material = Material::try_new(
-            m.name.get_ref(),
-            Rgb::from_array(*m.reflectance.get_ref()),
-            Rgb::from_array(emission),
-        );
-        materials.push(material.map_err(|e| match e {
-            SceneError::EmissionOutOfRange { .. } => {
-                let span = m.emission.as_ref().map_or(m.name.span(), Spanned::span);
-                loc.at(span, format!("{key}.emission"), e.to_string())
-            }
-            _ => loc.at(m.reflectance.span(), format!("{key}.reflectance"), e.to_string()),
-        })?);
-        if materials[..i].iter().any(|o: &Material| o.name == *m.name.get_ref()) {
-            return Err(loc.at(
-                m.name.span(),
-                format!("{key}.name"),
-                format!("material '{}' is defined twice", m.name.get_ref()),
-            ));
-        }
-    }
-
-    let mut objects = Vec::new();
-    for (i, o) in desc.object.iter().enumerate() {
-        objects.push(object(&loc, i, o, &materials)?);
-    }
-
-    let camera = match &desc.camera {
-        Some(c) => {
-            let d = c.get_ref();
-            Some(
-                Camera::try_new(v3(d.position), v3(d.look_at), v3(d.up), d.fov_y_deg)
-                    .map_err(|e| loc.at(c.span(), "camera", e.to_string()))?,
-            )
-        }
-        None => None,
-    };
+    let materials = materials(&loc, &desc.material)?;
+    let objects = desc
+        .object
+        .iter()
+        .enumerate()
+        .map(|(i, o)| object(&loc, i, o, &desc.material, &materials))
+        .collect::<Result<Vec<_>, _>>()?;
+    let camera = desc.camera.as_ref().map(|c| camera(&loc, c)).transpose()?;
+    let mesh = desc.mesh.as_ref().map(|m| mesh_params(&loc, m)).transpose()?;
+    let solver = desc.solver.as_ref().map(|s| solver_settings(&loc, s)).transpose()?.unwrap_or_default();
     let name = desc.name.clone().unwrap_or_else(|| {
-        Path::new(origin).file_stem().map_or("scene".into(), |s| s.to_string_lossy().into_owned())
+        Path::new(origin).file_stem().map_or_else(|| "scene".to_owned(), |s| s.to_string_lossy().into_owned())
     });
-    let mut scene = Scene::try_new(&name, camera, materials, objects).map_err(|e| {
-        let span = desc.object.first().map_or(0..0, |o| o.span());
-        loc.at(span, "object", e.to_string())
-    })?;
 
-    if let Some(m) = &desc.mesh {
-        let d = m.get_ref();
-        scene.mesh =
-            Some(MeshParams::try_new(*d.patch_size.get_ref(), *d.element_size.get_ref()).map_err(|e| {
-                let span = if matches!(e, SceneError::BadMeshSize { key: "patch_size", .. }) {
-                    d.patch_size.span()
-                } else {
-                    d.element_size.span()
-                };
-                loc.at(span, "mesh", e.to_string())
-            })?);
-    }
-    if let Some(s) = &desc.solver {
-        let d = s.get_ref();
-        if let Some(t) = &d.unshot_threshold {
-            let v = *t.get_ref();
-            if !(v > 0.0 && v < 1.0) {
-                return Err(loc.at(
-                    t.span(),
-                    "solver.unshot_threshold",
-                    format!("expected a number in (0, 1), got {v}"),
-                ));
+    // Whole-scene rules come last, once every local error has had its say. The unused light
+    // is found before `materials` and `objects` move into the scene, to explain a dark scene.
+    let unused_light = materials
+        .iter()
+        .enumerate()
+        .find(|(i, m)| m.is_emitter() && !objects.iter().any(|o| o.material == *i))
+        .map(|(i, _)| i);
+    let mut scene = Scene::try_new(&name, camera, materials, objects).map_err(|e| match e {
+        SceneError::NoObjects => loc.at(
+            0..0,
+            "object",
+            format!("{e}; add at least one [[object]] (polygon, polygons, box or sphere)"),
+        ),
+        SceneError::NoEmitter => match unused_light {
+            Some(i) => {
+                let m = desc.material[i].get_ref();
+                let span = m.emission.as_ref().map_or_else(|| m.name.span(), Spanned::span);
+                let message = format!("{e}; material '{}' emits but no object uses it", m.name.get_ref());
+                loc.at(span, format!("material[{i}].emission"), message)
             }
-            scene.solver.unshot_threshold = Some(v);
-        }
-        if let Some(n) = &d.max_shots {
-            let v = *n.get_ref();
-            if v <= 0 {
-                return Err(loc.at(
-                    n.span(),
-                    "solver.max_shots",
-                    format!("expected a whole number ≥ 1, got {v}"),
-                ));
-            }
-            scene.solver.max_shots = Some(v as u64);
-        }
-        if let Some(t) = &d.time_limit {
-            let v = *t.get_ref();
-            if !(v.is_finite() && v > 0.0) {
-                return Err(loc.at(t.span(), "solver.time_limit", format!("expected seconds > 0, got {v}")));
-            }
-            scene.solver.time_limit = Some(v);
-        }
-    }
+            None => loc.at(
+                0..0,
+                "material",
+                format!("{e}; give a material `emission = [r, g, b]` above 0 and use it on an object"),
+            ),
+        },
+        // Duplicates and unknown references were reported above with their spans.
+        other => loc.at(0..0, "scene", other.to_string()),
+    })?;
+    scene.mesh = mesh;
+    scene.solver = solver;
     Ok(scene)
 }
 
-/// The key assigned on the line holding byte `offset` (`reflectance` in
-/// `reflectance = [1, 2]`), or `toml` when the line assigns nothing.
-fn key_at(text: &str, offset: usize) -> String {
-    let offset = offset.min(text.len());
-    let start = text[..offset].rfind('\n').map_or(0, |p| p + 1);
-    let line = text[start..].lines().next().unwrap_or("");
-    match line.split_once('=') {
-        Some((k, _))
-            if !k.trim().is_empty()
-                && k.trim().chars().all(|c| c.is_alphanumeric() || "_-.\"".contains(c)) =>
-        {
-            k.trim().to_owned()
+fn materials(loc: &Locator, descs: &[Spanned<MaterialDesc>]) -> Result<Vec<Material>, LoadError> {
+    let mut materials: Vec<Material> = Vec::with_capacity(descs.len());
+    for (i, m) in descs.iter().enumerate() {
+        let m = m.get_ref();
+        let key = format!("material[{i}]");
+        let name = m.name.get_ref();
+        if let Some(first) = materials.iter().position(|o| o.name == *name) {
+            return Err(loc.at(
+                m.name.span(),
+                format!("{key}.name"),
+                format!(
+                    "material '{name}' is defined twice (first as material[{first}]); names must be unique"
+                ),
+            ));
         }
-        _ => "toml".to_owned(),
+        let emission = m.emission.as_ref().map_or([0.0; 3], |e| *e.get_ref());
+        let material =
+            Material::try_new(name, Rgb::from_array(*m.reflectance.get_ref()), Rgb::from_array(emission))
+                .map_err(|e| match (&e, &m.emission) {
+                    (SceneError::EmissionOutOfRange { .. }, Some(em)) => {
+                        loc.at(em.span(), format!("{key}.emission"), e.to_string())
+                    }
+                    _ => loc.at(m.reflectance.span(), format!("{key}.reflectance"), e.to_string()),
+                })?;
+        materials.push(material);
     }
+    Ok(materials)
 }
 
-/// The fields each object type takes; any other geometry field is an error, so a typo'd
-/// type or a stray key never goes unnoticed.
+fn camera(loc: &Locator, c: &Spanned<CameraDesc>) -> Result<Camera, LoadError> {
+    let d = c.get_ref();
+    let position = *d.position.get_ref();
+    let look_at = *d.look_at.get_ref();
+    let up = d.up.as_ref().map_or(DEFAULT_UP, |u| *u.get_ref());
+    let fov = d.fov_y_deg.as_ref().map_or(DEFAULT_FOV_Y_DEG, |f| *f.get_ref());
+    Camera::try_new(v3(position), v3(look_at), v3(up), fov).map_err(|e| {
+        // The core says what is wrong; name the field it is about, checking in the core's
+        // order (finite, distinct points, up, field of view). Whether `up` is at fault is
+        // asked of the core itself, with a field of view known to be good.
+        let field = if !all_finite(&position) {
+            "position"
+        } else if !all_finite(&look_at) || position == look_at {
+            "look_at"
+        } else if !all_finite(&up)
+            || Camera::try_new(v3(position), v3(look_at), v3(up), DEFAULT_FOV_Y_DEG).is_err()
+        {
+            "up"
+        } else {
+            "fov_y_deg"
+        };
+        let (span, note) = match field {
+            "position" => (d.position.span(), ""),
+            "look_at" => (d.look_at.span(), ""),
+            "up" => d.up.as_ref().map_or_else(
+                || (c.span(), "; `up` defaults to [0, 1, 0]: give another when looking straight up or down"),
+                |u| (u.span(), ""),
+            ),
+            _ => d.fov_y_deg.as_ref().map_or_else(|| (c.span(), ""), |f| (f.span(), "")),
+        };
+        loc.at(span, format!("camera.{field}"), format!("{e}{note}"))
+    })
+}
+
+/// The fields each object type takes besides `name`, `type` and `material`.
 fn allowed_fields(kind: &str) -> Option<&'static [&'static str]> {
     Some(match kind {
         "polygon" => &["vertices"],
@@ -264,30 +185,65 @@ fn allowed_fields(kind: &str) -> Option<&'static [&'static str]> {
     })
 }
 
+/// A polygon from its vertex list; a non-finite or non-convex vertex is pointed at itself.
+fn polygon(loc: &Locator, face: &Face, key: &str) -> Result<Polygon, LoadError> {
+    let points = face.get_ref();
+    Polygon::try_new(points.iter().map(|p| v3(*p.get_ref())).collect()).map_err(|e| {
+        let vertex = match &e {
+            SceneError::NonFiniteCoordinate { .. } => points.iter().position(|p| !all_finite(p.get_ref())),
+            SceneError::NonConvexPolygon { vertex } => Some(*vertex),
+            _ => None,
+        };
+        match vertex.and_then(|k| points.get(k).map(|p| (k, p))) {
+            Some((k, p)) => loc.at(p.span(), format!("{key}[{k}]"), e.to_string()),
+            None => loc.at(face.span(), key, e.to_string()),
+        }
+    })
+}
+
+fn facing(loc: &Locator, key: &str, normals: Option<&Spanned<String>>) -> Result<Facing, LoadError> {
+    match normals.map(|s| (s.get_ref().as_str(), s)) {
+        None | Some(("outward", _)) => Ok(Facing::Outward),
+        Some(("inward", _)) => Ok(Facing::Inward),
+        Some((other, s)) => Err(loc.at(
+            s.span(),
+            format!("{key}.normals"),
+            format!("expected \"inward\" or \"outward\", got \"{other}\""),
+        )),
+    }
+}
+
 fn object(
     loc: &Locator,
     i: usize,
     o: &Spanned<ObjectDesc>,
+    material_descs: &[Spanned<MaterialDesc>],
     materials: &[Material],
 ) -> Result<Object, LoadError> {
     let d = o.get_ref();
     let name = d.name.get_ref().clone();
-    let key = format!("object[{i}] ('{name}')");
+    let key = format!("object[{i}]");
     let kind = d.kind.get_ref().as_str();
     let Some(allowed) = allowed_fields(kind) else {
         return Err(loc.at(
             d.kind.span(),
             format!("{key}.type"),
-            format!("unknown object type '{kind}'; expected one of polygon, polygons, box, sphere, mesh"),
+            format!(
+                "object '{name}': unknown type '{kind}'; expected one of polygon, polygons, box, sphere, mesh"
+            ),
         ));
     };
     if kind == "mesh" {
         return Err(loc.at(
             d.kind.span(),
             format!("{key}.type"),
-            "object type 'mesh' (OBJ/glTF import) is not supported yet; use polygon, polygons, box or sphere",
+            format!(
+                "object '{name}': object type 'mesh' (OBJ/glTF import) is not supported yet; \
+                 use polygon, polygons, box or sphere"
+            ),
         ));
     }
+    // A field of another type (a `radius` on a box) is an error, not silently ignored.
     let present: [(&str, Option<Range<usize>>); 10] = [
         ("vertices", d.vertices.as_ref().map(Spanned::span)),
         ("faces", d.faces.as_ref().map(Spanned::span)),
@@ -300,224 +256,149 @@ fn object(
         ("file", d.file.as_ref().map(Spanned::span)),
         ("transform", d.transform.as_ref().map(Spanned::span)),
     ];
-    for (field, span) in &present {
+    for (field, span) in present {
         if let Some(span) = span
-            && !allowed.contains(field)
+            && !allowed.contains(&field)
         {
             return Err(loc.at(
-                span.clone(),
+                span,
                 format!("{key}.{field}"),
                 format!("'{field}' does not apply to type '{kind}' (it takes: {})", allowed.join(", ")),
             ));
         }
     }
     let material = materials.iter().position(|m| m.name == *d.material.get_ref()).ok_or_else(|| {
-        let known = materials.iter().map(|m| m.name.as_str()).collect::<Vec<_>>().join(", ");
+        let known = material_descs.iter().map(|m| m.get_ref().name.get_ref().as_str()).collect::<Vec<_>>();
+        let known = if known.is_empty() { "none".to_owned() } else { known.join(", ") };
         loc.at(
             d.material.span(),
             format!("{key}.material"),
-            format!("material '{}' is not defined (defined: {known})", d.material.get_ref()),
+            format!(
+                "object '{name}' uses material '{}', which is not defined (defined: {known})",
+                d.material.get_ref()
+            ),
         )
     })?;
-    let missing =
-        |field: &str| loc.at(o.span(), format!("{key}.{field}"), format!("type '{kind}' needs '{field}'"));
-    let facing = |n: &Option<Spanned<String>>| -> Result<Facing, LoadError> {
-        match n.as_ref().map(|s| (s.get_ref().as_str(), s.span())) {
-            None | Some(("outward", _)) => Ok(Facing::Outward),
-            Some(("inward", _)) => Ok(Facing::Inward),
-            Some((other, span)) => Err(loc.at(
-                span,
-                format!("{key}.normals"),
-                format!("expected \"inward\" or \"outward\", got \"{other}\""),
-            )),
-        }
+    let missing = |field: &str| {
+        loc.at(
+            o.span(),
+            format!("{key}.{field}"),
+            format!("object '{name}' of type '{kind}' needs '{field}'"),
+        )
     };
-    let poly = |pts: &[[f64; 3]], span: Range<usize>, field: String| {
-        Polygon::try_new(pts.iter().map(|p| v3(*p)).collect()).map_err(|e| loc.at(span, field, e.to_string()))
-    };
+
     let shape = match kind {
         "polygon" => {
             let v = d.vertices.as_ref().ok_or_else(|| missing("vertices"))?;
-            Shape::Polygons(vec![poly(v.get_ref(), v.span(), format!("{key}.vertices"))?])
+            Shape::Polygons(vec![polygon(loc, v, &format!("{key}.vertices"))?])
         }
         "polygons" => {
             let f = d.faces.as_ref().ok_or_else(|| missing("faces"))?;
             if f.get_ref().is_empty() {
-                return Err(loc.at(f.span(), format!("{key}.faces"), "expected at least one face"));
+                return Err(loc.at(f.span(), format!("{key}.faces"), "expected at least one face, got []"));
             }
             let faces = f
                 .get_ref()
                 .iter()
                 .enumerate()
-                .map(|(k, face)| poly(face, f.span(), format!("{key}.faces[{k}]")))
+                .map(|(k, face)| polygon(loc, face, &format!("{key}.faces[{k}]")))
                 .collect::<Result<_, _>>()?;
             Shape::Polygons(faces)
         }
         "box" => {
-            let (min, max) = (
-                d.min.as_ref().ok_or_else(|| missing("min"))?,
-                d.max.as_ref().ok_or_else(|| missing("max"))?,
-            );
-            let rot = d.rotate_y_deg.as_ref().map_or(0.0, |r| *r.get_ref());
-            let faces = box_faces(v3(*min.get_ref()), v3(*max.get_ref()), facing(&d.normals)?, rot)
-                .map_err(|e| loc.at(min.span(), format!("{key}.min"), e.to_string()))?;
+            let min = d.min.as_ref().ok_or_else(|| missing("min"))?;
+            let max = d.max.as_ref().ok_or_else(|| missing("max"))?;
+            let rotate_y_deg = match &d.rotate_y_deg {
+                None => 0.0,
+                Some(r) if r.get_ref().is_finite() => *r.get_ref(),
+                Some(r) => {
+                    return Err(loc.at(
+                        r.span(),
+                        format!("{key}.rotate_y_deg"),
+                        format!("expected a finite angle in degrees, got {}", r.get_ref()),
+                    ));
+                }
+            };
+            let facing = facing(loc, &key, d.normals.as_ref())?;
+            let faces =
+                box_faces(v3(*min.get_ref()), v3(*max.get_ref()), facing, rotate_y_deg).map_err(|e| {
+                    // A non-finite corner is named; otherwise (min ≥ max) both are in the message.
+                    let (field, span) = if all_finite(min.get_ref()) && !all_finite(max.get_ref()) {
+                        ("max", max.span())
+                    } else {
+                        ("min", min.span())
+                    };
+                    loc.at(span, format!("{key}.{field}"), e.to_string())
+                })?;
             Shape::Polygons(faces)
         }
         "sphere" => {
             let c = d.center.as_ref().ok_or_else(|| missing("center"))?;
             let r = d.radius.as_ref().ok_or_else(|| missing("radius"))?;
-            let s = Sphere::try_new(v3(*c.get_ref()), *r.get_ref(), facing(&d.normals)?).map_err(|e| {
-                let (span, field) = if matches!(e, SceneError::BadRadius { .. }) {
-                    (r.span(), "radius")
+            let facing = facing(loc, &key, d.normals.as_ref())?;
+            let s = Sphere::try_new(v3(*c.get_ref()), *r.get_ref(), facing).map_err(|e| {
+                let (field, span) = if matches!(e, SceneError::BadRadius { .. }) {
+                    ("radius", r.span())
                 } else {
-                    (c.span(), "center")
+                    ("center", c.span())
                 };
                 loc.at(span, format!("{key}.{field}"), e.to_string())
             })?;
             Shape::Sphere(s)
         }
-        _ => unreachable!("object types are checked above"),
+        _ => unreachable!("allowed_fields accepts only the types matched here"),
     };
     Ok(Object { name, material, shape })
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    const GOOD: &str = r#"
-name = "t"
-[[material]]
-name = "w"
-reflectance = [0.5, 0.5, 0.5]
-[[material]]
-name = "light"
-reflectance = [0, 0, 0]
-emission = [1, 1, 1]
-[[object]]
-name = "room"
-type = "box"
-min = [0, 0, 0]
-max = [1, 1, 1]
-normals = "inward"
-material = "w"
-[[object]]
-name = "lamp"
-type = "polygon"
-vertices = [[0.4, 0.99, 0.4], [0.4, 0.99, 0.6], [0.6, 0.99, 0.6], [0.6, 0.99, 0.4]]
-material = "light"
-"#;
-
-    /// Replaces the first `from` in GOOD by `to`, parses, and returns the error line.
-    fn error_of(from: &str, to: &str) -> String {
-        assert!(GOOD.contains(from), "{from}");
-        let text = GOOD.replacen(from, to, 1);
-        let e = parse_scene(&text, "bad.toml").expect_err("must fail");
-        let s = e.to_string();
-        assert_eq!(s.lines().count(), 1, "{s}");
-        assert!(s.starts_with("bad.toml:"), "{s}");
-        s
-    }
-
-    fn line_of(s: &str) -> usize {
-        s.split(':').nth(1).unwrap().parse().unwrap()
-    }
-
-    #[test]
-    fn good_scene_loads() {
-        let s = parse_scene(GOOD, "good.toml").unwrap();
-        assert_eq!(s.objects.len(), 2);
-        assert_eq!(s.name, "t");
-    }
-
-    #[test]
-    fn each_malformed_case_names_its_line_and_key() {
-        // (replace, with, expected line, text the message must hold)
-        let cases: &[(&str, &str, usize, &str)] = &[
-            ("reflectance = [0.5, 0.5, 0.5]", "reflectance = [1.0, 0.5, 0.5]", 5, "material[0].reflectance"),
-            ("reflectance = [0.5, 0.5, 0.5]", "reflectance = [nan, 0.5, 0.5]", 5, "[0, 1)"),
-            ("emission = [1, 1, 1]", "emission = [1, -1, 1]", 9, "material[1].emission"),
-            ("emission = [1, 1, 1]", "emission = [inf, 1, 1]", 9, "finite"),
-            ("material = \"light\"", "material = \"lite\"", 21, "defined: w, light"),
-            ("name = \"light\"", "name = \"w\"", 7, "defined twice"),
-            ("max = [1, 1, 1]", "max = [1, 0, 1]", 13, "min must be below max"),
-            ("[0.6, 0.99, 0.6]", "[0.4, 0.99, 0.4]", 20, "degenerate"),
-            ("[0.6, 0.99, 0.6]", "[0.6, 0.5, 0.6]", 20, "not planar"),
-            ("[0.6, 0.99, 0.6]", "[0.45, 0.99, 0.45]", 20, "not convex"),
-            ("[0.6, 0.99, 0.6], [0.6, 0.99, 0.4]", "", 20, "at least 3 vertices"),
-            ("[0.4, 0.99, 0.6]", "[0.4, nan, 0.6]", 20, "finite"),
-            ("normals = \"inward\"", "normals = \"in\"", 15, "\"inward\" or \"outward\""),
-            ("type = \"box\"", "type = \"cube\"", 12, "unknown object type"),
-            ("type = \"box\"", "type = \"mesh\"", 12, "not supported yet"),
-            ("min = [0, 0, 0]", "mins = [0, 0, 0]", 13, "mins"),
-            ("name = \"t\"", "name = \"t\"\ncolour = 1", 3, "colour"),
-            ("reflectance = [0.5, 0.5, 0.5]", "reflectance = [0.5, 0.5]", 5, "reflectance: invalid length 2"),
-            ("reflectance = [0.5, 0.5, 0.5]", "reflectance = \"grey\"", 5, "reflectance"),
-            ("[[material]]\nname = \"w\"", "[[material]\nname = \"w\"", 3, "toml"),
-            ("vertices =", "center = [0, 0, 0]\nvertices =", 20, "does not apply"),
-        ];
-        for (from, to, line, needle) in cases {
-            let s = error_of(from, to);
-            assert_eq!(line_of(&s), *line, "{from} -> {to}: {s}");
-            assert!(s.contains(needle), "{from} -> {to}: {s}");
-        }
-    }
-
-    #[test]
-    fn sphere_radius_and_light_and_mesh_errors() {
-        let sphere = GOOD.replace(
-            "type = \"box\"\nmin = [0, 0, 0]\nmax = [1, 1, 1]",
-            "type = \"sphere\"\ncenter = [0, 0, 0]\nradius = -1",
-        );
-        let e = parse_scene(&sphere, "s.toml").unwrap_err().to_string();
-        assert!(e.contains("radius") && e.contains(":14:"), "{e}");
-        let dark = GOOD.replace("emission = [1, 1, 1]", "emission = [0, 0, 0]");
-        let e = parse_scene(&dark, "d.toml").unwrap_err().to_string();
-        assert!(e.contains("no light"), "{e}");
-        let mesh = format!("{GOOD}[mesh]\npatch_size = 0.5\nelement_size = 0\n");
-        let e = parse_scene(&mesh, "m.toml").unwrap_err().to_string();
-        assert!(e.contains("element_size") && e.contains(":24:"), "{e}");
-        let solver = format!("{GOOD}[solver]\nunshot_threshold = 1.5\n");
-        let e = parse_scene(&solver, "m.toml").unwrap_err().to_string();
-        assert!(e.contains("(0, 1)") && e.contains(":23:"), "{e}");
-        let e = load_scene(Path::new("/no/such/file.toml")).unwrap_err().to_string();
-        assert!(e.contains("/no/such/file.toml"), "{e}");
-    }
-
-    #[test]
-    fn mutated_files_never_panic() {
-        // Deterministic mutations of the Cornell file: truncations, deletions, insertions,
-        // replacements. Every one must give Ok or a one-line Err, never a panic.
-        let base = include_str!("../../../scenes/cornell.toml").as_bytes().to_vec();
-        let alphabet = b"[]{}=\",.-0123456789 \nabcxyz#nanif";
-        let mut state = 0x1234_5678_9abc_def0u64;
-        let mut next = |n: usize| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state % n as u64) as usize
+fn mesh_params(loc: &Locator, d: &MeshDesc) -> Result<MeshParams, LoadError> {
+    MeshParams::try_new(*d.patch_size.get_ref(), *d.element_size.get_ref()).map_err(|e| {
+        let (field, span) = match e {
+            SceneError::BadMeshSize { key: "patch_size", .. } => ("patch_size", d.patch_size.span()),
+            _ => ("element_size", d.element_size.span()),
         };
-        for i in 0..3000 {
-            let mut b = base.clone();
-            match i % 4 {
-                0 => b.truncate(next(b.len())),
-                1 => {
-                    let at = next(b.len());
-                    b.remove(at);
-                }
-                2 => b.insert(next(b.len()), alphabet[next(alphabet.len())]),
-                _ => {
-                    let at = next(b.len());
-                    b[at] = alphabet[next(alphabet.len())];
-                }
-            }
-            let text = String::from_utf8_lossy(&b).into_owned();
-            let r = std::panic::catch_unwind(|| parse_scene(&text, "m.toml"));
-            match r {
-                Ok(Ok(_)) => {}
-                Ok(Err(e)) => assert_eq!(e.to_string().lines().count(), 1, "mutation {i}: {e}"),
-                Err(_) => panic!("mutation {i} panicked"),
-            }
+        loc.at(span, format!("mesh.{field}"), e.to_string())
+    })
+}
+
+fn solver_settings(loc: &Locator, d: &SolverDesc) -> Result<SolverSettings, LoadError> {
+    let mut settings = SolverSettings::default();
+    if let Some(t) = &d.unshot_threshold {
+        let v = *t.get_ref();
+        // Written so that NaN fails too.
+        if !(v > 0.0 && v < 1.0) {
+            return Err(loc.at(
+                t.span(),
+                "solver.unshot_threshold",
+                format!("expected a fraction of the emitted power in (0, 1), e.g. 0.001, got {v}"),
+            ));
         }
+        settings.unshot_threshold = Some(v);
     }
+    if let Some(n) = &d.max_shots {
+        let v = *n.get_ref();
+        let Ok(shots) = u64::try_from(v) else {
+            return Err(loc.at(
+                n.span(),
+                "solver.max_shots",
+                format!("expected a whole number ≥ 1, got {v}"),
+            ));
+        };
+        if shots == 0 {
+            return Err(loc.at(n.span(), "solver.max_shots", "expected a whole number ≥ 1, got 0"));
+        }
+        settings.max_shots = Some(shots);
+    }
+    if let Some(t) = &d.time_limit {
+        let v = *t.get_ref();
+        if !(v.is_finite() && v > 0.0) {
+            return Err(loc.at(
+                t.span(),
+                "solver.time_limit",
+                format!("expected a finite number of seconds > 0, got {v}"),
+            ));
+        }
+        settings.time_limit = Some(v);
+    }
+    Ok(settings)
 }
