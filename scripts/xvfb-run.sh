@@ -22,14 +22,21 @@ fi
 workdir=$(mktemp -d)
 chmod 700 "$workdir"
 xvfb_pid=""
+cmd_pid=""
 cleanup() {
+  if [ -n "$cmd_pid" ]; then
+    kill "$cmd_pid" 2>/dev/null || true
+  fi
   if [ -n "$xvfb_pid" ]; then
     kill "$xvfb_pid" 2>/dev/null || true
     wait "$xvfb_pid" 2>/dev/null || true
   fi
   rm -rf "$workdir"
 }
-trap cleanup EXIT INT TERM
+trap cleanup EXIT
+# On a signal, end the command and the display now, not when the command ends by itself.
+trap 'exit 143' TERM
+trap 'exit 130' INT
 
 mkfifo "$workdir/displayfd"
 Xvfb -displayfd 3 -screen 0 "${XVFB_SCREEN:-1280x800x24}" -nolisten tcp -noreset \
@@ -50,8 +57,13 @@ if [ -z "${XDG_RUNTIME_DIR:-}" ] || [ ! -d "$XDG_RUNTIME_DIR" ]; then
   export XDG_RUNTIME_DIR="$workdir/runtime"
 fi
 
+# The command runs in the background so a signal to this script is handled at once (bash
+# runs traps only between foreground commands); its stdin stays the script's.
 set +e
-"$@"
+"$@" <&0 &
+cmd_pid=$!
+wait "$cmd_pid"
 status=$?
+cmd_pid=""
 set -e
 exit "$status"

@@ -768,15 +768,17 @@ impl eframe::App for ViewerApp {
                     Color32::LIGHT_GRAY,
                 );
             }
-            let hint_rect = Rect::from_min_max(Pos2::new(rect.left(), rect.bottom() - 22.0), rect.max);
-            ui.painter().rect_filled(hint_rect, 0.0, Color32::from_black_alpha(140));
-            ui.painter().text(
-                hint_rect.left_center() + Vec2::new(8.0, 0.0),
-                egui::Align2::LEFT_CENTER,
-                KEY_HINT,
+            // The key hint along the bottom, wrapped onto two lines in a narrow window.
+            let galley = ui.painter().layout(
+                KEY_HINT.to_owned(),
                 egui::FontId::proportional(12.0),
                 Color32::from_gray(220),
+                rect.width() - 16.0,
             );
+            let hint_rect =
+                Rect::from_min_max(Pos2::new(rect.left(), rect.bottom() - galley.size().y - 8.0), rect.max);
+            ui.painter().rect_filled(hint_rect, 0.0, Color32::from_black_alpha(140));
+            ui.painter().galley(hint_rect.min + Vec2::new(8.0, 4.0), galley, Color32::from_gray(220));
         });
         self.scripted_capture(&ctx);
         let busy = matches!(self.status.state, WorkerState::Meshing) || self.loading.is_some();
