@@ -4,11 +4,38 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use anyhow::Result;
-use clap::Args;
+use clap::{Args, ValueEnum};
 use radiosity_core::MeshParams;
+use radiosity_image::Exposure;
 use radiosity_solver::{Ambient, FormFactorMethod, Overshoot, SolverParams};
+use radiosity_viewer::{DisplayMode, Wireframe};
 
 use crate::prepare::{FormFactorArg, InputError, SolveOpts, check_writable};
+use crate::render_cmd::ToneOpts;
+
+/// What the surfaces show, on the command line.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum DisplayArg {
+    /// Vertex radiosity interpolated across elements.
+    Smooth,
+    /// Each element's own radiosity.
+    Flat,
+    /// False colour of log luminance, with a legend.
+    FalseColour,
+    /// False colour of the unshot radiosity still waiting to be shot.
+    Unshot,
+}
+
+/// Subdivision lines on the command line.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum WireframeArg {
+    /// None.
+    Off,
+    /// Patch outlines.
+    Patches,
+    /// Element and patch outlines.
+    Elements,
+}
 
 /// Arguments of `radiosity view`.
 #[derive(Args)]
@@ -36,6 +63,14 @@ pub struct ViewArgs {
     /// Window height, points.
     #[arg(long, default_value_t = 760.0)]
     pub height: f32,
+    /// What the surfaces show at start (the panel changes it).
+    #[arg(long, value_enum, default_value_t = DisplayArg::Smooth)]
+    pub display: DisplayArg,
+    /// Subdivision lines at start.
+    #[arg(long, value_enum, default_value_t = WireframeArg::Off)]
+    pub wireframe: WireframeArg,
+    #[command(flatten)]
+    pub tone: ToneOpts,
     #[command(flatten)]
     pub solve: SolveOpts,
 }
@@ -99,5 +134,21 @@ pub fn run(a: ViewArgs) -> Result<()> {
     options.after_shots = a.after_shots;
     options.continuous = a.continuous;
     options.window_size = [a.width, a.height];
+    options.display = match a.display {
+        DisplayArg::Smooth => DisplayMode::Smooth,
+        DisplayArg::Flat => DisplayMode::FlatElements,
+        DisplayArg::FalseColour => DisplayMode::FalseColour,
+        DisplayArg::Unshot => DisplayMode::Unshot,
+    };
+    options.wireframe = match a.wireframe {
+        WireframeArg::Off => Wireframe::Off,
+        WireframeArg::Patches => Wireframe::Patches,
+        WireframeArg::Elements => Wireframe::Elements,
+    };
+    options.exposure_ev = match a.tone.exposure {
+        Exposure::Ev(ev) => Some(ev),
+        Exposure::Auto => None,
+    };
+    options.operator = a.tone.tonemap.into();
     radiosity_viewer::run(options)
 }

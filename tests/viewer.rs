@@ -36,7 +36,12 @@ fn run_view(args: &[&str]) -> std::process::Output {
         Err(_) => {
             // SIGTERM: the script then ends the viewer and its Xvfb too.
             let _ = Command::new("kill").arg(pid.to_string()).status();
-            panic!("radiosity {} did not finish within {:?} (started {:?} ago)", args.join(" "), TIMEOUT, start.elapsed());
+            panic!(
+                "radiosity {} did not finish within {:?} (started {:?} ago)",
+                args.join(" "),
+                TIMEOUT,
+                start.elapsed()
+            );
         }
     }
 }
@@ -115,8 +120,10 @@ fn view_cornell_screenshot_shows_the_lit_box() {
     assert!(red_at < 0.35, "the red wall must be on the left of the view: centroid at {red_at:.2}");
     assert!(green_at > 0.65, "the green wall must be on the right of the view: centroid at {green_at:.2}");
 
-    let pixels: Vec<[f64; 3]> =
-        (0..img.height).flat_map(|y| (0..view_width).map(move |x| (x, y))).map(|(x, y)| pixel(&img, x, y)).collect();
+    let pixels: Vec<[f64; 3]> = (0..img.height)
+        .flat_map(|y| (0..view_width).map(move |x| (x, y)))
+        .map(|(x, y)| pixel(&img, x, y))
+        .collect();
     let mean = pixels.iter().map(|p| (p[0] + p[1] + p[2]) / 3.0).sum::<f64>() / pixels.len() as f64;
     assert!(mean > 50.0, "the box must be lit: mean {mean:.1} of 255");
     let white = pixels.iter().filter(|p| p.iter().all(|c| *c >= 250.0)).count() as f64 / pixels.len() as f64;

@@ -184,11 +184,11 @@ impl ViewerApp {
         Ok(Self {
             view: ViewState {
                 camera,
-                auto_exposure: true,
-                exposure_ev: 0.0,
-                operator: ToneOperator::Aces,
-                mode: DisplayMode::Smooth,
-                wireframe: Wireframe::Off,
+                auto_exposure: options.exposure_ev.is_none(),
+                exposure_ev: options.exposure_ev.unwrap_or(0.0),
+                operator: options.operator,
+                mode: options.display,
+                wireframe: options.wireframe,
             },
             render_state,
             view_size: [1, 1],
@@ -504,14 +504,17 @@ impl ViewerApp {
         ui.add(egui::ProgressBar::new(p.done_fraction() as f32).desired_height(6.0));
         ui.horizontal(|ui| {
             let running = self.status.state == WorkerState::Running;
+            // A stopped solve has nothing left to shoot: only Restart makes sense.
+            let can_shoot = !matches!(self.status.state, WorkerState::Stopped(_) | WorkerState::Ended);
             if running {
                 if ui.button("Pause").clicked() {
                     self.worker.pause();
                 }
-            } else if ui.button("Resume").clicked() {
+            } else if ui.add_enabled(can_shoot, egui::Button::new("Resume")).clicked() {
                 self.worker.resume();
             }
-            if ui.button("Step").on_hover_text("shoot one more patch, then pause").clicked() {
+            let step = ui.add_enabled(can_shoot, egui::Button::new("Step"));
+            if step.on_hover_text("shoot one more patch, then pause").clicked() {
                 self.worker.step_one();
             }
             if ui.button("Restart").clicked() {

@@ -54,6 +54,14 @@ pub struct ViewerOptions {
     pub window_size: [f32; 2],
     /// Samples per pixel of the window (1 or 4); see [`default_samples`].
     pub samples: u32,
+    /// What the surfaces show at start.
+    pub display: DisplayMode,
+    /// Subdivision lines at start.
+    pub wireframe: Wireframe,
+    /// Exposure in stops at start; `None`: automatic (log-average luminance to middle grey).
+    pub exposure_ev: Option<f64>,
+    /// Tone-map operator at start.
+    pub operator: radiosity_image::ToneOperator,
 }
 
 impl ViewerOptions {
@@ -71,6 +79,10 @@ impl ViewerOptions {
             continuous: false,
             window_size: [1200.0, 760.0],
             samples: default_samples(),
+            display: DisplayMode::Smooth,
+            wireframe: Wireframe::Off,
+            exposure_ev: None,
+            operator: radiosity_image::ToneOperator::Aces,
         }
     }
 }
