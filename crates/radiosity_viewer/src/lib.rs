@@ -149,16 +149,12 @@ pub fn default_samples() -> u32 {
     }
 }
 
-/// An error and its causes on one line, as the command prints them.
+/// An error and its causes on one line, joined by ": " exactly as the command prints them.
 pub fn one_line(e: &(dyn std::error::Error + 'static)) -> String {
     let mut parts = vec![e.to_string()];
     let mut source = e.source();
     while let Some(s) = source {
-        let text = s.to_string();
-        // Wrappers often repeat their cause's text; print it once.
-        if !parts.last().is_some_and(|p| p.contains(&text)) {
-            parts.push(text);
-        }
+        parts.push(s.to_string());
         source = s.source();
     }
     parts.join(": ")
@@ -167,4 +163,27 @@ pub fn one_line(e: &(dyn std::error::Error + 'static)) -> String {
 /// Loads a scene file or built-in name, the error on one line as the command prints it.
 fn load_scene(arg: &str) -> Result<Scene, String> {
     radiosity_io::resolve_scene(arg).map_err(|e| one_line(&e))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The window shows the loader's error as the command prints it: one line, naming the
+    /// file and line.
+    #[test]
+    fn a_bad_scene_file_gives_the_command_line_error() {
+        let path = std::env::temp_dir().join(format!("radiosity-viewer-bad-{}.toml", std::process::id()));
+        std::fs::write(&path, "name = \"x\"\n[[material]]\nname = \"m\"\nreflectance = [2, 0, 0]\n").unwrap();
+        let arg = path.display().to_string();
+        let shown = load_scene(&arg).unwrap_err();
+        let command = radiosity_io::resolve_scene(&arg).unwrap_err().to_string();
+        std::fs::remove_file(&path).unwrap();
+        assert_eq!(shown, command);
+        assert_eq!(shown.lines().count(), 1);
+        assert!(shown.starts_with(&format!("{arg}:")), "{shown}");
+        let missing = load_scene("no-such-scene-anywhere").unwrap_err();
+        assert!(missing.contains("no-such-scene-anywhere"), "{missing}");
+        assert!(load_scene("cornell").is_ok());
+    }
 }
