@@ -278,6 +278,8 @@ impl ViewerApp {
                 }
                 let job = SolveJob { label: arg, scene, light_scale: 1.0, mesh_params, solver_params };
                 self.restart_with(job);
+                // A scene just opened is there to be seen lit, whatever the old one was doing.
+                self.worker.resume();
             }
             Ok(Err(e)) => {
                 self.load_error = Some(e);
