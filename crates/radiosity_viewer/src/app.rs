@@ -15,12 +15,12 @@ use eframe::egui::{self, Color32, Key, Pos2, Rect, Sense, Vec2};
 use eframe::{egui_wgpu, wgpu};
 use radiosity_core::{MeshParams, Scene};
 use radiosity_image::ToneOperator;
-use radiosity_solver::Solution;
 
 use crate::ViewerOptions;
 use crate::camera::{FlyCamera, MoveInput, SceneExtent};
 use crate::render::{
-    DisplayMode, FrameParams, RenderTarget, SceneRenderer, Wireframe, false_colour, false_colour_range,
+    DisplayMode, FrameParams, RenderTarget, SceneRenderer, Wireframe, auto_exposure_ev, false_colour,
+    false_colour_range,
 };
 use crate::worker::{SolveJob, SolveWorker, Status, WorkerOptions, WorkerState};
 
@@ -118,7 +118,8 @@ pub struct ViewerApp {
     camera_scene: Option<Arc<Scene>>,
     extent: SceneExtent,
     log_range: (f64, f64),
-    solution_ev: f64,
+    /// The automatic exposure as it adapts, stops.
+    auto_ev: Option<f64>,
     subdivision: Subdivision,
     open_text: String,
     loading: Option<(String, Receiver<Result<Scene, String>>)>,
@@ -131,6 +132,8 @@ pub struct ViewerApp {
     scripted: Option<(PathBuf, Option<u64>)>,
     outcome: Outcome,
     last_frame: Option<Instant>,
+    /// Time since the previous frame, seconds (capped at [`MAX_MOVE_DT`]).
+    last_dt: f64,
     /// When a scripted run reached its mark, and the frame rate while it was solving.
     mark: Option<(Instant, f64)>,
 }
@@ -138,6 +141,9 @@ pub struct ViewerApp {
 /// With continuous redraw, how long a scripted run keeps drawing after its mark before the
 /// screenshot, to measure the frame rate with the solver idle.
 const FPS_MEASURE: Duration = Duration::from_secs(3);
+
+/// Time constant of the automatic exposure's adaptation, seconds.
+const ADAPTATION: f64 = 0.3;
 
 impl ViewerApp {
     /// Sets up GPU resources and starts the solve worker.
@@ -206,7 +212,7 @@ impl ViewerApp {
             camera_scene: Some(scene),
             extent,
             log_range: (-1.0, 0.0),
-            solution_ev: 0.0,
+            auto_ev: None,
             loading: None,
             load_error: None,
             message: None,
@@ -216,6 +222,7 @@ impl ViewerApp {
             scripted: options.screenshot.map(|p| (p, options.after_shots)),
             outcome,
             last_frame: None,
+            last_dt: 0.0,
             mark: None,
         })
     }
@@ -312,7 +319,6 @@ impl ViewerApp {
         if self.view.mode.is_false_colour() {
             self.log_range = false_colour_range(&snap.solution, self.view.mode);
         }
-        self.solution_ev = log_average_ev(&snap.mesh, &snap.solution);
         // A new scene (not a re-mesh of the same one) gets its own camera.
         if self.camera_scene.as_ref().is_none_or(|s| !Arc::ptr_eq(s, &snap.job.scene)) {
             let (lo, hi) = snap.mesh.bounds();
@@ -325,7 +331,26 @@ impl ViewerApp {
     }
 
     fn exposure_ev(&self) -> f64 {
-        if self.view.auto_exposure { self.solution_ev } else { self.view.exposure_ev }
+        if self.view.auto_exposure { self.auto_ev.unwrap_or(0.0) } else { self.view.exposure_ev }
+    }
+
+    /// Follows the automatic exposure for the current view, easing towards it like an eye
+    /// adapting (time constant [`ADAPTATION`]) so walking past a lamp does not flash; a
+    /// scripted screenshot takes the exact value. Returns whether it is still adapting.
+    fn adapt_exposure(&mut self, size_px: [u32; 2], dt: f64) -> bool {
+        let Some(snap) = &self.shown else { return false };
+        let aspect = f64::from(size_px[0].max(1)) / f64::from(size_px[1].max(1));
+        let clip = self.view.camera.clip_from_view(aspect) * self.view.camera.view_from_world();
+        let Some(target) = auto_exposure_ev(&snap.mesh, &snap.solution, clip, self.view.camera.position)
+        else {
+            return false;
+        };
+        let ev = match self.auto_ev {
+            Some(ev) if self.scripted.is_none() => ev + (target - ev) * (1.0 - (-dt / ADAPTATION).exp()),
+            _ => target,
+        };
+        self.auto_ev = Some(ev);
+        (target - ev).abs() > 0.01
     }
 
     /// Camera keys, drag and wheel. Returns whether the camera is moving (so frames continue).
@@ -333,6 +358,7 @@ impl ViewerApp {
         let now = Instant::now();
         let dt = self.last_frame.map_or(0.0, |t| now.duration_since(t).as_secs_f64()).min(MAX_MOVE_DT);
         self.last_frame = Some(now);
+        self.last_dt = dt;
         let mut moving = false;
         if response.dragged() {
             let d = response.drag_delta();
@@ -542,7 +568,7 @@ impl ViewerApp {
             ui.horizontal(|ui| {
                 ui.checkbox(&mut self.view.auto_exposure, "auto exposure");
                 if self.view.auto_exposure {
-                    self.view.exposure_ev = self.solution_ev;
+                    self.view.exposure_ev = self.auto_ev.unwrap_or(0.0);
                 }
             });
             ui.add_enabled(
@@ -754,11 +780,17 @@ impl eframe::App for ViewerApp {
             egui::ScrollArea::vertical().show(ui, |ui| self.panel(ui));
         });
         let mut moving = false;
+        let mut adapting = false;
         egui::CentralPanel::no_frame().show(ui, |ui| {
             let rect = ui.max_rect();
             let response = ui.allocate_rect(rect, Sense::click_and_drag());
             let aspect = f64::from(rect.width().max(1.0)) / f64::from(rect.height().max(1.0));
             moving = self.handle_camera_input(&ctx, &response, aspect);
+            let view_px = [
+                (rect.width() * ctx.pixels_per_point()) as u32,
+                (rect.height() * ctx.pixels_per_point()) as u32,
+            ];
+            adapting = self.adapt_exposure(view_px, self.last_dt);
             // The camera may have moved, so draw after the input.
             self.draw_view(ui, rect);
             if self.view.mode.is_false_colour() && self.shown.is_some() {
@@ -787,7 +819,8 @@ impl eframe::App for ViewerApp {
         });
         self.scripted_capture(&ctx);
         let busy = matches!(self.status.state, WorkerState::Meshing) || self.loading.is_some();
-        if moving || self.continuous || busy || self.capture.is_some() || self.scripted.is_some() {
+        if moving || adapting || self.continuous || busy || self.capture.is_some() || self.scripted.is_some()
+        {
             ctx.request_repaint();
         } else if self.status.state == WorkerState::Running {
             // The worker's publications wake the window; this is a floor for the panel's
@@ -849,22 +882,4 @@ fn unique_path(name: &str) -> PathBuf {
         return first;
     }
     (2..).map(|k| PathBuf::from(format!("{name}-{k}.png"))).find(|p| !p.exists()).unwrap_or(first)
-}
-
-/// The area-weighted log-average luminance of a solution's radiance, as an exposure in stops
-/// that maps it to middle grey — the viewer's stand-in for `render`'s per-pixel auto exposure.
-pub(crate) fn log_average_ev(mesh: &radiosity_core::Mesh, solution: &Solution) -> f64 {
-    let mut sum = 0.0;
-    let mut area = 0.0;
-    for (el, b) in mesh.elements.iter().zip(&solution.element_radiosity) {
-        let l = b.luminance() / std::f64::consts::PI;
-        if l > 0.0 && l.is_finite() {
-            sum += el.area * l.ln();
-            area += el.area;
-        }
-    }
-    if area <= 0.0 {
-        return 0.0;
-    }
-    (radiosity_image::AUTO_EXPOSURE_KEY / (sum / area).exp()).log2()
 }

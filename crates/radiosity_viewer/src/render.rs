@@ -673,6 +673,43 @@ pub fn false_colour_range(solution: &Solution, mode: DisplayMode) -> (f64, f64) 
     if hi - lo < 1e-3 { (hi - 0.5, hi + 0.5) } else { (lo, hi) }
 }
 
+/// Most elements [`auto_exposure_ev`] looks at per call; bigger meshes are sampled evenly so
+/// the estimate stays a fraction of a millisecond.
+pub const AUTO_EXPOSURE_SAMPLES: usize = 50_000;
+
+/// Automatic exposure for what the camera sees, in stops: the log-average luminance of the
+/// visible radiance (B/π) goes to middle grey, as `render --exposure auto` does over its
+/// pixels (Reinhard et al. 2002). Each element in front of the camera, inside the view and
+/// facing it counts with its solid angle, area·cosθ/d² — the share of pixels it would cover,
+/// occlusion aside. `None` when nothing lit is in view.
+pub fn auto_exposure_ev(mesh: &Mesh, solution: &Solution, clip_from_world: DMat4, eye: DVec3) -> Option<f64> {
+    if solution.element_radiosity.len() != mesh.elements.len() {
+        return None;
+    }
+    let step = mesh.elements.len().div_ceil(AUTO_EXPOSURE_SAMPLES).max(1);
+    let (mut sum, mut weight) = (0.0, 0.0);
+    for (el, b) in mesh.elements.iter().zip(&solution.element_radiosity).step_by(step) {
+        let to_eye = eye - el.centre;
+        let d2 = to_eye.length_squared();
+        let cos = el.normal.dot(to_eye) / d2.sqrt();
+        // Back faces are culled, so only the lit side is ever seen (NaN: a degenerate element).
+        if cos.is_nan() || cos <= 0.0 {
+            continue;
+        }
+        let c = clip_from_world * el.centre.extend(1.0);
+        if c.w <= 0.0 || c.x.abs() > c.w || c.y.abs() > c.w {
+            continue;
+        }
+        let l = b.luminance() / std::f64::consts::PI;
+        if l > 0.0 && l.is_finite() {
+            let w = el.area * cos / d2;
+            sum += w * l.ln();
+            weight += w;
+        }
+    }
+    (weight > 0.0).then(|| (radiosity_image::AUTO_EXPOSURE_KEY / (sum / weight).exp()).log2())
+}
+
 /// The Turbo false-colour ramp at t in [0, 1], display values in [0, 1]; the same polynomial
 /// as `false_colour` in `tonemap.wgsl` (for the legend drawn by egui).
 pub fn false_colour(t: f64) -> [f64; 3] {
@@ -725,6 +762,59 @@ mod tests {
                 assert_ne!(bits, 2, "a patch edge is always an element edge");
             }
         }
+    }
+
+    /// Furnace: B = E / (1 − ρ) = 2 everywhere, so radiance 2/π wherever one looks.
+    #[test]
+    fn auto_exposure_of_a_uniform_scene_maps_its_radiance_to_middle_grey() {
+        let mesh = furnace_mesh();
+        let s =
+            Solution { element_radiosity: vec![Rgb::splat(2.0); mesh.elements.len()], ..Default::default() };
+        let extent = crate::SceneExtent::new(DVec3::ZERO, DVec3::ONE);
+        let cam = crate::FlyCamera::from_scene_camera(
+            &radiosity_core::Camera::try_new(DVec3::splat(0.5), DVec3::new(0.5, 0.5, 1.0), DVec3::Y, 60.0)
+                .unwrap(),
+            &extent,
+        );
+        let m = cam.clip_from_view(1.0) * cam.view_from_world();
+        let ev = auto_exposure_ev(&mesh, &s, m, cam.position).unwrap();
+        let expected = (radiosity_image::AUTO_EXPOSURE_KEY / (2.0 / std::f64::consts::PI)).log2();
+        assert!((ev - expected).abs() < 1e-9, "{ev} vs {expected}");
+        // Looking from outside, through the culled wall, still sees the lit far side.
+        let dark = Solution { element_radiosity: vec![Rgb::ZERO; mesh.elements.len()], ..Default::default() };
+        assert_eq!(auto_exposure_ev(&mesh, &dark, m, cam.position), None);
+    }
+
+    /// From the Cornell box's camera, the viewer's automatic exposure is that of
+    /// `render --exposure auto` (the CPU renderer's log-average over its pixels) within a
+    /// quarter of a stop: the solid-angle weights stand in for pixel counts, occlusion by the
+    /// blocks aside.
+    #[test]
+    fn auto_exposure_agrees_with_the_cpu_renderer() {
+        use radiosity_solver::{Solver, SolverParams, StepBudget, occluder_triangles};
+        let scene = radiosity_io::resolve_scene("cornell").unwrap();
+        let mesh = Arc::new(Mesh::build(&scene, &scene.mesh_params()).unwrap());
+        let accel = Arc::new(radiosity_accel::Bvh::new(&occluder_triangles(&mesh)));
+        let mut solver = Solver::new(mesh.clone(), accel, SolverParams::preview()).unwrap();
+        solver.step(StepBudget::Shots(200));
+        let solution = solver.solution();
+        let camera = scene.camera.unwrap();
+        let params = radiosity_image::RenderParams::preview();
+        let picture =
+            radiosity_image::Renderer::new(mesh.clone()).render(&solution, &camera, &params).unwrap();
+        let cpu = radiosity_image::Exposure::Auto.ev_for(&picture.radiance);
+        let (lo, hi) = mesh.bounds();
+        let fly = crate::FlyCamera::from_scene_camera(&camera, &crate::SceneExtent::new(lo, hi));
+        let aspect = f64::from(params.width) / f64::from(params.height);
+        let gpu = auto_exposure_ev(
+            &mesh,
+            &solution,
+            fly.clip_from_view(aspect) * fly.view_from_world(),
+            fly.position,
+        )
+        .unwrap();
+        eprintln!("viewer {gpu:.3} EV, render {cpu:.3} EV");
+        assert!((gpu - cpu).abs() < 0.25, "viewer {gpu:.3} EV, render {cpu:.3} EV");
     }
 
     #[test]
