@@ -117,6 +117,7 @@ fn view_cornell_screenshot_shows_the_lit_box() {
     assert!(red_sum > 0.05 * columns, "no red wall: {red_sum} column-shares");
     assert!(green_sum > 0.05 * columns, "no green wall: {green_sum} column-shares");
     let (red_at, green_at) = (red_x / red_sum / columns, green_x / green_sum / columns);
+    eprintln!("red wall centroid {red_at:.2}, green wall centroid {green_at:.2} of the view width");
     assert!(red_at < 0.35, "the red wall must be on the left of the view: centroid at {red_at:.2}");
     assert!(green_at > 0.65, "the green wall must be on the right of the view: centroid at {green_at:.2}");
 
@@ -125,8 +126,10 @@ fn view_cornell_screenshot_shows_the_lit_box() {
         .map(|(x, y)| pixel(&img, x, y))
         .collect();
     let mean = pixels.iter().map(|p| (p[0] + p[1] + p[2]) / 3.0).sum::<f64>() / pixels.len() as f64;
+    eprintln!("mean {mean:.1} of 255");
     assert!(mean > 50.0, "the box must be lit: mean {mean:.1} of 255");
     let white = pixels.iter().filter(|p| p.iter().all(|c| *c >= 250.0)).count() as f64 / pixels.len() as f64;
+    eprintln!("{:.2} % white", white * 100.0);
     assert!(white < 0.05, "blown out: {:.1} % of the view is white", white * 100.0);
 }
 

@@ -555,13 +555,14 @@ impl ViewerApp {
         ui.label("display");
         ui.horizontal_wrapped(|ui| {
             for m in DisplayMode::ALL {
-                ui.selectable_value(&mut self.view.mode, m, m.label());
+                ui.selectable_value(&mut self.view.mode, m, m.label()).on_hover_text(m.description());
             }
         });
         ui.horizontal(|ui| {
             ui.label("wireframe");
             for w in Wireframe::ALL {
-                ui.selectable_value(&mut self.view.wireframe, w, w.label());
+                ui.selectable_value(&mut self.view.wireframe, w, w.label())
+                    .on_hover_text("outlines of the patches (which shoot) or the elements (which receive)");
             }
         });
         ui.add_enabled_ui(!self.view.mode.is_false_colour(), |ui| {
@@ -591,24 +592,34 @@ impl ViewerApp {
         let diagonal = self.extent.diagonal();
         let mut apply = false;
         let released = |r: &egui::Response| r.drag_stopped() || (r.changed() && !r.dragged());
-        let r = ui.add(
-            egui::Slider::new(&mut self.subdivision.light_scale, 0.01..=100.0)
-                .logarithmic(true)
-                .text("light ×"),
-        );
+        let r = ui
+            .add(
+                egui::Slider::new(&mut self.subdivision.light_scale, 0.01..=100.0)
+                    .logarithmic(true)
+                    .text("light ×"),
+            )
+            .on_hover_text("multiplies every emission (the light intensity); the solve restarts");
         apply |= released(&r);
         let size_range = diagonal / 1000.0..=diagonal / 2.0;
-        let r = ui.add(
-            egui::Slider::new(&mut self.subdivision.patch_size, size_range.clone())
-                .logarithmic(true)
-                .text("patch size"),
-        );
+        let r = ui
+            .add(
+                egui::Slider::new(&mut self.subdivision.patch_size, size_range.clone())
+                    .logarithmic(true)
+                    .text("patch size"),
+            )
+            .on_hover_text(
+                "longest patch edge, scene units: patches shoot; smaller is slower and more accurate",
+            );
         apply |= released(&r);
-        let r = ui.add(
-            egui::Slider::new(&mut self.subdivision.element_size, size_range)
-                .logarithmic(true)
-                .text("element size"),
-        );
+        let r = ui
+            .add(
+                egui::Slider::new(&mut self.subdivision.element_size, size_range)
+                    .logarithmic(true)
+                    .text("element size"),
+            )
+            .on_hover_text(
+                "longest element edge, scene units: elements receive; smaller gives sharper shadows",
+            );
         apply |= released(&r);
         if apply {
             self.apply_subdivision();

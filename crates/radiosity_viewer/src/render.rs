@@ -68,6 +68,16 @@ impl DisplayMode {
         }
     }
 
+    /// One sentence for the panel's tooltip.
+    pub fn description(self) -> &'static str {
+        match self {
+            DisplayMode::Smooth => "vertex radiosity interpolated across elements, as `render` shows it",
+            DisplayMode::FlatElements => "each element's own radiosity: shows the subdivision",
+            DisplayMode::FalseColour => "log luminance of the radiosity on a colour scale, with a legend",
+            DisplayMode::Unshot => "radiosity still waiting to be shot, on a log colour scale",
+        }
+    }
+
     /// Whether the mode is drawn in false colour with a legend.
     pub fn is_false_colour(self) -> bool {
         matches!(self, DisplayMode::FalseColour | DisplayMode::Unshot)
