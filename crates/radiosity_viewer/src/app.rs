@@ -1,9 +1,9 @@
 //! The window: an egui panel beside the 3D view, camera input, scene loading, screenshots.
 //!
 //! Every frame reads the newest snapshot the worker published (never waiting for it), uploads
-//! its colours when it is new, draws the mesh into an offscreen [`RenderTarget`] and shows that
-//! texture as an egui image. Slow work — loading a file, meshing, solving — happens on other
-//! threads, so the window stays responsive whatever the scene.
+//! its colours when it is new, and adds the 3D view as a paint callback that draws the mesh
+//! straight into egui's render pass. Slow work — loading a file, meshing, solving — happens on
+//! other threads, so the window stays responsive whatever the scene.
 
 use std::collections::VecDeque;
 use std::path::PathBuf;
@@ -44,8 +44,8 @@ pub const KEY_HINT: &str = "WASD/arrows move · Q/E or Ctrl/Space down/up · dra
 pub struct ViewState {
     /// The fly-through camera.
     pub camera: FlyCamera,
-    /// Exposure follows the solution (log-average luminance to middle grey), as `render`'s
-    /// default `--exposure auto` does.
+    /// Exposure follows what the camera sees (its log-average luminance goes to middle grey),
+    /// as `render`'s default `--exposure auto` does for its picture.
     pub auto_exposure: bool,
     /// Exposure in stops when not automatic.
     pub exposure_ev: f64,
@@ -81,11 +81,9 @@ impl FpsCounter {
     }
 }
 
-/// A screenshot asked for and not yet written.
+/// A `--screenshot` asked for and not yet written.
 struct Capture {
     path: PathBuf,
-    /// Whether the program ends once it is written (`--screenshot`).
-    then_exit: bool,
     image: Arc<Mutex<Option<Arc<egui::ColorImage>>>>,
     requested: bool,
 }
@@ -714,12 +712,7 @@ impl ViewerApp {
             // rate printed then is the window's own.
             let measured = !self.continuous || self.mark.is_some_and(|(t, _)| t.elapsed() >= FPS_MEASURE);
             if ready && measured {
-                self.capture = Some(Capture {
-                    path: path.clone(),
-                    then_exit: true,
-                    image: Arc::default(),
-                    requested: false,
-                });
+                self.capture = Some(Capture { path: path.clone(), image: Arc::default(), requested: false });
             }
         }
         let Some(capture) = &mut self.capture else { return };
@@ -736,33 +729,21 @@ impl ViewerApp {
         let taken = capture.image.lock().unwrap_or_else(|e| e.into_inner()).take();
         if let Some(img) = taken {
             let path = capture.path.clone();
-            let then_exit = capture.then_exit;
             self.capture = None;
             let result = save_color_image(&img, &path);
-            if then_exit {
-                if result.is_ok() {
-                    let solving_fps = self.mark.map_or(0.0, |m| m.1);
-                    eprintln!(
-                        "wrote {} ({}×{} px, {} shots; {:.1} fps while solving{})",
-                        path.display(),
-                        img.size[0],
-                        img.size[1],
-                        self.status.progress.shots,
-                        solving_fps,
-                        if self.continuous {
-                            format!(", {:.1} fps idle", self.fps.fps())
-                        } else {
-                            String::new()
-                        }
-                    );
-                }
-                self.finish(ctx, result);
-            } else {
-                self.message = Some(match result {
-                    Ok(()) => format!("wrote {}", path.display()),
-                    Err(e) => format!("{e:#}"),
-                });
+            if result.is_ok() {
+                let solving_fps = self.mark.map_or(0.0, |m| m.1);
+                let idle_fps =
+                    if self.continuous { format!(", {:.1} fps idle", self.fps.fps()) } else { String::new() };
+                eprintln!(
+                    "wrote {} ({}×{} px, {} shots; {solving_fps:.1} fps while solving{idle_fps})",
+                    path.display(),
+                    img.size[0],
+                    img.size[1],
+                    self.status.progress.shots,
+                );
             }
+            self.finish(ctx, result);
         }
     }
 
@@ -808,10 +789,14 @@ impl eframe::App for ViewerApp {
                 self.legend(ui.painter(), rect);
             }
             if self.shown.is_none() {
+                let text = match &self.status.error {
+                    Some(e) => format!("cannot show the scene: {e}"),
+                    None => "meshing…".to_owned(),
+                };
                 ui.painter().text(
                     rect.center(),
                     egui::Align2::CENTER_CENTER,
-                    "meshing…",
+                    text,
                     egui::FontId::proportional(18.0),
                     Color32::LIGHT_GRAY,
                 );
