@@ -141,6 +141,13 @@ pub fn default_samples() -> u32 {
     if let Some(n) = std::env::var("RADIOSITY_MSAA").ok().and_then(|v| v.parse::<u32>().ok()) {
         return if n >= 4 { 4 } else { 1 };
     }
+    // Without a display there will be no window to draw in; spare the probe (and Mesa's
+    // warnings) and let `run` say what to do.
+    if cfg!(target_os = "linux")
+        && ["DISPLAY", "WAYLAND_DISPLAY", "WAYLAND_SOCKET"].iter().all(|v| std::env::var_os(v).is_none())
+    {
+        return 1;
+    }
     use eframe::wgpu;
     let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
     match pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions::default())) {
