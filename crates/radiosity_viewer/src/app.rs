@@ -235,6 +235,8 @@ impl ViewerApp {
         let s = self.subdivision;
         match MeshParams::try_new(s.patch_size, s.element_size) {
             Ok(mesh_params) => {
+                // Elements are never larger than their patches: show what will be used.
+                self.subdivision.element_size = mesh_params.element_size;
                 let job = SolveJob { light_scale: s.light_scale, mesh_params, ..self.job.clone() };
                 self.restart_with(job);
             }
