@@ -48,6 +48,8 @@ pub struct ViewerOptions {
     pub screenshot: Option<PathBuf>,
     /// Shots before the screenshot; the solve pauses there.
     pub after_shots: Option<u64>,
+    /// Folder where P writes pictures of the view.
+    pub screenshot_dir: PathBuf,
     /// Redraw every frame rather than only on change (shows the highest frame rate).
     pub continuous: bool,
     /// Initial window size, points.
@@ -76,6 +78,7 @@ impl ViewerOptions {
             threads: None,
             screenshot: None,
             after_shots: None,
+            screenshot_dir: PathBuf::from("."),
             continuous: false,
             window_size: [1200.0, 760.0],
             samples: default_samples(),
