@@ -103,24 +103,30 @@ fn input(msg: String) -> anyhow::Error {
     InputError(msg).into()
 }
 
-/// Loads `scene_arg` (a path or a built-in name), applies the options, meshes it and builds
-/// the ray-query structure.
+/// A scene with every solve option checked and turned into parameters, not yet meshed.
+pub struct Settings {
+    /// The scene as loaded; the light scale is NOT applied yet (callers apply it when they
+    /// mesh, so the viewer can change it live).
+    pub scene: Scene,
+    /// Subdivision from the scene and the options.
+    pub mesh_params: MeshParams,
+    /// Solver settings from the scene and the options.
+    pub solver_params: SolverParams,
+}
+
+/// Loads `scene_arg` (a path or a built-in name) and checks the options against it: the one
+/// place where command-line solve options become parameters.
 ///
 /// # Errors
 /// Bad scene files and out-of-range options (exit code 2).
-pub fn prepare(scene_arg: &str, o: &SolveOpts) -> Result<Prepared> {
-    if let Some(t) = o.threads {
-        if t == 0 {
-            return Err(input("--threads must be at least 1".into()));
-        }
-        // The global pool can be set once per process; a second call is a harmless no-op.
-        let _ = rayon::ThreadPoolBuilder::new().num_threads(t).build_global();
+pub fn settings(scene_arg: &str, o: &SolveOpts) -> Result<Settings> {
+    if o.threads == Some(0) {
+        return Err(input("--threads must be at least 1".into()));
     }
-    let mut scene = radiosity_io::resolve_scene(scene_arg)?;
+    let scene = radiosity_io::resolve_scene(scene_arg)?;
     if !(o.light_scale.is_finite() && o.light_scale > 0.0) {
         return Err(input(format!("--light-scale must be a finite number > 0, got {}", o.light_scale)));
     }
-    scene.scale_emission(o.light_scale);
     let base = scene.mesh_params();
     let patch = o.patch_size.unwrap_or(base.patch_size);
     let element = o.element_size.unwrap_or(if o.patch_size.is_some() {
@@ -129,14 +135,12 @@ pub fn prepare(scene_arg: &str, o: &SolveOpts) -> Result<Prepared> {
         base.element_size
     });
     let mesh_params = MeshParams::try_new(patch, element).map_err(|e| input(format!("mesh options: {e}")))?;
-    let mesh = Arc::new(Mesh::build(&scene, &mesh_params)?);
-    let accel = Arc::new(Bvh::new(&occluder_triangles(&mesh)));
     let time_limit = match o.time_limit.or(scene.solver.time_limit) {
         Some(t) if t.is_finite() && t >= 0.0 => Some(Duration::from_secs_f64(t)),
         Some(t) => return Err(input(format!("--time-limit must be a number of seconds ≥ 0, got {t}"))),
         None => None,
     };
-    let params = SolverParams {
+    let solver_params = SolverParams {
         form_factor: match o.form_factor {
             FormFactorArg::Exact => FormFactorMethod::Exact,
             FormFactorArg::Point => FormFactorMethod::PointToPoint,
@@ -150,7 +154,24 @@ pub fn prepare(scene_arg: &str, o: &SolveOpts) -> Result<Prepared> {
         overshoot: if o.overshoot == 1.0 { Overshoot::Off } else { Overshoot::Relaxation(o.overshoot) },
         ..SolverParams::default()
     };
-    Ok(Prepared { scene, mesh, accel, params })
+    Ok(Settings { scene, mesh_params, solver_params })
+}
+
+/// [`settings`], then the light scale, the mesh and the ray-query structure; sets the
+/// global thread pool when `--threads` is given.
+///
+/// # Errors
+/// Bad scene files, out-of-range options, meshes that would be too large (exit code 2).
+pub fn prepare(scene_arg: &str, o: &SolveOpts) -> Result<Prepared> {
+    let Settings { mut scene, mesh_params, solver_params } = settings(scene_arg, o)?;
+    if let Some(t) = o.threads {
+        // The global pool can be set once per process; a second call is a harmless no-op.
+        let _ = rayon::ThreadPoolBuilder::new().num_threads(t).build_global();
+    }
+    scene.scale_emission(o.light_scale);
+    let mesh = Arc::new(Mesh::build(&scene, &mesh_params)?);
+    let accel = Arc::new(Bvh::new(&occluder_triangles(&mesh)));
+    Ok(Prepared { scene, mesh, accel, params: solver_params })
 }
 
 /// Runs the solver to a stop criterion, with a progress bar on stderr when it is a terminal.

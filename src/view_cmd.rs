@@ -1,16 +1,13 @@
 //! `radiosity view`: the interactive window, solving while you walk through the scene.
 
 use std::path::PathBuf;
-use std::time::Duration;
 
 use anyhow::Result;
 use clap::{Args, ValueEnum};
-use radiosity_core::MeshParams;
 use radiosity_image::Exposure;
-use radiosity_solver::{Ambient, FormFactorMethod, Overshoot, SolverParams};
 use radiosity_viewer::{DisplayMode, Wireframe};
 
-use crate::prepare::{FormFactorArg, InputError, SolveOpts, check_writable};
+use crate::prepare::{InputError, Settings, SolveOpts, check_writable, settings};
 use crate::render_cmd::ToneOpts;
 
 /// What the surfaces show, on the command line.
@@ -83,42 +80,9 @@ fn input(msg: String) -> anyhow::Error {
 /// it to the viewer, which meshes and solves it on a worker thread.
 pub fn run(a: ViewArgs) -> Result<()> {
     let o = &a.solve;
-    let scene = radiosity_io::resolve_scene(&a.scene)?;
-    // The same rules as every solving command (see prepare::prepare), without meshing here:
-    // the viewer meshes on its worker so the window opens at once.
-    if o.threads == Some(0) {
-        return Err(input("--threads must be at least 1".into()));
-    }
-    if !(o.light_scale.is_finite() && o.light_scale > 0.0) {
-        return Err(input(format!("--light-scale must be a finite number > 0, got {}", o.light_scale)));
-    }
-    let base = scene.mesh_params();
-    let patch = o.patch_size.unwrap_or(base.patch_size);
-    let element = o.element_size.unwrap_or(if o.patch_size.is_some() {
-        patch.min(base.element_size)
-    } else {
-        base.element_size
-    });
-    let mesh_params = MeshParams::try_new(patch, element).map_err(|e| input(format!("mesh options: {e}")))?;
-    let time_limit = match o.time_limit.or(scene.solver.time_limit) {
-        Some(t) if t.is_finite() && t >= 0.0 => Some(Duration::from_secs_f64(t)),
-        Some(t) => return Err(input(format!("--time-limit must be a number of seconds ≥ 0, got {t}"))),
-        None => None,
-    };
-    let solver_params = SolverParams {
-        form_factor: match o.form_factor {
-            FormFactorArg::Exact => FormFactorMethod::Exact,
-            FormFactorArg::Point => FormFactorMethod::PointToPoint,
-        },
-        visibility_rays: o.visibility_rays,
-        unshot_threshold: o.unshot_threshold.or(scene.solver.unshot_threshold).unwrap_or(1e-3),
-        max_shots: o.max_shots.or(scene.solver.max_shots),
-        time_limit,
-        seed: o.seed,
-        ambient: if o.ambient { Ambient::On } else { Ambient::Off },
-        overshoot: if o.overshoot == 1.0 { Overshoot::Off } else { Overshoot::Relaxation(o.overshoot) },
-        ..SolverParams::default()
-    };
+    // The same option rules as every solving command, without meshing here: the viewer
+    // meshes on its worker so the window opens at once.
+    let Settings { scene, mesh_params, solver_params } = settings(&a.scene, o)?;
     if let Some(path) = &a.screenshot {
         check_writable(path, a.force)?;
     }
