@@ -22,12 +22,14 @@
 #![forbid(unsafe_code)]
 
 pub mod form_factor;
+mod occluders;
 mod sampling;
 mod solution;
 mod solver;
 
+pub use occluders::occluder_triangles;
 pub use solution::{ObjectRadiosity, Solution};
 pub use solver::{
     Ambient, EnergyBalance, FormFactorMethod, Overshoot, Solver, SolverError, SolverParams, StepBudget,
-    StepReport, StopReason, occluder_triangles,
+    StepReport, StopReason,
 };

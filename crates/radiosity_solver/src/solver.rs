@@ -14,13 +14,14 @@
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use glam::{DVec3, Vec3};
+use glam::DVec3;
 use radiosity_accel::RayQuery;
 use radiosity_core::{Mesh, Rgb};
 use rayon::prelude::*;
 use thiserror::Error;
 
 use crate::form_factor::{Rule, distance_to_polygon, for_each_point, point_to_point, point_to_polygon};
+use crate::occluders::OccluderBoxes;
 use crate::sampling::{Rng, point_on, stratified};
 use crate::solution::{Solution, vertex_average};
 
@@ -214,6 +215,7 @@ pub struct Solver {
     total_area: f64,
     mean_reflectance: Rgb,
     ray_offset: f64,
+    occluder_boxes: OccluderBoxes,
     shots: u64,
     rays: u64,
     elapsed: Duration,
@@ -276,6 +278,7 @@ impl Solver {
             patch_live: vec![false; mesh.patches.len()],
             factors: vec![(0.0, 0); n],
             ray_offset: 1e-6 * (hi - lo).length(),
+            occluder_boxes: OccluderBoxes::new(&mesh),
             mesh,
             accel,
             params,
@@ -461,13 +464,14 @@ impl Solver {
 
         let params = &self.params;
         let accel = &*self.accel;
+        let boxes = &self.occluder_boxes;
         let patch_live = &self.patch_live;
         let offset = self.ray_offset;
         let shot_index = self.shots;
         self.factors.par_iter_mut().enumerate().for_each(|(e, out)| {
             let el = &mesh.elements[e];
             *out = if patch_live[el.patch as usize] {
-                receive(&mesh, e, patch, accel, params, offset, shot_index)
+                receive(&mesh, e, patch, accel, boxes, params, offset, shot_index)
             } else {
                 (0.0, 0)
             };
@@ -530,6 +534,7 @@ fn receive(
     e: usize,
     shooter: &radiosity_core::Patch,
     accel: &dyn RayQuery,
+    boxes: &OccluderBoxes,
     params: &SolverParams,
     offset: f64,
     shot: u64,
@@ -561,6 +566,17 @@ fn receive(
     if unoccluded <= 0.0 {
         return (0.0, 0);
     }
+    // Every segment between the element and the shooter lies in the box around both; when no
+    // blocking triangle comes near that box the pair is fully visible and needs no ray.
+    let (lo, hi) = receiver
+        .iter()
+        .chain(corners)
+        .fold((DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)), |(a, b), p| {
+            (a.min(*p), b.max(*p))
+        });
+    if !boxes.may_block(lo, hi, 2.0 * offset) {
+        return (unoccluded, 0);
+    }
     // Visibility: stratified jittered rays between the element and the shooter.
     let k = params.visibility_rays;
     let mut rng = Rng::for_task(params.seed, shot, e as u64);
@@ -575,9 +591,4 @@ fn receive(
         }
     }
     (unoccluded * f64::from(visible) / f64::from(k), k)
-}
-
-/// The occluder triangles of a mesh in single precision, ready for a [`RayQuery`] backend.
-pub fn occluder_triangles(mesh: &Mesh) -> Vec<[Vec3; 3]> {
-    mesh.occluders.iter().map(|t| t.map(|p| p.as_vec3())).collect()
 }

@@ -166,3 +166,50 @@ fn shot_and_time_limits_stop_the_solve() {
     );
     assert_eq!(s.solve().stop_reason, Some(StopReason::TimeLimit));
 }
+
+/// The fast visibility path (walls that cannot block dropped from the BVH) gives the same
+/// solution as brute-force rays against every input triangle.
+#[test]
+fn culled_visibility_matches_brute_force_on_every_triangle() {
+    let mut scene = furnace_box(0.7, 0.01);
+    scene.materials.push(radiosity_core::Material::try_new("lamp", Rgb::ZERO, Rgb::splat(5.0)).unwrap());
+    let block = radiosity_core::box_faces(
+        glam::DVec3::new(0.3, 0.0, 0.3),
+        glam::DVec3::new(0.6, 0.5, 0.6),
+        radiosity_core::Facing::Outward,
+        25.0,
+    )
+    .unwrap();
+    let lamp = radiosity_core::Polygon::try_new(vec![
+        glam::DVec3::new(0.4, 0.99, 0.4),
+        glam::DVec3::new(0.6, 0.99, 0.4),
+        glam::DVec3::new(0.6, 0.99, 0.6),
+        glam::DVec3::new(0.4, 0.99, 0.6),
+    ])
+    .unwrap();
+    // Counter-clockwise seen from below: the lamp faces down.
+    let lamp = radiosity_core::Polygon::try_new(lamp.vertices().iter().rev().copied().collect()).unwrap();
+    scene.objects.push(radiosity_core::Object {
+        name: "block".into(),
+        material: 0,
+        shape: radiosity_core::Shape::Polygons(block),
+    });
+    scene.objects.push(radiosity_core::Object {
+        name: "lamp".into(),
+        material: 1,
+        shape: radiosity_core::Shape::Polygons(vec![lamp]),
+    });
+    let mesh = Arc::new(Mesh::build(&scene, &MeshParams::try_new(0.25, 0.0625).unwrap()).unwrap());
+    let params = SolverParams { max_shots: Some(80), ..SolverParams::default() };
+    let fast = Arc::new(Bvh::new(&occluder_triangles(&mesh)));
+    let all: Vec<[glam::Vec3; 3]> = mesh.occluders.iter().map(|t| t.map(|p| p.as_vec3())).collect();
+    assert!(occluder_triangles(&mesh).len() < all.len());
+    let brute = Arc::new(radiosity_accel::BruteForce::new(&all));
+    let mut a = Solver::new(mesh.clone(), fast, params.clone()).unwrap();
+    let mut b = Solver::new(mesh, brute, params).unwrap();
+    a.solve();
+    b.solve();
+    for (x, y) in a.solution().element_radiosity.iter().zip(b.solution().element_radiosity.iter()) {
+        assert!((x.g - y.g).abs() <= 1e-9 * y.g.max(1e-12), "{} vs {}", x.g, y.g);
+    }
+}
