@@ -36,6 +36,34 @@ fn clip_to_hemisphere(p: DVec3, n: DVec3, poly: &[DVec3], out: &mut [DVec3; 8]) 
     count
 }
 
+/// `atan2(y, x)` for `y ≥ 0`, in [0, π]: the angle between two vectors from the length of
+/// their cross product and their dot product.
+///
+/// The form factor's hot loop calls this four times per evaluation, and libm's `atan2` was a
+/// quarter of the solve time; this is the classic reduction (Cephes `atan`): fold into
+/// t ∈ [0, 1], then by atan(t) = π/6 + atan((√3 t − 1)/(√3 + t)) into |t| ≤ tan(π/12), where
+/// the odd Taylor series to t¹⁵ leaves about 1e-11 rad of error.
+#[inline]
+fn angle(y: f64, x: f64) -> f64 {
+    use std::f64::consts::{FRAC_PI_2, FRAC_PI_6};
+    const TAN_PI_12: f64 = 0.267_949_192_431_122_7;
+    const SQRT_3: f64 = 1.732_050_807_568_877_2;
+    let ax = x.abs();
+    let (num, den, swapped) = if y <= ax { (y, ax, false) } else { (ax, y, true) };
+    let t = if den > 0.0 { num / den } else { 0.0 };
+    let (t, offset) = if t > TAN_PI_12 { ((SQRT_3 * t - 1.0) / (SQRT_3 + t), FRAC_PI_6) } else { (t, 0.0) };
+    let t2 = t * t;
+    let series = t
+        * (1.0
+            - t2 * (1.0 / 3.0
+                - t2 * (1.0 / 5.0
+                    - t2 * (1.0 / 7.0
+                        - t2 * (1.0 / 9.0 - t2 * (1.0 / 11.0 - t2 * (1.0 / 13.0 - t2 / 15.0)))))));
+    let a = offset + series;
+    let a = if swapped { FRAC_PI_2 - a } else { a };
+    if x < 0.0 { PI - a } else { a }
+}
+
 /// Exact form factor from a differential area at `p` with unit normal `n` to a convex planar
 /// polygon (any winding), ignoring occlusion. Parts of the polygon behind the receiver's
 /// tangent plane are clipped away, so the result is in [0, 1].
@@ -53,7 +81,7 @@ pub fn point_to_polygon(p: DVec3, n: DVec3, polygon: &[DVec3]) -> f64 {
         if len <= 1e-300 {
             continue;
         }
-        let gamma = len.atan2(ra.dot(rb));
+        let gamma = angle(len, ra.dot(rb));
         sum += gamma * n.dot(c) / len;
     }
     (sum / (2.0 * PI)).abs().min(1.0)
@@ -263,6 +291,21 @@ mod tests {
         1.0 / (2.0 * PI)
             * (x / (1.0 + x * x).sqrt() * (y / (1.0 + x * x).sqrt()).atan()
                 + y / (1.0 + y * y).sqrt() * (x / (1.0 + y * y).sqrt()).atan())
+    }
+
+    #[test]
+    fn fast_angle_matches_atan2() {
+        let mut worst: f64 = 0.0;
+        for i in 0..=400 {
+            for j in -400..=400 {
+                let (y, x) = (i as f64 * 0.013, j as f64 * 0.0071);
+                worst = worst.max((angle(y, x) - y.atan2(x)).abs());
+            }
+        }
+        // The series remainder at the reduced range edge: about 1e-11 rad.
+        assert!(worst < 2e-11, "{worst}");
+        assert_eq!(angle(0.0, 0.0), 0.0);
+        assert!((angle(1.0, 0.0) - PI / 2.0).abs() < 1e-15);
     }
 
     #[test]
