@@ -462,19 +462,19 @@ impl Solver {
                 && in_front(corners, r.centre, r.normal);
         });
 
-        let params = &self.params;
-        let accel = &*self.accel;
-        let boxes = &self.occluder_boxes;
+        let shot = Shot {
+            mesh: &mesh,
+            shooter: patch,
+            accel: &*self.accel,
+            boxes: &self.occluder_boxes,
+            params: &self.params,
+            offset: self.ray_offset,
+            index: self.shots,
+        };
         let patch_live = &self.patch_live;
-        let offset = self.ray_offset;
-        let shot_index = self.shots;
         self.factors.par_iter_mut().enumerate().for_each(|(e, out)| {
             let el = &mesh.elements[e];
-            *out = if patch_live[el.patch as usize] {
-                receive(&mesh, e, patch, accel, boxes, params, offset, shot_index)
-            } else {
-                (0.0, 0)
-            };
+            *out = if patch_live[el.patch as usize] { receive(&shot, e) } else { (0.0, 0) };
         });
 
         // Apply sequentially in element order: the sums are the same for any thread count.
@@ -529,17 +529,22 @@ fn quadrature(el_radius: f64, gap: f64, max: u32) -> (u32, Rule) {
     (((4.0 * el_radius / gap).ceil() as u32).clamp(1, max), Rule::Gauss)
 }
 
-/// Form factor F_{e→shooter} (with visibility) and the number of rays traced.
-fn receive(
-    mesh: &Mesh,
-    e: usize,
-    shooter: &radiosity_core::Patch,
-    accel: &dyn RayQuery,
-    boxes: &OccluderBoxes,
-    params: &SolverParams,
+/// What every receiver of one shot reads.
+struct Shot<'a> {
+    mesh: &'a Mesh,
+    shooter: &'a radiosity_core::Patch,
+    accel: &'a dyn RayQuery,
+    boxes: &'a OccluderBoxes,
+    params: &'a SolverParams,
+    /// Ray origins and targets are lifted this far off their surfaces.
     offset: f64,
-    shot: u64,
-) -> (f64, u32) {
+    /// Shot index, for the random streams.
+    index: u64,
+}
+
+/// Form factor F_{e→shooter} (with visibility) and the number of rays traced.
+fn receive(shot: &Shot, e: usize) -> (f64, u32) {
+    let Shot { mesh, shooter, accel, boxes, params, offset, index } = *shot;
     let el = &mesh.elements[e];
     let mut pts = [DVec3::ZERO; 4];
     for (k, p) in mesh.element_corners(e).enumerate() {
@@ -580,7 +585,7 @@ fn receive(
     }
     // Visibility: stratified jittered rays between the element and the shooter.
     let k = params.visibility_rays;
-    let mut rng = Rng::for_task(params.seed, shot, e as u64);
+    let mut rng = Rng::for_task(params.seed, index, e as u64);
     let mut visible = 0;
     for i in 0..k {
         let (u, v) = stratified(i, k, &mut rng);
