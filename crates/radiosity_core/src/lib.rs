@@ -16,7 +16,8 @@ pub use canonical::{furnace_box, furnace_sphere, two_plates, unit_cube_floor_lig
 pub use color::Rgb;
 pub use mesh::{Element, MAX_ELEMENTS, Mesh, MeshError, MeshParams, Patch, Surface};
 pub use scene::{
-    Camera, Facing, Material, Object, Polygon, Scene, SceneError, Shape, SolverSettings, Sphere, box_faces,
+    Camera, Facing, Material, Object, Polygon, PolygonMesh, Scene, SceneError, Shape, SolverSettings, Sphere,
+    box_faces,
 };
 
 /// Re-export of the vector maths used in the public API.

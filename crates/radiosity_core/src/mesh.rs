@@ -14,7 +14,7 @@ use glam::DVec3;
 use thiserror::Error;
 
 use crate::Material;
-use crate::scene::{Facing, Polygon, Scene, SceneError, Shape, Sphere};
+use crate::scene::{Facing, Polygon, PolygonMesh, Scene, SceneError, Shape, Sphere};
 
 /// Subdivision of surfaces (the source document's "discrétisation", S10).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -125,7 +125,8 @@ impl Patch {
     }
 }
 
-/// One input polygon or one sphere: the unit within which vertices are shared.
+/// One input polygon, one sphere, or one group of coplanar edge-connected triangles of a
+/// polygon mesh: the unit within which vertices are shared.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Surface {
     /// Index into [`Mesh::object_names`].
@@ -238,6 +239,19 @@ fn mesh_triangle(b: &mut SurfaceBuilder, t: [DVec3; 3], normal: DVec3, np: usize
     let at = |i: usize, j: usize| {
         t[0] + (t[1] - t[0]) * (i as f64 / n as f64) + (t[2] - t[0]) * (j as f64 / n as f64)
     };
+    mesh_triangle_lattice(b, &at, normal, np, ne);
+}
+
+/// The lattice of [`mesh_triangle`] with lattice point `(i, j)` (`i` steps along the first
+/// edge, `j` along the third, `np * ne` steps per edge) placed by `at`.
+fn mesh_triangle_lattice(
+    b: &mut SurfaceBuilder,
+    at: &dyn Fn(usize, usize) -> DVec3,
+    normal: DVec3,
+    np: usize,
+    ne: usize,
+) {
+    let n = np * ne;
     let coarse = |i: usize, j: usize| at(i * ne, j * ne);
     let mut patch_of: HashMap<(usize, usize, bool), usize> = HashMap::new();
     let mut label = |b: &mut SurfaceBuilder, x3: usize, y3: usize| {
@@ -325,6 +339,176 @@ fn mesh_sphere(b: &mut SurfaceBuilder, s: &Sphere, params: &MeshParams) {
     }
 }
 
+/// Patch and element steps per edge for a triangle meshed on its own, as [`mesh_polygon`]
+/// chooses them for a one-triangle fan.
+fn triangle_steps(t: &[DVec3; 3], params: &MeshParams) -> (usize, usize) {
+    let longest = t[0].distance(t[1]).max(t[1].distance(t[2])).max(t[2].distance(t[0]));
+    let np = divisions(longest, params.patch_size);
+    (np, divisions(longest / np as f64, params.element_size))
+}
+
+/// Disjoint sets over triangle numbers, to group triangles into surfaces.
+struct UnionFind(Vec<u32>);
+
+impl UnionFind {
+    fn find(&mut self, mut x: u32) -> u32 {
+        while self.0[x as usize] != x {
+            // Path halving keeps the trees flat without recursion.
+            self.0[x as usize] = self.0[self.0[x as usize] as usize];
+            x = self.0[x as usize];
+        }
+        x
+    }
+
+    fn union(&mut self, a: u32, b: u32) {
+        let (ra, rb) = (self.find(a), self.find(b));
+        // The smaller root wins, so a group's root is its first triangle: deterministic order.
+        if ra != rb {
+            let (lo, hi) = (ra.min(rb), ra.max(rb));
+            self.0[hi as usize] = lo;
+        }
+    }
+}
+
+/// How the faces of a [`PolygonMesh`] are cut into surfaces: groups of triangles (face
+/// numbers), each meshed with shared vertices; a face of 4+ vertices is a group of its own.
+///
+/// Two triangles join one group when they share an edge (by vertex index) used by no other
+/// face, are coplanar (normals within ~1e-4 rad, the far vertex within 1e-6 of the longest
+/// edge off the plane) and — unless the pair is exactly a convex quad — get the same patch and
+/// element steps, so the lattice points on their common edge coincide bit for bit.
+fn group_mesh_faces(m: &PolygonMesh, params: &MeshParams) -> Vec<Vec<u32>> {
+    let faces = m.faces();
+    let polys = m.polygons();
+    let is_tri = |f: usize| faces[f].len() == 3;
+    // Edge → the (up to two) triangles using it, and how many faces use it at all.
+    let mut edges: HashMap<(u32, u32), (u32, u32, u32)> = HashMap::new();
+    for (f, face) in faces.iter().enumerate() {
+        for k in 0..face.len() {
+            let (a, b) = (face[k], face[(k + 1) % face.len()]);
+            let e = edges.entry((a.min(b), a.max(b))).or_insert((u32::MAX, u32::MAX, 0));
+            if is_tri(f) {
+                if e.0 == u32::MAX {
+                    e.0 = f as u32;
+                } else if e.1 == u32::MAX {
+                    e.1 = f as u32;
+                }
+            }
+            e.2 += 1;
+        }
+    }
+    let coplanar = |a: usize, b: usize| {
+        let (pa, pb) = (&polys[a], &polys[b]);
+        if pa.normal().dot(pb.normal()) < 1.0 - 5e-9 {
+            return false;
+        }
+        let v = pa.vertices();
+        let longest = (0..3).map(|k| v[k].distance(v[(k + 1) % 3])).fold(0.0, f64::max);
+        pb.vertices().iter().all(|p| (*p - v[0]).dot(pa.normal()).abs() <= 1e-6 * longest)
+    };
+    let steps = |f: usize| {
+        let v = polys[f].vertices();
+        triangle_steps(&[v[0], v[1], v[2]], params)
+    };
+    let mut pairs: Vec<(u32, u32)> = edges
+        .values()
+        .filter(|&&(a, b, count)| count == 2 && b != u32::MAX && coplanar(a as usize, b as usize))
+        .map(|&(a, b, _)| (a.min(b), a.max(b)))
+        .collect();
+    // HashMap order is arbitrary; sorting keeps the grouping (and so the mesh) deterministic.
+    pairs.sort_unstable();
+    // First pass: every coplanar edge-connected set. A set of exactly two triangles is kept
+    // whole (it becomes a quad when convex); larger sets are split where the steps differ.
+    let mut all = UnionFind((0..faces.len() as u32).collect());
+    for &(a, b) in &pairs {
+        all.union(a, b);
+    }
+    let mut size = vec![0u32; faces.len()];
+    for f in 0..faces.len() as u32 {
+        let r = all.find(f);
+        size[r as usize] += 1;
+    }
+    let mut same_steps = UnionFind((0..faces.len() as u32).collect());
+    for &(a, b) in &pairs {
+        let pair_only = size[all.find(a) as usize] == 2;
+        if pair_only || steps(a as usize) == steps(b as usize) {
+            same_steps.union(a, b);
+        }
+    }
+    let mut group_of: HashMap<u32, usize> = HashMap::new();
+    let mut groups: Vec<Vec<u32>> = Vec::new();
+    for f in 0..faces.len() as u32 {
+        let r = same_steps.find(f);
+        let g = *group_of.entry(r).or_insert_with(|| {
+            groups.push(Vec::new());
+            groups.len() - 1
+        });
+        groups[g].push(f);
+    }
+    groups
+}
+
+/// The quad formed by two triangles sharing an edge, when it is planar and convex.
+fn pair_as_quad(m: &PolygonMesh, a: usize, b: usize) -> Option<Polygon> {
+    let (fa, fb) = (&m.faces()[a], &m.faces()[b]);
+    // Rotate `a` so that its edge k→k+1 is the one `b` shares (b runs it the other way).
+    for k in 0..3 {
+        let (u, v) = (fa[k], fa[(k + 1) % 3]);
+        if let Some(j) = (0..3).find(|&j| fb[j] == v && fb[(j + 1) % 3] == u) {
+            let w = fb[(j + 2) % 3];
+            let x = fa[(k + 2) % 3];
+            let pts = [x, u, w, v].map(|i| m.positions()[i as usize]);
+            return Polygon::try_new(pts.to_vec()).ok();
+        }
+    }
+    None
+}
+
+/// Meshes a group of coplanar triangles into `b` with the same steps for all, placing lattice
+/// points on an edge from the edge's lower vertex index so both triangles on a shared edge
+/// compute the same bits and their vertices merge.
+fn mesh_triangle_group(b: &mut SurfaceBuilder, m: &PolygonMesh, group: &[u32], params: &MeshParams) {
+    let (mut np, mut ne) = (1, 1);
+    for &f in group {
+        let v = m.polygons()[f as usize].vertices();
+        let (p, e) = triangle_steps(&[v[0], v[1], v[2]], params);
+        np = np.max(p);
+        ne = ne.max(e);
+    }
+    let n = np * ne;
+    let pos = m.positions();
+    for &f in group {
+        let idx = &m.faces()[f as usize];
+        let normal = m.polygons()[f as usize].normal();
+        let t = [idx[0], idx[1], idx[2]];
+        let edge = |p: u32, q: u32, k: usize| {
+            // Point k of n from vertex p towards q, computed from the lower index.
+            let (a, c, k) = if p < q { (p, q, k) } else { (q, p, n - k) };
+            let (pa, pc) = (pos[a as usize], pos[c as usize]);
+            if k == 0 {
+                pa
+            } else if k == n {
+                pc
+            } else {
+                pa + (pc - pa) * (k as f64 / n as f64)
+            }
+        };
+        let at = |i: usize, j: usize| {
+            if j == 0 {
+                edge(t[0], t[1], i)
+            } else if i == 0 {
+                edge(t[0], t[2], j)
+            } else if i + j == n {
+                edge(t[1], t[2], j)
+            } else {
+                let [p0, p1, p2] = t.map(|i| pos[i as usize]);
+                p0 + (p1 - p0) * (i as f64 / n as f64) + (p2 - p0) * (j as f64 / n as f64)
+            }
+        };
+        mesh_triangle_lattice(b, &at, normal, np, ne);
+    }
+}
+
 fn estimate_polygon_elements(poly: &Polygon, params: &MeshParams) -> usize {
     let v = poly.vertices();
     let diameter = v.iter().flat_map(|a| v.iter().map(move |b| a.distance(*b))).fold(0.0, f64::max);
@@ -352,6 +536,7 @@ impl Mesh {
                     let k = divisions(std::f64::consts::PI * s.radius, params.element_size).max(6) as f64;
                     (k * k * 4.0).min(usize::MAX as f64) as usize
                 }
+                Shape::Mesh(m) => m.polygons().iter().map(|p| estimate_polygon_elements(p, params)).sum(),
             });
             if estimate > MAX_ELEMENTS {
                 return Err(too_many());
@@ -380,6 +565,28 @@ impl Mesh {
                         mesh.occluders.extend((1..pts.len() - 1).map(|i| [pts[0], pts[i], pts[i + 1]]));
                     }
                     mesh.push_surface(b, oi, o.material);
+                }
+                Shape::Mesh(m) => {
+                    for group in group_mesh_faces(m, params) {
+                        let mut b = SurfaceBuilder::default();
+                        let first = group[0] as usize;
+                        if m.faces()[first].len() > 3 {
+                            mesh_polygon(&mut b, &m.polygons()[first], params);
+                        } else if let [a, c] = group[..]
+                            && let Some(quad) = pair_as_quad(m, a as usize, c as usize)
+                        {
+                            // Two triangles that make a convex quad (how exporters write one
+                            // quad) are meshed as that quad, exactly as a quad polygon would be.
+                            mesh_polygon(&mut b, &quad, params);
+                        } else {
+                            mesh_triangle_group(&mut b, m, &group, params);
+                        }
+                        mesh.push_surface(b, oi, o.material);
+                    }
+                    for p in m.polygons() {
+                        let v = p.vertices();
+                        mesh.occluders.extend((1..v.len() - 1).map(|i| [v[0], v[i], v[i + 1]]));
+                    }
                 }
             }
         }
@@ -584,6 +791,106 @@ mod tests {
             }
             assert!(count.values().all(|&c| c == 2));
         }
+    }
+
+    /// A flat n×n grid of unit squares in z = 0, each cut into two triangles.
+    fn triangle_grid(n: u32) -> PolygonMesh {
+        let positions =
+            (0..=n).flat_map(|j| (0..=n).map(move |i| DVec3::new(i as f64, j as f64, 0.0))).collect();
+        let at = |i: u32, j: u32| j * (n + 1) + i;
+        let faces = (0..n)
+            .flat_map(|j| {
+                (0..n).flat_map(move |i| {
+                    [
+                        vec![at(i, j), at(i + 1, j), at(i + 1, j + 1)],
+                        vec![at(i, j), at(i + 1, j + 1), at(i, j + 1)],
+                    ]
+                })
+            })
+            .collect();
+        PolygonMesh::try_new(positions, faces).unwrap()
+    }
+
+    #[test]
+    fn coplanar_connected_triangles_form_one_surface_with_shared_vertices() {
+        let grid = triangle_grid(4);
+        let params = MeshParams::try_new(2.0, 1.0).unwrap();
+        let mesh = Mesh::build(&scene_of(Shape::Mesh(grid)), &params).unwrap();
+        assert_eq!(mesh.surfaces.len(), 1);
+        // Each triangle (longest edge √2) gets 2 element steps: 4 elements, 32 triangles.
+        assert_eq!(mesh.elements.len(), 128);
+        assert_eq!(mesh.positions.len(), 81);
+        // Shared exactly: every lattice point of the 9×9 grid once, none doubled along an edge.
+        let mut distinct: Vec<[u64; 3]> =
+            mesh.positions.iter().map(|p| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]).collect();
+        distinct.sort_unstable();
+        distinct.dedup();
+        assert_eq!(distinct.len(), mesh.positions.len());
+        // A disc: V − E + F = 1 only when every shared edge's points merged.
+        let mut edges = std::collections::HashSet::new();
+        for e in &mesh.elements {
+            let v = e.vertex_indices();
+            for k in 0..v.len() {
+                edges.insert((v[k].min(v[(k + 1) % v.len()]), v[k].max(v[(k + 1) % v.len()])));
+            }
+        }
+        assert_eq!(mesh.positions.len() as i64 - edges.len() as i64 + mesh.elements.len() as i64, 1);
+        check_mesh(&mesh, 16.0, &params);
+    }
+
+    #[test]
+    fn a_triangle_pair_making_a_quad_is_meshed_as_that_quad() {
+        let params = MeshParams::try_new(2.0, 0.5).unwrap();
+        let quad =
+            Polygon::try_new(vec![DVec3::ZERO, DVec3::X * 4.0, DVec3::new(4.0, 2.0, 0.0), DVec3::Y * 2.0])
+                .unwrap();
+        let as_polygon = Mesh::build(&scene_of(Shape::Polygons(vec![quad])), &params).unwrap();
+        let pair = PolygonMesh::try_new(
+            vec![DVec3::ZERO, DVec3::X * 4.0, DVec3::new(4.0, 2.0, 0.0), DVec3::Y * 2.0],
+            vec![vec![0, 1, 2], vec![0, 2, 3]],
+        )
+        .unwrap();
+        let as_pair = Mesh::build(&scene_of(Shape::Mesh(pair)), &params).unwrap();
+        assert_eq!(as_pair.elements.len(), as_polygon.elements.len());
+        assert_eq!(as_pair.patches.len(), as_polygon.patches.len());
+        let mut a: Vec<f64> = as_pair.elements.iter().map(|e| e.area).collect();
+        let mut b: Vec<f64> = as_polygon.elements.iter().map(|e| e.area).collect();
+        a.sort_by(f64::total_cmp);
+        b.sort_by(f64::total_cmp);
+        assert!(a.iter().zip(&b).all(|(x, y)| (x - y).abs() < 1e-9));
+        assert_eq!(as_pair.occluders.len(), 2);
+    }
+
+    #[test]
+    fn folded_or_differently_sized_triangles_stay_apart() {
+        // A cube as 12 triangles: six quads, never one surface across a fold.
+        let c = |x: u32, y: u32, z: u32| x + 2 * y + 4 * z;
+        let positions = (0..8).map(|k| DVec3::new((k & 1) as f64, ((k >> 1) & 1) as f64, (k >> 2) as f64));
+        let quads = [
+            [c(0, 0, 0), c(0, 1, 0), c(1, 1, 0), c(1, 0, 0)],
+            [c(0, 0, 1), c(1, 0, 1), c(1, 1, 1), c(0, 1, 1)],
+            [c(0, 0, 0), c(1, 0, 0), c(1, 0, 1), c(0, 0, 1)],
+            [c(0, 1, 0), c(0, 1, 1), c(1, 1, 1), c(1, 1, 0)],
+            [c(0, 0, 0), c(0, 0, 1), c(0, 1, 1), c(0, 1, 0)],
+            [c(1, 0, 0), c(1, 1, 0), c(1, 1, 1), c(1, 0, 1)],
+        ];
+        let faces = quads.iter().flat_map(|q| [vec![q[0], q[1], q[2]], vec![q[0], q[2], q[3]]]).collect();
+        let cube = PolygonMesh::try_new(positions.collect(), faces).unwrap();
+        let mesh =
+            Mesh::build(&scene_of(Shape::Mesh(cube)), &MeshParams::try_new(0.5, 0.25).unwrap()).unwrap();
+        assert_eq!(mesh.surfaces.len(), 6);
+        assert_eq!(mesh.positions.len(), 6 * 25, "each face the 5×5 lattice of a quad");
+        assert!((mesh.total_area() - 6.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn bad_mesh_faces_name_the_face() {
+        let p = vec![DVec3::ZERO, DVec3::X, DVec3::Y];
+        let e = PolygonMesh::try_new(p.clone(), vec![vec![0, 1, 2], vec![0, 1, 7]]).unwrap_err();
+        assert_eq!(e, SceneError::VertexIndexOutOfRange { face: 1, index: 7, count: 3 });
+        let e = PolygonMesh::try_new(p.clone(), vec![vec![0, 1, 1]]).unwrap_err();
+        assert!(e.to_string().starts_with("face 0: polygon is degenerate"), "{e}");
+        assert_eq!(PolygonMesh::try_new(p, vec![]).unwrap_err(), SceneError::EmptyMesh);
     }
 
     #[test]

@@ -114,6 +114,27 @@ pub enum SceneError {
         /// What is wrong.
         reason: String,
     },
+    /// A face of a polygon mesh refers to a vertex that does not exist.
+    #[error("face {face}: vertex index {index} out of range (the mesh has {count} vertices)")]
+    VertexIndexOutOfRange {
+        /// 0-based face number.
+        face: usize,
+        /// The offending 0-based vertex index.
+        index: usize,
+        /// Number of vertices in the mesh.
+        count: usize,
+    },
+    /// A face of a polygon mesh is not a valid polygon.
+    #[error("face {face}: {source}")]
+    BadMeshFace {
+        /// 0-based face number.
+        face: usize,
+        /// Why the face's polygon was rejected.
+        source: Box<SceneError>,
+    },
+    /// A polygon mesh has no faces.
+    #[error("the mesh has no faces")]
+    EmptyMesh,
 }
 
 /// A diffuse (Lambertian) material.
@@ -237,6 +258,68 @@ impl Polygon {
     }
 }
 
+/// An indexed mesh of planar convex faces (triangles or larger polygons), as read from a model
+/// file: vertices are shared by index, so faces that share an edge can be meshed into one
+/// surface (see `Mesh::build`) and shade smoothly across it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PolygonMesh {
+    positions: Vec<DVec3>,
+    faces: Vec<Vec<u32>>,
+    polygons: Vec<Polygon>,
+}
+
+impl PolygonMesh {
+    /// A validated mesh: every index in range, every face a valid polygon
+    /// ([`Polygon::try_new`]: 3+ vertices, finite, non-degenerate, planar, convex), counter-
+    /// clockwise seen from its lit side. Positions are kept as given (no welding): faces are
+    /// connected only where they use the same index.
+    ///
+    /// # Errors
+    /// [`SceneError::EmptyMesh`], [`SceneError::VertexIndexOutOfRange`], or
+    /// [`SceneError::BadMeshFace`] with the face number and the polygon's error.
+    pub fn try_new(positions: Vec<DVec3>, faces: Vec<Vec<u32>>) -> Result<Self, SceneError> {
+        if faces.is_empty() {
+            return Err(SceneError::EmptyMesh);
+        }
+        let mut polygons = Vec::with_capacity(faces.len());
+        for (face, f) in faces.iter().enumerate() {
+            let mut vertices = Vec::with_capacity(f.len());
+            for &i in f {
+                let p = positions.get(i as usize).ok_or(SceneError::VertexIndexOutOfRange {
+                    face,
+                    index: i as usize,
+                    count: positions.len(),
+                })?;
+                vertices.push(*p);
+            }
+            let polygon = Polygon::try_new(vertices)
+                .map_err(|e| SceneError::BadMeshFace { face, source: Box::new(e) })?;
+            polygons.push(polygon);
+        }
+        Ok(Self { positions, faces, polygons })
+    }
+
+    /// Vertex positions, scene units.
+    pub fn positions(&self) -> &[DVec3] {
+        &self.positions
+    }
+
+    /// Faces as vertex indices into [`PolygonMesh::positions`], counter-clockwise.
+    pub fn faces(&self) -> &[Vec<u32>] {
+        &self.faces
+    }
+
+    /// Faces as validated polygons (normal, area), in the order of [`PolygonMesh::faces`].
+    pub fn polygons(&self) -> &[Polygon] {
+        &self.polygons
+    }
+
+    /// Total area, scene units².
+    pub fn area(&self) -> f64 {
+        self.polygons.iter().map(Polygon::area).sum()
+    }
+}
+
 /// Which way the surface normals of a closed shape point.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Facing {
@@ -320,6 +403,8 @@ pub enum Shape {
     Polygons(Vec<Polygon>),
     /// A sphere.
     Sphere(Sphere),
+    /// An indexed mesh from a model file; coplanar faces that share edges become one surface.
+    Mesh(PolygonMesh),
 }
 
 /// A named object with one material.
@@ -468,6 +553,12 @@ impl Scene {
                     lo = lo.min(s.center - DVec3::splat(s.radius));
                     hi = hi.max(s.center + DVec3::splat(s.radius));
                 }
+                Shape::Mesh(m) => {
+                    for v in m.positions() {
+                        lo = lo.min(*v);
+                        hi = hi.max(*v);
+                    }
+                }
             }
         }
         (lo, hi)
@@ -505,6 +596,7 @@ impl Scene {
                 let area = match &o.shape {
                     Shape::Polygons(ps) => ps.iter().map(Polygon::area).sum(),
                     Shape::Sphere(s) => 4.0 * std::f64::consts::PI * s.radius * s.radius,
+                    Shape::Mesh(m) => m.area(),
                 };
                 self.materials[o.material].emission * area
             })
