@@ -146,6 +146,20 @@ impl BruteForce {
     }
 }
 
+impl BruteForce {
+    /// [`RayQuery::occluded`] against only the triangles at `indices` (indices into the slice
+    /// this was built from): the same ray and the same triangle test, so on a list that holds
+    /// every triangle the segment could meet the answer is the full query's answer.
+    ///
+    /// The solver gathers such lists once per shooter and receiving patch (shaft culling,
+    /// Haines & Wallace 1991) and tests a handful of triangles per ray instead of walking a
+    /// tree.
+    pub fn occluded_by(&self, from: Vec3, to: Vec3, indices: &[u32]) -> bool {
+        let ray = segment_ray(from, to);
+        indices.iter().any(|&i| self.triangles[i as usize].intersect(&ray).is_finite())
+    }
+}
+
 impl RayQuery for BruteForce {
     fn occluded(&self, from: Vec3, to: Vec3) -> bool {
         let ray = segment_ray(from, to);

@@ -73,9 +73,16 @@ pub fn point_to_polygon(p: DVec3, n: DVec3, polygon: &[DVec3]) -> f64 {
     if k < 3 {
         return 0.0;
     }
+    point_to_polygon_in_front(p, n, &clipped[..k])
+}
+
+/// [`point_to_polygon`] for a polygon known to lie wholly in front of the receiver's tangent
+/// plane, so the clipping can be skipped: the same sum in the same order, so the same bits.
+pub fn point_to_polygon_in_front(p: DVec3, n: DVec3, polygon: &[DVec3]) -> f64 {
+    let k = polygon.len();
     let mut sum = 0.0;
     for i in 0..k {
-        let (ra, rb) = (clipped[i] - p, clipped[(i + 1) % k] - p);
+        let (ra, rb) = (polygon[i] - p, polygon[(i + 1) % k] - p);
         let c = ra.cross(rb);
         let len = c.length();
         if len <= 1e-300 {

@@ -24,6 +24,7 @@
 pub mod form_factor;
 mod occluders;
 mod sampling;
+mod shaft;
 mod solution;
 mod solver;
 

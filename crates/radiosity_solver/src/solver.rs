@@ -20,9 +20,12 @@ use radiosity_core::{Mesh, Rgb};
 use rayon::prelude::*;
 use thiserror::Error;
 
-use crate::form_factor::{Rule, distance_to_polygon, for_each_point, point_to_point, point_to_polygon};
+use crate::form_factor::{
+    Rule, distance_to_polygon, for_each_point, point_to_point, point_to_polygon, point_to_polygon_in_front,
+};
 use crate::occluders::OccluderBoxes;
 use crate::sampling::{Rng, point_on, stratified};
+use crate::shaft::{Blockers, FEW, Pair, Visibility, bounds};
 use crate::solution::{Solution, vertex_average};
 
 /// How the form factor from a receiving element to a shooting patch is computed.
@@ -77,6 +80,11 @@ pub struct SolverParams {
     pub ambient: Ambient,
     /// Over-relaxation. Default off.
     pub overshoot: Overshoot,
+    /// Turns off every shortcut meant to change only the speed, not the answer: per-patch
+    /// shaft culling and candidate lists, and per-patch quadrature decisions. Each element
+    /// then takes the plain path (its own quadrature choice, rays through the caller's ray
+    /// structure). For tests that the shortcuts give the same answer. Default false.
+    pub reference_path: bool,
 }
 
 impl Default for SolverParams {
@@ -91,6 +99,7 @@ impl Default for SolverParams {
             seed: 0,
             ambient: Ambient::Off,
             overshoot: Overshoot::Off,
+            reference_path: false,
         }
     }
 }
@@ -216,6 +225,9 @@ pub struct Solver {
     mean_reflectance: Rgb,
     ray_offset: f64,
     occluder_boxes: OccluderBoxes,
+    blockers: Blockers,
+    /// Largest circumradius of the elements of each patch (about their centres).
+    patch_element_radius: Vec<f64>,
     shots: u64,
     rays: u64,
     elapsed: Duration,
@@ -224,8 +236,31 @@ pub struct Solver {
     shots_since_best: u64,
     stop: Option<StopReason>,
     // Per-shot scratch, kept to avoid allocating in the loop.
-    patch_live: Vec<bool>,
+    plans: Vec<PatchPlan>,
     factors: Vec<(f64, u32)>,
+    shooter_cdf: Vec<f64>,
+}
+
+/// What one shot decides once for a whole receiving patch, so its elements need not.
+#[derive(Clone, Debug)]
+struct PatchPlan {
+    /// Some part of the patch and of the shooter face each other.
+    live: bool,
+    /// Every element is far enough for the single-midpoint rule.
+    far: bool,
+    /// The patch lies strictly in front of the shooter's plane and the shooter strictly in
+    /// front of the patch's, so no receiver point needs hemisphere clipping.
+    facing: bool,
+    /// How its rays are answered.
+    visibility: Visibility,
+    /// The blocking triangles that may meet its rays, when `visibility` is `Few`.
+    candidates: Vec<u32>,
+}
+
+impl Default for PatchPlan {
+    fn default() -> Self {
+        Self { live: false, far: false, facing: false, visibility: Visibility::Tree, candidates: Vec::new() }
+    }
 }
 
 impl Solver {
@@ -273,12 +308,24 @@ impl Solver {
         let mean_reflectance =
             mesh.elements.iter().zip(&reflectance).map(|(el, r)| *r * el.area).sum::<Rgb>() / total_area;
         let (lo, hi) = mesh.bounds();
+        let patch_element_radius = mesh
+            .patches
+            .iter()
+            .map(|p| {
+                (p.elements.start..p.elements.end)
+                    .map(|e| element_radius(&mesh, e as usize))
+                    .fold(0.0, f64::max)
+            })
+            .collect();
         let mut s = Self {
             patch_unshot_power: vec![Rgb::ZERO; mesh.patches.len()],
-            patch_live: vec![false; mesh.patches.len()],
+            plans: vec![PatchPlan::default(); mesh.patches.len()],
+            shooter_cdf: Vec::new(),
             factors: vec![(0.0, 0); n],
             ray_offset: 1e-6 * (hi - lo).length(),
             occluder_boxes: OccluderBoxes::new(&mesh),
+            blockers: Blockers::new(&mesh),
+            patch_element_radius,
             mesh,
             accel,
             params,
@@ -451,30 +498,76 @@ impl Solver {
         let shot_b = self.patch_unshot_power[shooter] * (omega / patch.area);
         let corners = patch.corners();
 
-        // Cull whole receiving patches first: a patch receives only if part of it is in front
-        // of the shooter and part of the shooter is in front of it.
+        // Decide per receiving patch first. A patch receives only if part of it is in front
+        // of the shooter and part of the shooter is in front of it; then its shaft says which
+        // triangles can block its rays, and its distance whether all its elements may use
+        // one midpoint.
         let in_front =
             |pts: &[DVec3], c: DVec3, n: DVec3| pts.iter().any(|p| n.dot(*p - c) > 1e-12 * patch.area.sqrt());
-        self.patch_live.par_iter_mut().enumerate().for_each(|(q, live)| {
+        let (blockers, offset, reference) = (&self.blockers, self.ray_offset, self.params.reference_path);
+        let radius = &self.patch_element_radius;
+        self.plans.par_iter_mut().enumerate().for_each(|(q, plan)| {
             let r = &mesh.patches[q];
-            *live = q != shooter
+            plan.live = q != shooter
                 && in_front(r.corners(), patch.centre, patch.normal)
                 && in_front(corners, r.centre, r.normal);
+            if !plan.live || reference {
+                plan.far = false;
+                plan.facing = false;
+                plan.visibility = Visibility::Tree;
+                return;
+            }
+            // Each element's own test is 16·r_e < d(c_e) − r_e, and d(c_e) ≥ d(c_q) − r_q for
+            // every element centre c_e of the patch, so this implies it for all of them.
+            let patch_radius = r.corners().iter().map(|p| p.distance(r.centre)).fold(0.0, f64::max);
+            let strictly = |pts: &[DVec3], c: DVec3, n: DVec3| {
+                pts.iter().all(|p| n.dot(*p - c) > 1e-9 * patch.area.sqrt())
+            };
+            plan.facing = strictly(r.corners(), corners[0], patch.normal)
+                && strictly(corners, mesh.elements[r.elements.start as usize].centre, r.normal);
+            plan.far = 17.0 * radius[q] < distance_to_polygon(r.centre, patch.normal, corners) - patch_radius;
+            plan.visibility = blockers.gather(
+                Pair { a: corners, na: patch.normal, b: r.corners(), nb: r.normal, offset },
+                &mut plan.candidates,
+            );
         });
+
+        // Where on the shooter the light is: ray ends are drawn from its elements in proportion
+        // to their unshot power, so a patch lit on one part only (half under a block, half in
+        // a shadow) shoots from that part instead of spreading its power over the dark part,
+        // whose rays would be blocked and its light lost.
+        self.shooter_cdf.clear();
+        let mut acc = 0.0;
+        for e in patch.elements.start..patch.elements.end {
+            acc += (self.unshot[e as usize] * mesh.elements[e as usize].area).abs().sum();
+            self.shooter_cdf.push(acc);
+        }
+        if acc <= 0.0 || !acc.is_finite() {
+            self.shooter_cdf.clear();
+            for e in patch.elements.start..patch.elements.end {
+                acc += mesh.elements[e as usize].area;
+                self.shooter_cdf.push(acc);
+            }
+        }
+        for c in &mut self.shooter_cdf {
+            *c /= acc;
+        }
 
         let shot = Shot {
             mesh: &mesh,
             shooter: patch,
+            shooter_cdf: &self.shooter_cdf,
             accel: &*self.accel,
             boxes: &self.occluder_boxes,
+            blockers: &self.blockers,
             params: &self.params,
             offset: self.ray_offset,
             index: self.shots,
         };
-        let patch_live = &self.patch_live;
+        let plans = &self.plans;
         self.factors.par_iter_mut().enumerate().for_each(|(e, out)| {
-            let el = &mesh.elements[e];
-            *out = if patch_live[el.patch as usize] { receive(&shot, e) } else { (0.0, 0) };
+            let plan = &plans[mesh.elements[e].patch as usize];
+            *out = if plan.live { receive(&shot, plan, e) } else { (0.0, 0) };
         });
 
         // Apply sequentially in element order: the sums are the same for any thread count.
@@ -533,8 +626,11 @@ fn quadrature(el_radius: f64, gap: f64, max: u32) -> (u32, Rule) {
 struct Shot<'a> {
     mesh: &'a Mesh,
     shooter: &'a radiosity_core::Patch,
+    /// Cumulative share of the shooter's unshot power over its elements, ending at 1.
+    shooter_cdf: &'a [f64],
     accel: &'a dyn RayQuery,
     boxes: &'a OccluderBoxes,
+    blockers: &'a Blockers,
     params: &'a SolverParams,
     /// Ray origins and targets are lifted this far off their surfaces.
     offset: f64,
@@ -542,9 +638,32 @@ struct Shot<'a> {
     index: u64,
 }
 
+/// The point at `(u, v)` ∈ [0,1)² on the shooter, drawn by unshot power: `u` picks the
+/// element from the cumulative shares and, rescaled into that element's share, places the
+/// point within it with `v`, so stratification in `(u, v)` carries over.
+fn shooter_point(mesh: &Mesh, shooter: &radiosity_core::Patch, cdf: &[f64], u: f64, v: f64) -> DVec3 {
+    let k = cdf.partition_point(|&c| c <= u).min(cdf.len() - 1);
+    let below = if k == 0 { 0.0 } else { cdf[k - 1] };
+    let share = cdf[k] - below;
+    let u = if share > 0.0 { ((u - below) / share).clamp(0.0, 1.0 - f64::EPSILON) } else { 0.5 };
+    let e = shooter.elements.start as usize + k;
+    let mut pts = [DVec3::ZERO; 4];
+    let count = mesh.elements[e].vertex_count as usize;
+    for (slot, p) in pts.iter_mut().zip(mesh.element_corners(e)) {
+        *slot = p;
+    }
+    point_on(&pts[..count], u, v)
+}
+
+/// Circumradius of element `e` about its centre.
+fn element_radius(mesh: &Mesh, e: usize) -> f64 {
+    let c = mesh.elements[e].centre;
+    mesh.element_corners(e).map(|p| p.distance(c)).fold(0.0, f64::max)
+}
+
 /// Form factor F_{e→shooter} (with visibility) and the number of rays traced.
-fn receive(shot: &Shot, e: usize) -> (f64, u32) {
-    let Shot { mesh, shooter, accel, boxes, params, offset, index } = *shot;
+fn receive(shot: &Shot, plan: &PatchPlan, e: usize) -> (f64, u32) {
+    let Shot { mesh, shooter, shooter_cdf, accel, boxes, blockers, params, offset, index } = *shot;
     let el = &mesh.elements[e];
     let mut pts = [DVec3::ZERO; 4];
     for (k, p) in mesh.element_corners(e).enumerate() {
@@ -554,15 +673,25 @@ fn receive(shot: &Shot, e: usize) -> (f64, u32) {
     let corners = shooter.corners();
     let unoccluded = match params.form_factor {
         FormFactorMethod::Exact => {
-            let el_radius = receiver.iter().map(|p| p.distance(el.centre)).fold(0.0, f64::max);
-            let gap = distance_to_polygon(el.centre, shooter.normal, corners) - el_radius;
-            let (n, rule) = quadrature(el_radius, gap, params.max_quadrature);
+            let (n, rule) = if plan.far {
+                (1, Rule::Midpoint)
+            } else {
+                let el_radius = receiver.iter().map(|p| p.distance(el.centre)).fold(0.0, f64::max);
+                let gap = distance_to_polygon(el.centre, shooter.normal, corners) - el_radius;
+                quadrature(el_radius, gap, params.max_quadrature)
+            };
             let mut f = 0.0;
-            for_each_point(receiver, n, rule, |p, w| {
-                if shooter.normal.dot(p - corners[0]) > 0.0 {
-                    f += w * point_to_polygon(p, el.normal, corners);
-                }
-            });
+            if plan.facing {
+                for_each_point(receiver, n, rule, |p, w| {
+                    f += w * point_to_polygon_in_front(p, el.normal, corners)
+                });
+            } else {
+                for_each_point(receiver, n, rule, |p, w| {
+                    if shooter.normal.dot(p - corners[0]) > 0.0 {
+                        f += w * point_to_polygon(p, el.normal, corners);
+                    }
+                });
+            }
             f
         }
         FormFactorMethod::PointToPoint => {
@@ -574,15 +703,25 @@ fn receive(shot: &Shot, e: usize) -> (f64, u32) {
     }
     // Every segment between the element and the shooter lies in the box around both; when no
     // blocking triangle comes near that box the pair is fully visible and needs no ray.
-    let (lo, hi) = receiver
-        .iter()
-        .chain(corners)
-        .fold((DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)), |(a, b), p| {
-            (a.min(*p), b.max(*p))
-        });
-    if !boxes.may_block(lo, hi, 2.0 * offset) {
+    if plan.visibility == Visibility::Clear {
         return (unoccluded, 0);
     }
+    let few = plan.visibility == Visibility::Few;
+    let mut narrowed = [0u32; FEW];
+    let kept = if few {
+        blockers.narrow(
+            &plan.candidates,
+            Pair { a: corners, na: shooter.normal, b: receiver, nb: el.normal, offset },
+            &mut narrowed,
+        )
+    } else {
+        let (lo, hi) = bounds(receiver.iter().chain(corners));
+        usize::from(boxes.may_block(lo, hi, 2.0 * offset))
+    };
+    if kept == 0 {
+        return (unoccluded, 0);
+    }
+    let candidates = &narrowed[..kept];
     // Visibility: stratified jittered rays between the element and the shooter.
     let k = params.visibility_rays;
     let mut rng = Rng::for_task(params.seed, index, e as u64);
@@ -591,8 +730,10 @@ fn receive(shot: &Shot, e: usize) -> (f64, u32) {
         let (u, v) = stratified(i, k, &mut rng);
         let from = point_on(receiver, u, v) + el.normal * offset;
         let (u, v) = stratified(i, k, &mut rng);
-        let to = point_on(corners, u, v) + shooter.normal * offset;
-        if !accel.occluded(from.as_vec3(), to.as_vec3()) {
+        let to = shooter_point(mesh, shooter, shooter_cdf, u, v) + shooter.normal * offset;
+        let (from, to) = (from.as_vec3(), to.as_vec3());
+        let blocked = if few { blockers.occluded_by(from, to, candidates) } else { accel.occluded(from, to) };
+        if !blocked {
             visible += 1;
         }
     }
