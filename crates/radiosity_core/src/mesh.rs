@@ -457,7 +457,9 @@ fn pair_as_quad(m: &PolygonMesh, a: usize, b: usize) -> Option<Polygon> {
         if let Some(j) = (0..3).find(|&j| fb[j] == v && fb[(j + 1) % 3] == u) {
             let w = fb[(j + 2) % 3];
             let x = fa[(k + 2) % 3];
-            let pts = [x, u, w, v].map(|i| m.positions()[i as usize]);
+            // Start at `v`: for the usual fan split of a quad [0 1 2] [0 2 3] that is the quad's
+            // own first vertex, so the lattice (and element order) is the quad's exactly.
+            let pts = [v, x, u, w].map(|i| m.positions()[i as usize]);
             return Polygon::try_new(pts.to_vec()).ok();
         }
     }

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use crate::{LoadError, Scene, load_scene, parse_scene};
+use crate::{LoadError, LoadedScene, ModelFormat, Scene, load_scene_warned, parse_scene};
 
 /// Built-in scene names with the origin shown in messages and the embedded text.
 const FILES: &[(&str, &str, &str)] = &[
@@ -29,18 +29,27 @@ pub fn builtin_scene(name: &str) -> Option<Scene> {
 }
 
 /// A scene from a command-line argument: the file at `arg` when that is an existing file or
-/// `arg` ends in `.toml` (so a mistyped path says "cannot read", not "unknown scene"),
-/// otherwise the built-in scene of that name.
+/// `arg` ends in `.toml`, `.obj`, `.gltf` or `.glb` (so a mistyped path says "cannot read",
+/// not "unknown scene"), otherwise the built-in scene of that name.
 ///
 /// # Errors
 /// As [`load_scene`] for a path; [`LoadError::UnknownScene`], listing the built-ins, for
 /// any other name.
 pub fn resolve_scene(arg: &str) -> Result<Scene, LoadError> {
+    resolve_scene_warned(arg).map(|l| l.scene)
+}
+
+/// [`resolve_scene`] with the loader's warnings (model files: dropped faces, missing MTL).
+///
+/// # Errors
+/// As [`resolve_scene`]; [`LoadError::Model`] for a broken model file.
+pub fn resolve_scene_warned(arg: &str) -> Result<LoadedScene, LoadError> {
     let path = Path::new(arg);
-    if path.is_file() || arg.ends_with(".toml") {
-        return load_scene(path);
+    if path.is_file() || arg.ends_with(".toml") || ModelFormat::from_path(path).is_some() {
+        return load_scene_warned(path);
     }
     builtin_scene(arg)
+        .map(|scene| LoadedScene { scene, warnings: Vec::new() })
         .ok_or_else(|| LoadError::UnknownScene { name: arg.to_owned(), known: BUILTIN_SCENES.join(", ") })
 }
 

@@ -70,8 +70,9 @@ pub(crate) struct ObjectDesc {
     /// `polygon`, `polygons`, `box`, `sphere` or `mesh`.
     #[serde(rename = "type")]
     pub(crate) kind: Spanned<String>,
-    /// Name of a `[[material]]`.
-    pub(crate) material: Spanned<String>,
+    /// Name of a `[[material]]`; required except for `mesh`, where it overrides the file's
+    /// materials.
+    pub(crate) material: Option<Spanned<String>>,
     /// `polygon`: the vertices, counter-clockwise seen from the lit side.
     pub(crate) vertices: Option<Face>,
     /// `polygons`: several vertex lists.
@@ -88,10 +89,36 @@ pub(crate) struct ObjectDesc {
     pub(crate) center: Option<Point>,
     /// `sphere`: radius > 0.
     pub(crate) radius: Option<Spanned<f64>>,
-    /// `mesh`: OBJ or glTF file (not supported yet, but part of the format).
+    /// `mesh`: OBJ or glTF file, relative to the scene file's folder.
     pub(crate) file: Option<Spanned<String>>,
-    /// `mesh`: placement (not supported yet).
-    pub(crate) transform: Option<Spanned<toml::Value>>,
+    /// `mesh`: placement of the model.
+    pub(crate) transform: Option<Spanned<TransformDesc>>,
+}
+
+/// `transform = { … }` of a `mesh` object: scale, rotate about x, y, z, then translate.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct TransformDesc {
+    /// Offset, scene units; default 0.
+    pub(crate) translate: Option<Spanned<[f64; 3]>>,
+    /// One number or one per axis, each finite and ≠ 0; default 1.
+    pub(crate) scale: Option<Spanned<Scale>>,
+    /// Degrees about x; default 0.
+    pub(crate) rotate_x_deg: Option<Spanned<f64>>,
+    /// Degrees about y; default 0.
+    pub(crate) rotate_y_deg: Option<Spanned<f64>>,
+    /// Degrees about z; default 0.
+    pub(crate) rotate_z_deg: Option<Spanned<f64>>,
+}
+
+/// A uniform or per-axis scale.
+#[derive(Deserialize)]
+#[serde(untagged, expecting = "a number or [x, y, z]")]
+pub(crate) enum Scale {
+    /// The same factor on every axis.
+    Uniform(f64),
+    /// One factor per axis.
+    PerAxis([f64; 3]),
 }
 
 /// `[mesh]`.

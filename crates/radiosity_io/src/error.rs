@@ -31,6 +31,17 @@ pub enum LoadError {
         /// The system's reason.
         reason: String,
     },
+    /// Something wrong in a model file (OBJ, MTL, glTF): the file, the line when the format
+    /// has lines, and the element (face, vertex, material, accessor) with what was expected.
+    #[error("{origin}{}: {message}", .line.map_or_else(String::new, |l| format!(":{l}")))]
+    Model {
+        /// File name of the model (or its MTL).
+        origin: String,
+        /// 1-based line, for text formats.
+        line: Option<usize>,
+        /// What is wrong, naming the element.
+        message: String,
+    },
     /// The argument is neither an existing file nor a built-in scene name.
     #[error("'{name}' is neither a scene file nor a built-in scene (built-ins: {known})")]
     UnknownScene {

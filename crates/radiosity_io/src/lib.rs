@@ -24,11 +24,15 @@
 mod builtin;
 mod desc;
 mod error;
+mod gltf_in;
 mod locate;
+mod model;
+mod obj;
 mod scene_file;
 
-pub use builtin::{BUILTIN_SCENES, builtin_scene, resolve_scene};
+pub use builtin::{BUILTIN_SCENES, builtin_scene, resolve_scene, resolve_scene_warned};
 pub use error::LoadError;
-pub use scene_file::{load_scene, parse_scene};
+pub use model::{DEFAULT_GREY, Model, ModelFormat, ModelPart, Transform, load_model};
+pub use scene_file::{LoadedScene, load_scene, load_scene_warned, parse_scene, parse_scene_warned};
 
 use radiosity_core::Scene;

@@ -17,8 +17,11 @@ use radiosity_core::{
 use toml::Spanned;
 
 use crate::LoadError;
-use crate::desc::{CameraDesc, Face, MaterialDesc, MeshDesc, ObjectDesc, SceneDesc, SolverDesc};
+use crate::desc::{
+    CameraDesc, Face, MaterialDesc, MeshDesc, ObjectDesc, Scale, SceneDesc, SolverDesc, TransformDesc,
+};
 use crate::locate::Locator;
+use crate::model::{ModelFormat, Transform, load_model, model_error};
 
 /// Camera `up` when the file gives none.
 const DEFAULT_UP: [f64; 3] = [0.0, 1.0, 0.0];
@@ -39,9 +42,56 @@ fn all_finite(a: &[f64; 3]) -> bool {
 /// [`LoadError::Unreadable`] naming the file when it cannot be read as UTF-8 text; otherwise
 /// as [`parse_scene`], with the path as origin.
 pub fn load_scene(path: &Path) -> Result<Scene, LoadError> {
+    load_scene_warned(path).map(|l| l.scene)
+}
+
+/// A scene and what the loader dropped or defaulted on the way (degenerate faces of a model,
+/// a missing MTL file), one line each, for the user to read.
+#[derive(Clone, Debug)]
+pub struct LoadedScene {
+    /// The validated scene.
+    pub scene: Scene,
+    /// Warnings, each one line naming its file.
+    pub warnings: Vec<String>,
+}
+
+/// [`load_scene`] for a TOML scene file or a model file (`.obj`, `.gltf`, `.glb`, chosen by
+/// extension), with the loader's warnings.
+///
+/// A model file becomes a scene of its parts: named as in the file, the file's camera or none
+/// (the renderer frames the bounds), mesh sizes from the extent.
+///
+/// # Errors
+/// As [`load_scene`] for TOML; [`LoadError::Model`] for model files, and for a model without
+/// any emitting material.
+pub fn load_scene_warned(path: &Path) -> Result<LoadedScene, LoadError> {
+    if ModelFormat::from_path(path).is_some() {
+        return scene_from_model(path);
+    }
     let text = std::fs::read_to_string(path)
         .map_err(|e| LoadError::Unreadable { path: path.to_owned(), reason: e.to_string() })?;
-    parse_scene(&text, &path.display().to_string())
+    parse_scene_warned(&text, &path.display().to_string())
+}
+
+fn scene_from_model(path: &Path) -> Result<LoadedScene, LoadError> {
+    let origin = path.display().to_string();
+    let model = load_model(path, &Transform::default())?;
+    let objects = model.parts.into_iter().map(|p| Object {
+        name: p.name,
+        material: p.material,
+        shape: Shape::Mesh(p.mesh),
+    });
+    let name = path.file_stem().map_or_else(|| "model".to_owned(), |s| s.to_string_lossy().into_owned());
+    let scene = Scene::try_new(&name, model.camera, model.materials, objects.collect()).map_err(|e| {
+        let hint = match e {
+            SceneError::NoEmitter => {
+                "; give a material an emission (OBJ/MTL: `Ke r g b`; glTF: emissiveFactor) or place the model in a scene file with a light"
+            }
+            _ => "",
+        };
+        model_error(&origin, None, format!("{e}{hint}"))
+    })?;
+    Ok(LoadedScene { scene, warnings: model.warnings })
 }
 
 /// Parses and validates the text of a scene file; `origin` (usually the path) starts every
@@ -59,16 +109,30 @@ pub fn load_scene(path: &Path) -> Result<Scene, LoadError> {
 /// least one object and at least one light. TOML's `nan` and `inf` are rejected wherever a
 /// number is validated.
 pub fn parse_scene(text: &str, origin: &str) -> Result<Scene, LoadError> {
+    parse_scene_warned(text, origin).map(|l| l.scene)
+}
+
+/// [`parse_scene`] with the loader's warnings (from the model files of `mesh` objects, which
+/// are read relative to the folder of `origin`).
+///
+/// # Errors
+/// As [`parse_scene`]; [`LoadError::Model`] for a broken model file.
+pub fn parse_scene_warned(text: &str, origin: &str) -> Result<LoadedScene, LoadError> {
     let loc = Locator { origin, text };
     let desc: SceneDesc = toml::from_str(text).map_err(|e| loc.toml_error(&e))?;
 
-    let materials = materials(&loc, &desc.material)?;
-    let objects = desc
-        .object
-        .iter()
-        .enumerate()
-        .map(|(i, o)| object(&loc, i, o, &desc.material, &materials))
-        .collect::<Result<Vec<_>, _>>()?;
+    let mut materials = materials(&loc, &desc.material)?;
+    let declared = materials.len();
+    let mut objects = Vec::new();
+    let mut warnings = Vec::new();
+    for (i, o) in desc.object.iter().enumerate() {
+        if o.get_ref().kind.get_ref() == "mesh" {
+            let parts = mesh_object(&loc, i, o, &desc.material[..declared], &mut materials, &mut warnings)?;
+            objects.extend(parts);
+        } else {
+            objects.push(object(&loc, i, o, &desc.material, &materials[..declared])?);
+        }
+    }
     let camera = desc.camera.as_ref().map(|c| camera(&loc, c)).transpose()?;
     let mesh = desc.mesh.as_ref().map(|m| mesh_params(&loc, m)).transpose()?;
     let solver = desc.solver.as_ref().map(|s| solver_settings(&loc, s)).transpose()?.unwrap_or_default();
@@ -89,7 +153,7 @@ pub fn parse_scene(text: &str, origin: &str) -> Result<Scene, LoadError> {
             "object",
             format!("{e}; add at least one [[object]] (polygon, polygons, box or sphere)"),
         ),
-        SceneError::NoEmitter => match unused_light {
+        SceneError::NoEmitter => match unused_light.filter(|&i| i < declared) {
             Some(i) => {
                 let m = desc.material[i].get_ref();
                 let span = m.emission.as_ref().map_or_else(|| m.name.span(), Spanned::span);
@@ -107,7 +171,7 @@ pub fn parse_scene(text: &str, origin: &str) -> Result<Scene, LoadError> {
     })?;
     scene.mesh = mesh;
     scene.solver = solver;
-    Ok(scene)
+    Ok(LoadedScene { scene, warnings })
 }
 
 fn materials(loc: &Locator, descs: &[Spanned<MaterialDesc>]) -> Result<Vec<Material>, LoadError> {
@@ -233,52 +297,11 @@ fn object(
             ),
         ));
     };
-    if kind == "mesh" {
-        return Err(loc.at(
-            d.kind.span(),
-            format!("{key}.type"),
-            format!(
-                "object '{name}': object type 'mesh' (OBJ/glTF import) is not supported yet; \
-                 use polygon, polygons, box or sphere"
-            ),
-        ));
-    }
-    // A field of another type (a `radius` on a box) is an error, not silently ignored.
-    let present: [(&str, Option<Range<usize>>); 10] = [
-        ("vertices", d.vertices.as_ref().map(Spanned::span)),
-        ("faces", d.faces.as_ref().map(Spanned::span)),
-        ("min", d.min.as_ref().map(Spanned::span)),
-        ("max", d.max.as_ref().map(Spanned::span)),
-        ("normals", d.normals.as_ref().map(Spanned::span)),
-        ("rotate_y_deg", d.rotate_y_deg.as_ref().map(Spanned::span)),
-        ("center", d.center.as_ref().map(Spanned::span)),
-        ("radius", d.radius.as_ref().map(Spanned::span)),
-        ("file", d.file.as_ref().map(Spanned::span)),
-        ("transform", d.transform.as_ref().map(Spanned::span)),
-    ];
-    for (field, span) in present {
-        if let Some(span) = span
-            && !allowed.contains(&field)
-        {
-            return Err(loc.at(
-                span,
-                format!("{key}.{field}"),
-                format!("'{field}' does not apply to type '{kind}' (it takes: {})", allowed.join(", ")),
-            ));
-        }
-    }
-    let material = materials.iter().position(|m| m.name == *d.material.get_ref()).ok_or_else(|| {
-        let known = material_descs.iter().map(|m| m.get_ref().name.get_ref().as_str()).collect::<Vec<_>>();
-        let known = if known.is_empty() { "none".to_owned() } else { known.join(", ") };
-        loc.at(
-            d.material.span(),
-            format!("{key}.material"),
-            format!(
-                "object '{name}' uses material '{}', which is not defined (defined: {known})",
-                d.material.get_ref()
-            ),
-        )
-    })?;
+    check_fields(loc, &key, kind, allowed, d)?;
+    let Some(material_name) = d.material.as_ref() else {
+        return Err(loc.at(o.span(), format!("{key}.material"), format!("object '{name}' needs 'material'")));
+    };
+    let material = material_index(loc, &key, &name, material_name, material_descs, materials)?;
     let missing = |field: &str| {
         loc.at(
             o.span(),
@@ -346,9 +369,187 @@ fn object(
             })?;
             Shape::Sphere(s)
         }
-        _ => unreachable!("allowed_fields accepts only the types matched here"),
+        _ => unreachable!("mesh objects go through mesh_object; allowed_fields accepts only these types"),
     };
     Ok(Object { name, material, shape })
+}
+
+/// A field of another type (a `radius` on a box) is an error, not silently ignored.
+fn check_fields(
+    loc: &Locator,
+    key: &str,
+    kind: &str,
+    allowed: &[&str],
+    d: &ObjectDesc,
+) -> Result<(), LoadError> {
+    let present: [(&str, Option<Range<usize>>); 10] = [
+        ("vertices", d.vertices.as_ref().map(Spanned::span)),
+        ("faces", d.faces.as_ref().map(Spanned::span)),
+        ("min", d.min.as_ref().map(Spanned::span)),
+        ("max", d.max.as_ref().map(Spanned::span)),
+        ("normals", d.normals.as_ref().map(Spanned::span)),
+        ("rotate_y_deg", d.rotate_y_deg.as_ref().map(Spanned::span)),
+        ("center", d.center.as_ref().map(Spanned::span)),
+        ("radius", d.radius.as_ref().map(Spanned::span)),
+        ("file", d.file.as_ref().map(Spanned::span)),
+        ("transform", d.transform.as_ref().map(Spanned::span)),
+    ];
+    for (field, span) in present {
+        if let Some(span) = span
+            && !allowed.contains(&field)
+        {
+            return Err(loc.at(
+                span,
+                format!("{key}.{field}"),
+                format!("'{field}' does not apply to type '{kind}' (it takes: {})", allowed.join(", ")),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn material_index(
+    loc: &Locator,
+    key: &str,
+    name: &str,
+    material: &Spanned<String>,
+    material_descs: &[Spanned<MaterialDesc>],
+    materials: &[Material],
+) -> Result<usize, LoadError> {
+    materials.iter().position(|m| m.name == *material.get_ref()).ok_or_else(|| {
+        let known = material_descs.iter().map(|m| m.get_ref().name.get_ref().as_str()).collect::<Vec<_>>();
+        let known = if known.is_empty() { "none".to_owned() } else { known.join(", ") };
+        loc.at(
+            material.span(),
+            format!("{key}.material"),
+            format!(
+                "object '{name}' uses material '{}', which is not defined (defined: {known})",
+                material.get_ref()
+            ),
+        )
+    })
+}
+
+/// A finite number from a transform, or an error at its span.
+fn finite(loc: &Locator, key: &str, v: &Spanned<f64>) -> Result<f64, LoadError> {
+    let x = *v.get_ref();
+    if x.is_finite() {
+        Ok(x)
+    } else {
+        Err(loc.at(v.span(), key, format!("expected a finite number, got {x}")))
+    }
+}
+
+fn transform(loc: &Locator, key: &str, t: &Spanned<TransformDesc>) -> Result<Transform, LoadError> {
+    let d = t.get_ref();
+    let mut out = Transform::default();
+    if let Some(tr) = &d.translate {
+        if !all_finite(tr.get_ref()) {
+            return Err(loc.at(
+                tr.span(),
+                format!("{key}.translate"),
+                format!("expected finite numbers, got {:?}", tr.get_ref()),
+            ));
+        }
+        out.translate = *tr.get_ref();
+    }
+    if let Some(sc) = &d.scale {
+        let scale = match sc.get_ref() {
+            Scale::Uniform(s) => [*s; 3],
+            Scale::PerAxis(a) => *a,
+        };
+        if !scale.iter().all(|s| s.is_finite() && *s != 0.0) {
+            return Err(loc.at(
+                sc.span(),
+                format!("{key}.scale"),
+                format!("expected a finite number ≠ 0 or three of them, got {scale:?}"),
+            ));
+        }
+        out.scale = scale;
+    }
+    for (field, value, slot) in [
+        ("rotate_x_deg", &d.rotate_x_deg, &mut out.rotate_x_deg),
+        ("rotate_y_deg", &d.rotate_y_deg, &mut out.rotate_y_deg),
+        ("rotate_z_deg", &d.rotate_z_deg, &mut out.rotate_z_deg),
+    ] {
+        if let Some(v) = value {
+            *slot = finite(loc, &format!("{key}.{field}"), v)?;
+        }
+    }
+    Ok(out)
+}
+
+/// A `mesh` object: the model file's parts as objects named `object/part`, with the file's
+/// materials added as `object/material` (or every part in the object's `material`).
+fn mesh_object(
+    loc: &Locator,
+    i: usize,
+    o: &Spanned<ObjectDesc>,
+    material_descs: &[Spanned<MaterialDesc>],
+    materials: &mut Vec<Material>,
+    warnings: &mut Vec<String>,
+) -> Result<Vec<Object>, LoadError> {
+    let d = o.get_ref();
+    let name = d.name.get_ref().clone();
+    let key = format!("object[{i}]");
+    check_fields(loc, &key, "mesh", allowed_fields("mesh").unwrap_or(&[]), d)?;
+    let Some(file) = d.file.as_ref() else {
+        return Err(loc.at(
+            o.span(),
+            format!("{key}.file"),
+            format!("object '{name}' of type 'mesh' needs 'file'"),
+        ));
+    };
+    let override_material = d
+        .material
+        .as_ref()
+        .map(|m| material_index(loc, &key, &name, m, material_descs, &materials[..material_descs.len()]))
+        .transpose()?;
+    let transform = d
+        .transform
+        .as_ref()
+        .map(|t| transform(loc, &format!("{key}.transform"), t))
+        .transpose()?
+        .unwrap_or_default();
+    let folder = Path::new(loc.origin).parent().unwrap_or(Path::new(""));
+    let path = folder.join(file.get_ref());
+    if ModelFormat::from_path(&path).is_none() {
+        return Err(loc.at(
+            file.span(),
+            format!("{key}.file"),
+            format!("'{}' is not a model file; expected a .obj, .gltf or .glb file", file.get_ref()),
+        ));
+    }
+    if !path.is_file() {
+        return Err(loc.at(
+            file.span(),
+            format!("{key}.file"),
+            format!(
+                "cannot read '{}' ({}): no such file (paths are relative to the scene file's folder)",
+                file.get_ref(),
+                path.display()
+            ),
+        ));
+    }
+    let model = load_model(&path, &transform)?;
+    warnings.extend(model.warnings);
+    let first = materials.len();
+    if override_material.is_none() {
+        for m in &model.materials {
+            let mut m = m.clone();
+            m.name = format!("{name}/{}", m.name);
+            materials.push(m);
+        }
+    }
+    Ok(model
+        .parts
+        .into_iter()
+        .map(|p| Object {
+            name: format!("{name}/{}", p.name),
+            material: override_material.unwrap_or(first + p.material),
+            shape: Shape::Mesh(p.mesh),
+        })
+        .collect())
 }
 
 fn mesh_params(loc: &Locator, d: &MeshDesc) -> Result<MeshParams, LoadError> {

@@ -400,10 +400,25 @@ fn unknown_object_type() {
 }
 
 #[test]
-fn mesh_objects_are_not_supported_yet() {
+fn mesh_object_with_a_missing_file() {
     let from = "type = \"sphere\"\ncenter = [0.5, 0.3, 0.5]\nradius = 0.2";
     let to = "type = \"mesh\"\nfile = \"statue.obj\"\ntransform = { scale = 2.0 }";
-    check(from, to, "object[2].type", "object type 'mesh' (OBJ/glTF import) is not supported yet");
+    // The `file` line, just below `type`.
+    check_at(from, to, line_in_base(from) + 1, "object[2].file", "cannot read 'statue.obj'");
+}
+
+#[test]
+fn mesh_object_with_a_bad_transform() {
+    let from = "type = \"sphere\"\ncenter = [0.5, 0.3, 0.5]\nradius = 0.2";
+    let to = "type = \"mesh\"\nfile = \"statue.obj\"\ntransform = { scale = 0.0 }";
+    let line = line_in_base(from);
+    check_at(from, to, line + 2, "object[2].transform.scale", "expected a finite number ≠ 0");
+    let to = "type = \"mesh\"\nfile = \"statue.obj\"\ntransform = { spin = 1.0 }";
+    check_at(from, to, line + 2, "object[2].transform", "unknown field `spin`");
+    let to = "type = \"mesh\"\nfile = \"statue.png\"";
+    check_at(from, to, line + 1, "object[2].file", "not a model file");
+    let to = "type = \"mesh\"\nfile = \"statue.obj\"\nradius = 1.0";
+    check_at(from, to, line + 2, "object[2].radius", "'radius' does not apply to type 'mesh'");
 }
 
 #[test]

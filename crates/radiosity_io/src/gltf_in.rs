@@ -1,0 +1,345 @@
+//! glTF 2.0 (`.gltf` JSON or `.glb` binary) through the `gltf` crate.
+//!
+//! The crate's accessor readers trust the file (a float index accessor reaches an
+//! `unreachable!`, a zero count underflows, a short buffer view is sliced past its end), so
+//! every accessor is checked here against its buffer before it is read: a broken file is an
+//! error naming the mesh, primitive and accessor, never a panic.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use gltf::accessor::{DataType, Dimensions};
+use gltf::mesh::Mode;
+use radiosity_core::glam::{DMat4, DVec3};
+use radiosity_core::{Camera, Material, Rgb};
+
+use crate::LoadError;
+use crate::model::{
+    DEFAULT_GREY, Model, ModelPart, PartBuilder, Transform, model_error, model_material, unique_names,
+};
+
+/// Checks that `accessor` can be read as `dims` of one of `types` without leaving its buffer.
+fn check_accessor(
+    accessor: &gltf::Accessor,
+    dims: Dimensions,
+    types: &[DataType],
+    buffers: &[gltf::buffer::Data],
+) -> Result<(), String> {
+    let index = accessor.index();
+    if accessor.dimensions() != dims || !types.contains(&accessor.data_type()) {
+        return Err(format!(
+            "accessor {index}: expected {dims:?} of {types:?}, got {:?} of {:?}",
+            accessor.dimensions(),
+            accessor.data_type()
+        ));
+    }
+    if accessor.count() == 0 {
+        return Err(format!("accessor {index}: count is 0"));
+    }
+    if accessor.sparse().is_some() {
+        return Err(format!("accessor {index}: sparse accessors are not supported"));
+    }
+    let Some(view) = accessor.view() else {
+        return Err(format!("accessor {index}: has no buffer view"));
+    };
+    let size = accessor.size();
+    let stride = view.stride().unwrap_or(size);
+    if stride < size {
+        return Err(format!(
+            "accessor {index}: byte stride {stride} is smaller than an element ({size} bytes)"
+        ));
+    }
+    let end = (accessor.count() - 1)
+        .checked_mul(stride)
+        .and_then(|v| v.checked_add(size))
+        .and_then(|v| v.checked_add(accessor.offset()));
+    if end.is_none_or(|end| end > view.length()) {
+        return Err(format!(
+            "accessor {index}: {} elements from byte {} run past its buffer view ({} bytes)",
+            accessor.count(),
+            accessor.offset(),
+            view.length()
+        ));
+    }
+    let data_len = buffers.get(view.buffer().index()).map_or(0, |d| d.len());
+    if view.offset().checked_add(view.length()).is_none_or(|end| end > data_len) {
+        return Err(format!(
+            "buffer view {}: bytes {}..{} run past buffer {} ({data_len} bytes)",
+            view.index(),
+            view.offset(),
+            view.offset().saturating_add(view.length()),
+            view.buffer().index()
+        ));
+    }
+    Ok(())
+}
+
+/// Mean linear colour of an 8-bit sRGB image, or `None` for other pixel formats.
+fn mean_linear_colour(image: &gltf::image::Data) -> Option<[f64; 3]> {
+    use gltf::image::Format;
+    let channels = match image.format {
+        Format::R8G8B8 => 3,
+        Format::R8G8B8A8 => 4,
+        _ => return None,
+    };
+    let lut: Vec<f64> = (0..256).map(|v| radiosity_image::srgb_decode(v as f64 / 255.0)).collect();
+    let mut sum = [0.0; 3];
+    let mut n = 0usize;
+    for px in image.pixels.chunks_exact(channels) {
+        for c in 0..3 {
+            sum[c] += lut[px[c] as usize];
+        }
+        n += 1;
+    }
+    (n > 0).then(|| sum.map(|s| s / n as f64))
+}
+
+/// Parses glTF or GLB bytes; external buffers and images are read from `base`.
+///
+/// # Errors
+/// See [`crate::load_model`].
+pub(crate) fn parse_gltf(
+    bytes: &[u8],
+    origin: &str,
+    base: Option<&Path>,
+    transform: &Transform,
+) -> Result<Model, LoadError> {
+    let err = |message: String| model_error(origin, None, message);
+    let gltf::Gltf { document, blob } =
+        gltf::Gltf::from_slice(bytes).map_err(|e| err(format!("glTF: {e}")))?;
+    let buffers =
+        gltf::import_buffers(&document, base, blob).map_err(|e| err(format!("glTF buffers: {e}")))?;
+    let mut warnings = Vec::new();
+
+    // Base colour textures are averaged when their pixels can be read; otherwise the factor
+    // alone is used, with a warning.
+    let needs_images =
+        document.materials().any(|m| m.pbr_metallic_roughness().base_color_texture().is_some());
+    let images = if needs_images {
+        match gltf::import_images(&document, base, &buffers) {
+            Ok(images) => images,
+            Err(e) => {
+                warnings.push(format!("{origin}: textures not read ({e}); base colour factors used alone"));
+                Vec::new()
+            }
+        }
+    } else {
+        Vec::new()
+    };
+
+    let mut materials: Vec<Material> = Vec::new();
+    let mut material_of: HashMap<Option<usize>, usize> = HashMap::new();
+    let mut material_index = |m: gltf::Material, warnings: &mut Vec<String>| -> Result<usize, LoadError> {
+        if let Some(&i) = material_of.get(&m.index()) {
+            return Ok(i);
+        }
+        let material = match m.index() {
+            None => {
+                warnings.push(format!(
+                    "{origin}: primitives without a material are default grey ({DEFAULT_GREY}), not glTF's white (ρ = 1 never converges)"
+                ));
+                model_material(origin, None, "default", [DEFAULT_GREY; 3], [0.0; 3])?
+            }
+            Some(i) => {
+                let name = m.name().map_or_else(|| format!("material{i}"), str::to_owned);
+                let pbr = m.pbr_metallic_roughness();
+                let f = pbr.base_color_factor();
+                let mut reflectance = [f[0] as f64, f[1] as f64, f[2] as f64];
+                if let Some(tex) = pbr.base_color_texture() {
+                    match images.get(tex.texture().source().index()).and_then(mean_linear_colour) {
+                        Some(mean) => {
+                            for c in 0..3 {
+                                reflectance[c] *= mean[c];
+                            }
+                        }
+                        None if !images.is_empty() => warnings.push(format!(
+                            "{origin}: material '{name}': base colour texture format not averaged; factor used alone"
+                        )),
+                        None => {}
+                    }
+                }
+                let strength = m.emissive_strength().unwrap_or(1.0) as f64;
+                let emission = m.emissive_factor().map(|v| v as f64 * strength);
+                Material::try_new(&name, Rgb::from_array(reflectance), Rgb::from_array(emission))
+                    .map_err(|e| err(format!("material {i}: {e}")))?
+            }
+        };
+        let mut names: Vec<String> = materials.iter().map(|m| m.name.clone()).collect();
+        names.push(material.name.clone());
+        unique_names(&mut names);
+        let mut material = material;
+        material.name = names.pop().unwrap_or_default();
+        materials.push(material);
+        material_of.insert(m.index(), materials.len() - 1);
+        Ok(materials.len() - 1)
+    };
+
+    let scene = document.default_scene().or_else(|| document.scenes().next());
+    let roots: Vec<gltf::Node> = match &scene {
+        Some(s) => s.nodes().collect(),
+        // No scene: every node that is no one's child is a root.
+        None => {
+            let children: Vec<usize> =
+                document.nodes().flat_map(|n| n.children().map(|c| c.index())).collect();
+            document.nodes().filter(|n| !children.contains(&n.index())).collect()
+        }
+    };
+    let world_from_file = transform.matrix();
+    // A stack pops last first: roots (and children, below) go on reversed, so parts come in
+    // file order.
+    let mut stack: Vec<(gltf::Node, DMat4, usize)> =
+        roots.into_iter().rev().map(|n| (n, world_from_file, 0)).collect();
+    let mut parts = Vec::new();
+    let mut camera = None;
+    let mut dropped = 0usize;
+    let mut skipped_modes = 0usize;
+    let mut visits = 0usize;
+    let mut by_material = Vec::new();
+    while let Some((node, parent, depth)) = stack.pop() {
+        // A cycle in a malformed file would loop forever; glTF trees are finite and shallow.
+        visits += 1;
+        if depth > 256 || visits > 1_000_000 {
+            return Err(err(format!("node {}: the node hierarchy is cyclic or too deep", node.index())));
+        }
+        let local = node.transform().matrix().map(|c| c.map(|v| v as f64));
+        let world = parent * DMat4::from_cols_array_2d(&local);
+        if !world.is_finite() {
+            return Err(err(format!("node {}: transform is not finite", node.index())));
+        }
+        for child in node.children().collect::<Vec<_>>().into_iter().rev() {
+            stack.push((child, world, depth + 1));
+        }
+        if camera.is_none()
+            && let Some(cam) = node.camera()
+        {
+            match cam.projection() {
+                gltf::camera::Projection::Perspective(p) => {
+                    let position = world.transform_point3(DVec3::ZERO);
+                    let forward = world.transform_vector3(-DVec3::Z).normalize_or_zero();
+                    let up = world.transform_vector3(DVec3::Y);
+                    let fov = (p.yfov() as f64).to_degrees();
+                    match Camera::try_new(position, position + forward, up, fov) {
+                        Ok(c) => camera = Some(c),
+                        Err(e) => {
+                            warnings.push(format!("{origin}: camera of node {}: {e}; ignored", node.index()))
+                        }
+                    }
+                }
+                gltf::camera::Projection::Orthographic(_) => {
+                    warnings.push(format!("{origin}: orthographic camera of node {} ignored", node.index()));
+                }
+            }
+        }
+        let Some(mesh) = node.mesh() else { continue };
+        let node_name =
+            node.name().or(mesh.name()).map_or_else(|| format!("node{}", node.index()), str::to_owned);
+        let primitives: Vec<gltf::Primitive> = mesh.primitives().collect();
+        for prim in &primitives {
+            let what = format!("mesh {} ('{node_name}') primitive {}", mesh.index(), prim.index());
+            if !matches!(prim.mode(), Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan) {
+                skipped_modes += 1;
+                continue;
+            }
+            let Some(positions) = prim.get(&gltf::Semantic::Positions) else {
+                return Err(err(format!("{what}: no POSITION attribute")));
+            };
+            check_accessor(&positions, Dimensions::Vec3, &[DataType::F32], &buffers)
+                .map_err(|m| err(format!("{what}: POSITION {m}")))?;
+            if let Some(ind) = prim.indices() {
+                check_accessor(
+                    &ind,
+                    Dimensions::Scalar,
+                    &[DataType::U8, DataType::U16, DataType::U32],
+                    &buffers,
+                )
+                .map_err(|m| err(format!("{what}: indices {m}")))?;
+            }
+            let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+            let Some(points) = reader.read_positions() else {
+                return Err(err(format!("{what}: POSITION cannot be read")));
+            };
+            let mut b = PartBuilder::new(world);
+            let mut welded = Vec::new();
+            for (k, p) in points.enumerate() {
+                let v = b
+                    .vertex(DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64))
+                    .map_err(|m| err(format!("{what}: vertex {k}: {m}")))?;
+                welded.push(v);
+            }
+            let indices: Vec<u32> = match reader.read_indices() {
+                Some(ind) => ind.into_u32().collect(),
+                None => (0..welded.len() as u32).collect(),
+            };
+            let triangles: Vec<[u32; 3]> = match prim.mode() {
+                Mode::TriangleStrip => (2..indices.len())
+                    .map(|k| {
+                        // Every other triangle of a strip is wound the other way.
+                        if k % 2 == 0 {
+                            [indices[k - 2], indices[k - 1], indices[k]]
+                        } else {
+                            [indices[k - 1], indices[k - 2], indices[k]]
+                        }
+                    })
+                    .collect(),
+                Mode::TriangleFan => {
+                    (2..indices.len()).map(|k| [indices[0], indices[k - 1], indices[k]]).collect()
+                }
+                _ => {
+                    if !indices.len().is_multiple_of(3) {
+                        return Err(err(format!(
+                            "{what}: {} indices is not a whole number of triangles",
+                            indices.len()
+                        )));
+                    }
+                    indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect()
+                }
+            };
+            for (t, tri) in triangles.iter().enumerate() {
+                let mut face = Vec::with_capacity(3);
+                for &i in tri {
+                    let Some(&v) = welded.get(i as usize) else {
+                        return Err(err(format!(
+                            "{what}: triangle {t}: vertex index {i} out of range (POSITION has {} vertices)",
+                            welded.len()
+                        )));
+                    };
+                    face.push(v);
+                }
+                b.face(face);
+            }
+            dropped += b.dropped;
+            let material = material_index(prim.material(), &mut warnings)?;
+            // Several primitives of one node are told apart by material (named below, once
+            // the material list is complete).
+            let name = node_name.clone();
+            if b.is_empty() {
+                warnings.push(format!("{origin}: {what} has no triangle with an area; left out"));
+                continue;
+            }
+            let mesh = b.build().map_err(|m| err(format!("{what}: {m}")))?;
+            by_material.push(primitives.len() > 1);
+            parts.push(ModelPart { name, material, mesh });
+        }
+    }
+    if skipped_modes > 0 {
+        warnings.push(format!("{origin}: {skipped_modes} primitive(s) of points or lines left out"));
+    }
+    if dropped > 0 {
+        warnings.push(format!("{origin}: {dropped} degenerate triangle(s) (zero area) dropped"));
+    }
+    if parts.is_empty() {
+        return Err(err("no triangle with an area in the default scene".into()));
+    }
+    let mut names: Vec<String> = parts
+        .iter()
+        .zip(&by_material)
+        .map(
+            |(p, &by)| if by { format!("{}/{}", p.name, materials[p.material].name) } else { p.name.clone() },
+        )
+        .collect();
+    unique_names(&mut names);
+    for (p, n) in parts.iter_mut().zip(names) {
+        p.name = n;
+    }
+    Ok(Model { parts, materials, camera, warnings })
+}

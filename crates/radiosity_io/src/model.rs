@@ -1,0 +1,338 @@
+//! Model files in: OBJ + MTL (through `tobj`) and glTF 2.0 / GLB (through `gltf`), turned into
+//! named parts of validated [`PolygonMesh`]es with diffuse [`Material`]s.
+//!
+//! What is taken from the files:
+//! * OBJ/MTL: `Kd` → reflectance, `Ke` → emission (emitted radiosity, W per unit², the same
+//!   quantity as `emission` in a scene file). A missing MTL file or an unknown `usemtl` gives
+//!   the default grey (ρ = 0.5) and a warning. Vertex normals and texture coordinates are
+//!   ignored: facets are flat for the solve.
+//! * glTF: `baseColorFactor` (times the mean of the base colour texture, decoded from sRGB,
+//!   when the texture's pixels can be read) → reflectance; `emissiveFactor` ×
+//!   `KHR_materials_emissive_strength` → emission; node transforms; the first perspective
+//!   camera. A primitive without a material gets the default grey and a warning (the glTF
+//!   default, white ρ = 1, would never converge).
+//!
+//! Faces are kept as polygons when planar and convex (so an OBJ of quads meshes exactly like
+//! the same quads in a scene file), fan-split when convex but not planar, ear-clipped when
+//! concave. Positions equal to the bit after the transform are welded, so faces that an
+//! exporter split at texture seams still share edges (and so surfaces, see
+//! `radiosity_core::Mesh::build`). Degenerate faces are dropped with a warning count; an
+//! object left with no face is an error.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use radiosity_core::glam::{DMat4, DQuat, DVec3};
+use radiosity_core::{Camera, Material, Polygon, PolygonMesh, Rgb, SceneError};
+
+use crate::LoadError;
+use crate::locate::one_line;
+
+/// Reflectance given to faces whose material is missing or unknown.
+pub const DEFAULT_GREY: f64 = 0.5;
+
+/// Placement of a model in a scene: scale, then rotations about x, y, z (degrees, right-
+/// handed), then translation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Transform {
+    /// Offset added last, scene units.
+    pub translate: [f64; 3],
+    /// Scale per axis (a uniform scale repeats one number); a negative product mirrors the
+    /// model, and its faces are turned round so they still face the same way.
+    pub scale: [f64; 3],
+    /// Rotation about the x axis, degrees.
+    pub rotate_x_deg: f64,
+    /// Rotation about the y (vertical) axis, degrees.
+    pub rotate_y_deg: f64,
+    /// Rotation about the z axis, degrees.
+    pub rotate_z_deg: f64,
+}
+
+impl Default for Transform {
+    fn default() -> Self {
+        Self { translate: [0.0; 3], scale: [1.0; 3], rotate_x_deg: 0.0, rotate_y_deg: 0.0, rotate_z_deg: 0.0 }
+    }
+}
+
+impl Transform {
+    /// The matrix `world_from_model`.
+    pub fn matrix(&self) -> DMat4 {
+        let rotation = DQuat::from_rotation_z(self.rotate_z_deg.to_radians())
+            * DQuat::from_rotation_y(self.rotate_y_deg.to_radians())
+            * DQuat::from_rotation_x(self.rotate_x_deg.to_radians());
+        DMat4::from_scale_rotation_translation(
+            DVec3::from_array(self.scale),
+            rotation,
+            DVec3::from_array(self.translate),
+        )
+    }
+}
+
+/// One named part of a model with one material.
+#[derive(Clone, Debug)]
+pub struct ModelPart {
+    /// OBJ `o`/`g` name or glTF node/mesh name (with the material's name appended when a
+    /// part uses several materials).
+    pub name: String,
+    /// Index into [`Model::materials`].
+    pub material: usize,
+    /// The geometry, in world units (transform applied).
+    pub mesh: PolygonMesh,
+}
+
+/// A model file read and validated.
+#[derive(Clone, Debug)]
+pub struct Model {
+    /// Parts in file order.
+    pub parts: Vec<ModelPart>,
+    /// Materials used by the parts, names unique.
+    pub materials: Vec<Material>,
+    /// The file's camera (glTF only), transformed.
+    pub camera: Option<Camera>,
+    /// Things dropped or defaulted, one line each, for the user.
+    pub warnings: Vec<String>,
+}
+
+/// Which importer a file name asks for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ModelFormat {
+    /// Wavefront OBJ (materials from the MTL files it names).
+    Obj,
+    /// glTF 2.0, JSON (`.gltf`) or binary (`.glb`).
+    Gltf,
+}
+
+impl ModelFormat {
+    /// The format for a path's extension (case-insensitive), or `None` for another file.
+    pub fn from_path(path: &Path) -> Option<Self> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "obj" => Some(Self::Obj),
+            "gltf" | "glb" => Some(Self::Gltf),
+            _ => None,
+        }
+    }
+}
+
+/// Reads the model at `path` with `transform` applied.
+///
+/// # Errors
+/// [`LoadError::Model`], one line naming the file (and line, for OBJ/MTL) and the element:
+/// unreadable or malformed files, indices out of range, non-finite coordinates, reflectance
+/// outside [0, 1), negative emission, or no face left after dropping degenerate ones.
+pub fn load_model(path: &Path, transform: &Transform) -> Result<Model, LoadError> {
+    let origin = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|e| LoadError::Model {
+        origin: origin.clone(),
+        line: None,
+        message: format!("cannot read the model file: {e}"),
+    })?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    match ModelFormat::from_path(path) {
+        Some(ModelFormat::Obj) => crate::obj::parse_obj(&bytes, &origin, Some(base), transform),
+        Some(ModelFormat::Gltf) => crate::gltf_in::parse_gltf(&bytes, &origin, Some(base), transform),
+        None => Err(LoadError::Model {
+            origin,
+            line: None,
+            message: "unknown model format; expected a .obj, .gltf or .glb file".into(),
+        }),
+    }
+}
+
+/// A model error at `origin` (and `line`, when known).
+pub(crate) fn model_error(origin: &str, line: Option<usize>, message: impl Into<String>) -> LoadError {
+    LoadError::Model { origin: one_line(origin), line, message: one_line(&message.into()) }
+}
+
+/// A validated material from a model file, with the file named in the error.
+pub(crate) fn model_material(
+    origin: &str,
+    line: Option<usize>,
+    name: &str,
+    reflectance: [f64; 3],
+    emission: [f64; 3],
+) -> Result<Material, LoadError> {
+    Material::try_new(name, Rgb::from_array(reflectance), Rgb::from_array(emission))
+        .map_err(|e| model_error(origin, line, e.to_string()))
+}
+
+/// Collects the faces of one part: welds positions, drops degenerate faces (counted), and
+/// splits faces that are not planar convex polygons.
+pub(crate) struct PartBuilder {
+    world_from_model: DMat4,
+    mirrored: bool,
+    positions: Vec<DVec3>,
+    index_of: HashMap<[u64; 3], u32>,
+    faces: Vec<Vec<u32>>,
+    /// Faces dropped because they had no area.
+    pub(crate) dropped: usize,
+}
+
+impl PartBuilder {
+    /// A builder placing points with `world_from_model`.
+    pub(crate) fn new(world_from_model: DMat4) -> Self {
+        Self {
+            world_from_model,
+            mirrored: world_from_model.determinant() < 0.0,
+            positions: Vec::new(),
+            index_of: HashMap::new(),
+            faces: Vec::new(),
+            dropped: 0,
+        }
+    }
+
+    /// The welded index of model-space point `p`.
+    ///
+    /// # Errors
+    /// The message for a non-finite point (before or after the transform).
+    pub(crate) fn vertex(&mut self, p: DVec3) -> Result<u32, String> {
+        let w = self.world_from_model.transform_point3(p);
+        if !p.is_finite() || !w.is_finite() {
+            return Err(format!("coordinates must be finite numbers, got {:?}", p.to_array()));
+        }
+        // -0.0 and 0.0 are one point.
+        let w = w + DVec3::ZERO;
+        let key = [w.x.to_bits(), w.y.to_bits(), w.z.to_bits()];
+        let next = self.positions.len() as u32;
+        Ok(*self.index_of.entry(key).or_insert_with(|| {
+            self.positions.push(w);
+            next
+        }))
+    }
+
+    /// Adds a face of welded indices, counter-clockwise in model space.
+    pub(crate) fn face(&mut self, mut f: Vec<u32>) {
+        if self.mirrored {
+            f.reverse();
+        }
+        // Consecutive repeats (welded points) carry no area.
+        f.dedup();
+        while f.len() > 1 && f.first() == f.last() {
+            f.pop();
+        }
+        if f.len() < 3 {
+            self.dropped += 1;
+            return;
+        }
+        let pts: Vec<DVec3> = f.iter().map(|&i| self.positions[i as usize]).collect();
+        match Polygon::try_new(pts.clone()) {
+            Ok(_) => self.faces.push(f),
+            Err(SceneError::NonPlanarPolygon { .. }) => {
+                // Convex but bent: a fan keeps every triangle inside the outline.
+                for k in 1..f.len() - 1 {
+                    self.triangle([f[0], f[k], f[k + 1]]);
+                }
+            }
+            Err(SceneError::NonConvexPolygon { .. }) => {
+                for t in ear_clip(&pts) {
+                    self.triangle(t.map(|k| f[k]));
+                }
+            }
+            Err(_) => self.dropped += 1,
+        }
+    }
+
+    fn triangle(&mut self, t: [u32; 3]) {
+        let pts = t.map(|i| self.positions[i as usize]).to_vec();
+        if Polygon::try_new(pts).is_ok() {
+            self.faces.push(t.to_vec());
+        } else {
+            self.dropped += 1;
+        }
+    }
+
+    /// True when no face was kept.
+    pub(crate) fn is_empty(&self) -> bool {
+        self.faces.is_empty()
+    }
+
+    /// The validated mesh.
+    ///
+    /// # Errors
+    /// The core's message (cannot happen for faces that passed [`PartBuilder::face`], kept
+    /// as an error rather than a panic).
+    pub(crate) fn build(self) -> Result<PolygonMesh, String> {
+        PolygonMesh::try_new(self.positions, self.faces).map_err(|e| e.to_string())
+    }
+}
+
+/// Triangles (as indices into `pts`) of a simple planar polygon, by ear clipping in the plane
+/// of its Newell normal. A polygon that is not simple gives what ears it can; the rest is left
+/// out (and counted by the caller as dropped area only through missing triangles).
+fn ear_clip(pts: &[DVec3]) -> Vec<[usize; 3]> {
+    let mut n = DVec3::ZERO;
+    for (i, &a) in pts.iter().enumerate() {
+        n += a.cross(pts[(i + 1) % pts.len()]);
+    }
+    let n = n.normalize_or_zero();
+    let mut idx: Vec<usize> = (0..pts.len()).collect();
+    let mut out = Vec::new();
+    let convex = |a: DVec3, b: DVec3, c: DVec3| (b - a).cross(c - b).dot(n) > 0.0;
+    let inside = |p: DVec3, a: DVec3, b: DVec3, c: DVec3| {
+        (b - a).cross(p - a).dot(n) >= 0.0
+            && (c - b).cross(p - b).dot(n) >= 0.0
+            && (a - c).cross(p - c).dot(n) >= 0.0
+    };
+    let mut guard = 0;
+    while idx.len() > 3 && guard < pts.len() * pts.len() {
+        guard += 1;
+        let k = idx.len();
+        let ear = (0..k).find(|&i| {
+            let (a, b, c) = (idx[(i + k - 1) % k], idx[i], idx[(i + 1) % k]);
+            convex(pts[a], pts[b], pts[c])
+                && idx.iter().all(|&j| j == a || j == b || j == c || !inside(pts[j], pts[a], pts[b], pts[c]))
+        });
+        let Some(i) = ear else { break };
+        out.push([idx[(i + k - 1) % k], idx[i], idx[(i + 1) % k]]);
+        idx.remove(i);
+    }
+    if idx.len() == 3 {
+        out.push([idx[0], idx[1], idx[2]]);
+    }
+    out
+}
+
+/// Names made unique by appending `#2`, `#3`, … to repeats, in order.
+pub(crate) fn unique_names(names: &mut [String]) {
+    let mut seen: HashMap<String, usize> = HashMap::new();
+    for name in names.iter_mut() {
+        let count = seen.entry(name.clone()).or_insert(0);
+        *count += 1;
+        if *count > 1 {
+            *name = format!("{name}#{count}");
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ear_clipping_splits_an_l_shape_into_four_triangles_of_its_area() {
+        let l = [(0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (1.0, 1.0), (1.0, 2.0), (0.0, 2.0)]
+            .map(|(x, y)| DVec3::new(x, y, 0.0));
+        let tris = ear_clip(&l);
+        assert_eq!(tris.len(), 4);
+        let area: f64 = tris.iter().map(|t| 0.5 * (l[t[1]] - l[t[0]]).cross(l[t[2]] - l[t[0]]).z).sum();
+        assert!((area - 3.0).abs() < 1e-12, "{area}");
+    }
+
+    #[test]
+    fn a_mirroring_transform_keeps_faces_facing_out() {
+        let t = Transform { scale: [-1.0, 1.0, 1.0], ..Transform::default() };
+        let mut b = PartBuilder::new(t.matrix());
+        let f = [DVec3::ZERO, DVec3::X, DVec3::Y].map(|p| b.vertex(p).unwrap()).to_vec();
+        b.face(f);
+        let m = b.build().unwrap();
+        assert!((m.polygons()[0].normal() - DVec3::Z).length() < 1e-12);
+    }
+
+    #[test]
+    fn rotations_apply_x_then_y_then_z() {
+        let t = Transform { rotate_x_deg: 90.0, rotate_z_deg: 90.0, ..Transform::default() };
+        // y → z under x, z stays under z.
+        let p = t.matrix().transform_point3(DVec3::Y);
+        assert!((p - DVec3::Z).length() < 1e-12, "{p}");
+    }
+}

@@ -1,0 +1,356 @@
+//! Wavefront OBJ + MTL through `tobj`, after a line scan of our own: `tobj` reports *what* is
+//! wrong but not *where*, and a user with a 100k-line file needs the line. The scan checks
+//! what `tobj` would reject or accept badly (vertex lines that are not finite numbers, face
+//! indices out of range, faces of fewer than 3 vertices) and records each face's line.
+
+use std::cell::RefCell;
+use std::collections::HashMap;
+use std::io::Cursor;
+use std::path::Path;
+
+use radiosity_core::glam::DVec3;
+
+use crate::LoadError;
+use crate::model::{
+    DEFAULT_GREY, Model, ModelPart, PartBuilder, Transform, model_error, model_material, unique_names,
+};
+
+/// What the line scan learns: the line of every face, in file order.
+struct Scan {
+    face_lines: Vec<usize>,
+}
+
+/// Checks `v` and `f` lines; the first problem is an error naming its line and element.
+fn scan(text: &str, origin: &str) -> Result<Scan, LoadError> {
+    let mut vertices = 0usize;
+    let mut face_lines = Vec::new();
+    for (l, line) in text.lines().enumerate() {
+        let line_no = l + 1;
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => {
+                vertices += 1;
+                let numbers: Vec<&str> = words.take(3).collect();
+                let values: Vec<Option<f64>> = numbers.iter().map(|w| w.parse::<f64>().ok()).collect();
+                if values.len() < 3 || values.iter().any(Option::is_none) {
+                    return Err(model_error(
+                        origin,
+                        Some(line_no),
+                        format!("vertex {vertices}: expected 3 numbers x y z, got '{}'", line.trim()),
+                    ));
+                }
+                let p: Vec<f64> = values.into_iter().flatten().collect();
+                if p.iter().any(|v| !v.is_finite()) {
+                    return Err(model_error(
+                        origin,
+                        Some(line_no),
+                        format!("vertex {vertices}: coordinates must be finite numbers, got {p:?}"),
+                    ));
+                }
+            }
+            Some("f") => {
+                let face = face_lines.len() + 1;
+                let corners: Vec<&str> = words.collect();
+                if corners.len() < 3 {
+                    return Err(model_error(
+                        origin,
+                        Some(line_no),
+                        format!("face {face}: a face needs at least 3 vertices, got {}", corners.len()),
+                    ));
+                }
+                for c in corners {
+                    let first = c.split('/').next().unwrap_or("");
+                    let Ok(i) = first.parse::<i64>() else {
+                        return Err(model_error(
+                            origin,
+                            Some(line_no),
+                            format!("face {face}: expected a vertex index, got '{c}'"),
+                        ));
+                    };
+                    // OBJ indices count from 1; negative ones count back from the last vertex.
+                    let resolved = if i < 0 { vertices as i64 + 1 + i } else { i };
+                    if resolved < 1 || resolved > vertices as i64 {
+                        return Err(model_error(
+                            origin,
+                            Some(line_no),
+                            format!(
+                                "face {face}: vertex index {i} out of range (file has {vertices} vertices)"
+                            ),
+                        ));
+                    }
+                }
+                face_lines.push(line_no);
+            }
+            _ => {}
+        }
+    }
+    Ok(Scan { face_lines })
+}
+
+/// Line of `key` within material `name` of an MTL text, for errors.
+fn mtl_line(text: &str, name: &str, key: &str) -> Option<usize> {
+    let mut in_material = false;
+    for (l, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("newmtl") => in_material = words.collect::<Vec<_>>().join(" ") == name,
+            Some(k) if in_material && k == key => return Some(l + 1),
+            _ => {}
+        }
+    }
+    None
+}
+
+/// Parses an OBJ file's bytes; MTL libraries are read from `base` (none: every face grey).
+///
+/// # Errors
+/// See [`crate::load_model`].
+pub(crate) fn parse_obj(
+    bytes: &[u8],
+    origin: &str,
+    base: Option<&Path>,
+    transform: &Transform,
+) -> Result<Model, LoadError> {
+    let text = std::str::from_utf8(bytes).map_err(|e| {
+        model_error(origin, None, format!("not a text file (invalid UTF-8 at byte {})", e.valid_up_to()))
+    })?;
+    let scan = scan(text, origin)?;
+    if scan.face_lines.is_empty() {
+        return Err(model_error(origin, None, "the file has no faces (`f` lines)"));
+    }
+    // MTL texts read by the loader, kept for error lines; and why a library could not be read.
+    let mtl_texts: RefCell<Vec<(String, String)>> = RefCell::new(Vec::new());
+    let mtl_problems: RefCell<Vec<String>> = RefCell::new(Vec::new());
+    let options = tobj::LoadOptions {
+        triangulate: false,
+        single_index: false,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    let loaded = tobj::load_obj_buf(&mut Cursor::new(bytes), &options, |p| {
+        let Some(base) = base else {
+            mtl_problems.borrow_mut().push(format!("'{}': no folder to read it from", p.display()));
+            return Err(tobj::LoadError::OpenFileFailed);
+        };
+        let path = base.join(p);
+        match std::fs::read(&path) {
+            Ok(mtl) => {
+                let result = tobj::load_mtl_buf(&mut Cursor::new(&mtl));
+                if let Err(e) = &result {
+                    mtl_problems.borrow_mut().push(format!("{}: {e}", path.display()));
+                }
+                mtl_texts
+                    .borrow_mut()
+                    .push((path.display().to_string(), String::from_utf8_lossy(&mtl).into()));
+                result
+            }
+            Err(e) => {
+                mtl_problems.borrow_mut().push(format!("{}: {e}", path.display()));
+                Err(tobj::LoadError::OpenFileFailed)
+            }
+        }
+    });
+    let (models, materials) = loaded.map_err(|e| model_error(origin, None, format!("OBJ: {e}")))?;
+    let mut warnings = Vec::new();
+    let materials = materials.unwrap_or_else(|_| Vec::new());
+    for p in mtl_problems.into_inner() {
+        warnings.push(format!(
+            "{origin}: cannot read material library {p}; its faces are default grey ({DEFAULT_GREY})"
+        ));
+    }
+    let mtl_texts = mtl_texts.into_inner();
+
+    // Our materials: those the parts use, in order of first use, plus the grey default.
+    let mut out_materials: Vec<radiosity_core::Material> = Vec::new();
+    let mut material_of: HashMap<Option<usize>, usize> = HashMap::new();
+    let mut resolve = |id: Option<usize>, warnings: &mut Vec<String>| -> Result<usize, LoadError> {
+        if let Some(&m) = material_of.get(&id) {
+            return Ok(m);
+        }
+        let material = match id.and_then(|i| materials.get(i)) {
+            Some(m) => {
+                let found =
+                    mtl_texts.iter().find_map(|(f, t)| mtl_line(t, &m.name, "newmtl").map(|_| (f, t)));
+                let (mtl_origin, line_of) = match found {
+                    Some((f, t)) => (f.as_str(), Some(t.as_str())),
+                    None => (origin, None),
+                };
+                let line = |key: &str| line_of.and_then(|t| mtl_line(t, &m.name, key));
+                let reflectance = m.diffuse.unwrap_or_else(|| {
+                    warnings.push(format!(
+                        "{mtl_origin}: material '{}' has no Kd; it is default grey ({DEFAULT_GREY})",
+                        m.name
+                    ));
+                    [DEFAULT_GREY; 3]
+                });
+                let emission = m.emissive.unwrap_or([0.0; 3]);
+                // Name the line of the value at fault: Kd unless only the emission is wrong.
+                let bad_kd = !reflectance.iter().all(|v| v.is_finite() && (0.0..1.0).contains(v));
+                let key_line = if bad_kd { line("Kd") } else { line("Ke") };
+                let key_line = if key_line.is_some() { key_line } else { line("newmtl") };
+                model_material(mtl_origin, key_line, &m.name, reflectance, emission)?
+            }
+            None => {
+                if let Some(i) = id {
+                    warnings.push(format!(
+                        "{origin}: material #{i} is not in any material library; its faces are default grey"
+                    ));
+                }
+                model_material(origin, None, "default", [DEFAULT_GREY; 3], [0.0; 3])?
+            }
+        };
+        let name = material.name.clone();
+        // Two MTL files may define the same name; the second one becomes `name#2`.
+        let mut names: Vec<String> = out_materials.iter().map(|m| m.name.clone()).collect();
+        names.push(name);
+        unique_names(&mut names);
+        let mut material = material;
+        material.name = names.pop().unwrap_or_default();
+        out_materials.push(material);
+        material_of.insert(id, out_materials.len() - 1);
+        Ok(out_materials.len() - 1)
+    };
+
+    let total_faces: usize = models
+        .iter()
+        .map(|m| {
+            if m.mesh.face_arities.is_empty() { m.mesh.indices.len() / 3 } else { m.mesh.face_arities.len() }
+        })
+        .sum();
+    // tobj keeps faces in file order; when the counts agree, face k of the file is line k.
+    let face_line =
+        |k: usize| (total_faces == scan.face_lines.len()).then(|| scan.face_lines.get(k).copied()).flatten();
+    let mut parts = Vec::new();
+    let mut dropped = 0usize;
+    let mut face_number = 0usize;
+    let stem =
+        Path::new(origin).file_stem().map_or_else(|| "model".into(), |s| s.to_string_lossy().into_owned());
+    for model in &models {
+        let mesh = &model.mesh;
+        let material = resolve(mesh.material_id, &mut warnings)?;
+        let mut b = PartBuilder::new(transform.matrix());
+        let mut welded = Vec::with_capacity(mesh.positions.len() / 3);
+        for (k, p) in mesh.positions.chunks_exact(3).enumerate() {
+            let v = b.vertex(DVec3::new(p[0], p[1], p[2])).map_err(|m| {
+                model_error(origin, None, format!("object '{}': vertex {}: {m}", model.name, k + 1))
+            })?;
+            welded.push(v);
+        }
+        let arities: Vec<usize> = if mesh.face_arities.is_empty() {
+            vec![3; mesh.indices.len() / 3]
+        } else {
+            mesh.face_arities.iter().map(|&a| a as usize).collect()
+        };
+        let mut start = 0;
+        for arity in arities {
+            face_number += 1;
+            let Some(ids) = mesh.indices.get(start..start + arity) else {
+                return Err(model_error(
+                    origin,
+                    face_line(face_number - 1),
+                    format!("face {face_number}: indices missing"),
+                ));
+            };
+            start += arity;
+            let mut face = Vec::with_capacity(arity);
+            for &i in ids {
+                let Some(&v) = welded.get(i as usize) else {
+                    return Err(model_error(
+                        origin,
+                        face_line(face_number - 1),
+                        format!(
+                            "face {face_number}: vertex index {} out of range (object has {} vertices)",
+                            i + 1,
+                            welded.len()
+                        ),
+                    ));
+                };
+                face.push(v);
+            }
+            b.face(face);
+        }
+        dropped += b.dropped;
+        let name = if model.name.is_empty() || model.name == "unnamed_object" {
+            stem.clone()
+        } else {
+            model.name.clone()
+        };
+        if b.is_empty() {
+            warnings.push(format!("{origin}: object '{name}' has no face with an area; left out"));
+            continue;
+        }
+        let mesh = b.build().map_err(|m| model_error(origin, None, format!("object '{name}': {m}")))?;
+        parts.push(ModelPart { name, material, mesh });
+    }
+    if dropped > 0 {
+        warnings.push(format!("{origin}: {dropped} degenerate face(s) (zero area) dropped"));
+    }
+    if parts.is_empty() {
+        return Err(model_error(origin, None, "no face with an area: every face is degenerate"));
+    }
+    // tobj starts a new model at each `usemtl`: parts named alike are told apart by material.
+    let mut counts: HashMap<&str, usize> = HashMap::new();
+    for p in &parts {
+        *counts.entry(p.name.as_str()).or_insert(0) += 1;
+    }
+    let mut names: Vec<String> = parts
+        .iter()
+        .map(|p| {
+            if counts[p.name.as_str()] > 1 {
+                format!("{}/{}", p.name, out_materials[p.material].name)
+            } else {
+                p.name.clone()
+            }
+        })
+        .collect();
+    unique_names(&mut names);
+    for (p, n) in parts.iter_mut().zip(names) {
+        p.name = n;
+    }
+    Ok(Model { parts, materials: out_materials, camera: None, warnings })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn err(text: &str) -> String {
+        parse_obj(text.as_bytes(), "m.obj", None, &Transform::default()).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn the_scan_names_line_face_and_index() {
+        let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 40\n";
+        assert_eq!(err(text), "m.obj:5: face 2: vertex index 40 out of range (file has 3 vertices)");
+        assert_eq!(
+            err("v 0 0 nan\n"),
+            "m.obj:1: vertex 1: coordinates must be finite numbers, got [0.0, 0.0, NaN]"
+        );
+        assert_eq!(err("v 0 0\n"), "m.obj:1: vertex 1: expected 3 numbers x y z, got 'v 0 0'");
+        assert_eq!(err("v 0 0 0\nf 1 1\n"), "m.obj:2: face 1: a face needs at least 3 vertices, got 2");
+        assert_eq!(err("v 0 0 0\nf 1 x 1\n"), "m.obj:2: face 1: expected a vertex index, got 'x'");
+        assert_eq!(err("v 0 0 0\n"), "m.obj: the file has no faces (`f` lines)");
+    }
+
+    #[test]
+    fn negative_indices_and_ngons_load_without_an_mtl() {
+        let text = "o quad\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf -4 -3 -2 -1\n";
+        let m = parse_obj(text.as_bytes(), "m.obj", None, &Transform::default()).unwrap();
+        assert_eq!(m.parts.len(), 1);
+        assert_eq!(m.parts[0].name, "quad");
+        assert_eq!(m.parts[0].mesh.faces()[0].len(), 4);
+        assert_eq!(m.materials[0].reflectance, radiosity_core::Rgb::splat(DEFAULT_GREY));
+    }
+
+    #[test]
+    fn degenerate_faces_are_dropped_and_counted() {
+        let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 3\nf 1 2 4\n";
+        let m = parse_obj(text.as_bytes(), "m.obj", None, &Transform::default()).unwrap();
+        assert_eq!(m.parts[0].mesh.faces().len(), 1);
+        assert!(m.warnings.iter().any(|w| w.contains("1 degenerate face(s)")), "{:?}", m.warnings);
+        assert_eq!(
+            err("v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n"),
+            "m.obj: no face with an area: every face is degenerate"
+        );
+    }
+}
