@@ -1,6 +1,7 @@
-//! `radiosity`: solve, render and view diffuse global illumination by progressive shooting.
+//! `radiosity`: solve, render, view and export diffuse global illumination by progressive shooting.
 
 mod bench_cmd;
+mod export_cmd;
 mod info_cmd;
 mod prepare;
 mod render_cmd;
@@ -33,6 +34,8 @@ enum Command {
     Tonemap(render_cmd::TonemapArgs),
     /// Open a window that solves the scene live while you fly through it.
     View(view_cmd::ViewArgs),
+    /// Solve a scene and write the lit mesh (glTF, GLB, PLY) with baked colours, and lightmaps.
+    Export(export_cmd::ExportArgs),
 }
 
 fn main() -> ExitCode {
@@ -44,6 +47,7 @@ fn main() -> ExitCode {
         Command::Render(a) => render_cmd::run(a),
         Command::Tonemap(a) => render_cmd::run_tonemap(a),
         Command::View(a) => view_cmd::run(a),
+        Command::Export(a) => export_cmd::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -114,7 +114,8 @@ pub struct Settings {
     pub solver_params: SolverParams,
 }
 
-/// Loads `scene_arg` (a path or a built-in name) and checks the options against it: the one
+/// Loads `scene_arg` (a scene file, a model file — `.obj`, `.gltf`, `.glb` — or a built-in
+/// name) and checks the options against it: the one
 /// place where command-line solve options become parameters.
 ///
 /// # Errors
@@ -123,7 +124,12 @@ pub fn settings(scene_arg: &str, o: &SolveOpts) -> Result<Settings> {
     if o.threads == Some(0) {
         return Err(input("--threads must be at least 1".into()));
     }
-    let scene = radiosity_io::resolve_scene(scene_arg)?;
+    // A model file given where a scene is expected loads as a scene of its parts; what the
+    // loader dropped or defaulted (degenerate faces, a missing MTL) is said once, here.
+    let radiosity_io::LoadedScene { scene, warnings } = radiosity_io::resolve_scene_warned(scene_arg)?;
+    for w in &warnings {
+        eprintln!("warning: {w}");
+    }
     if !(o.light_scale.is_finite() && o.light_scale > 0.0) {
         return Err(input(format!("--light-scale must be a finite number > 0, got {}", o.light_scale)));
     }

@@ -24,6 +24,7 @@
 mod builtin;
 mod desc;
 mod error;
+mod export;
 mod gltf_in;
 mod locate;
 mod model;
@@ -32,6 +33,10 @@ mod scene_file;
 
 pub use builtin::{BUILTIN_SCENES, builtin_scene, resolve_scene, resolve_scene_warned};
 pub use error::LoadError;
+pub use export::{
+    ExportFormat, LIGHTMAP_CELL_TEXELS, Lightmap, VertexColours, file_stem_for, glb_bytes, gltf_text,
+    lightmaps, ply_bytes, vertex_colours, write_lightmaps,
+};
 pub use model::{DEFAULT_GREY, Model, ModelFormat, ModelPart, Transform, load_model};
 pub use scene_file::{LoadedScene, load_scene, load_scene_warned, parse_scene, parse_scene_warned};
 

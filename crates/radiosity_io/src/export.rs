@@ -1,0 +1,422 @@
+//! Lit meshes out: the solved element mesh with per-vertex colours as glTF 2.0 (`.gltf` with
+//! the buffer embedded, or `.glb`) and PLY, and per-object lightmaps (OpenEXR) with an OBJ
+//! that maps them.
+//!
+//! * glTF: one node and mesh per object (named as in the scene), triangles of the elements
+//!   (a quad element gives two), `POSITION` (float), `COLOR_0` (float RGB in [0, 1], linear
+//!   as glTF requires), `_RADIOSITY` (float RGB: the radiosity B, W per unit², of
+//!   [`radiosity_solver::Solution::vertex_radiosity`], unclamped — glTF's colours may not
+//!   exceed 1, and a light's radiosity does) and a `KHR_materials_unlit` material with a white
+//!   base colour, so every viewer shows the baked colour itself whatever its lights. See
+//!   [`VertexColours`] for what `COLOR_0` holds.
+//! * PLY: binary little endian; per vertex `float x y z`, `uchar red green blue` (sRGB-encoded
+//!   display colour, what PLY viewers show) and `float radiosity_r radiosity_g radiosity_b`
+//!   (linear B); faces are the elements (triangles and quads) as `list uchar uint`.
+//! * Lightmaps: see [`write_lightmaps`].
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use radiosity_core::{Mesh, Rgb};
+use radiosity_image::{HdrImage, ToneOperator, ToneParams, encode_srgb, tone_map};
+use radiosity_solver::Solution;
+use serde_json::{Value, json};
+
+/// What the exported vertex colours (`COLOR_0`) hold. glTF requires colours in [0, 1], so
+/// radiosity itself (lights reach 65 W per unit² in the Cornell box) goes unclamped into the
+/// `_RADIOSITY` attribute, and `COLOR_0` holds a displayable colour.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum VertexColours {
+    /// Linear radiance B/π times 2^`exposure_ev`, clamped to [0, 1]: proportional to
+    /// radiosity up to white (the `linear` tone operator).
+    Linear {
+        /// Exposure in stops.
+        exposure_ev: f64,
+    },
+    /// The display colour of the radiance B/π under these tone-mapping settings.
+    Display(ToneParams),
+}
+
+/// Lit-mesh file formats.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ExportFormat {
+    /// glTF 2.0 JSON with the buffer embedded as a base64 data URI.
+    Gltf,
+    /// Binary glTF.
+    Glb,
+    /// Stanford PLY, binary little endian.
+    Ply,
+}
+
+impl ExportFormat {
+    /// The format for an output path's extension (case-insensitive), or `None`.
+    pub fn from_path(path: &Path) -> Option<Self> {
+        match path.extension()?.to_str()?.to_ascii_lowercase().as_str() {
+            "gltf" => Some(Self::Gltf),
+            "glb" => Some(Self::Glb),
+            "ply" => Some(Self::Ply),
+            _ => None,
+        }
+    }
+}
+
+/// The colour of every mesh vertex for `mode`, each channel in [0, 1].
+pub fn vertex_colours(solution: &Solution, mode: VertexColours) -> Vec<Rgb> {
+    let tone = match mode {
+        VertexColours::Linear { exposure_ev } => ToneParams::new(exposure_ev, ToneOperator::Linear),
+        VertexColours::Display(tone) => tone,
+    };
+    solution.vertex_radiosity.iter().map(|&b| tone_map(b / std::f64::consts::PI, &tone)).collect()
+}
+
+/// The vertices and triangles of each object: `(object, vertex list, triangles in local
+/// indices)`. Vertices are never shared across surfaces, so never across objects.
+fn objects_of(mesh: &Mesh) -> Vec<(usize, Vec<u32>, Vec<[u32; 3]>)> {
+    let mut local = vec![u32::MAX; mesh.positions.len()];
+    let mut out: Vec<(usize, Vec<u32>, Vec<[u32; 3]>)> =
+        (0..mesh.object_names.len()).map(|o| (o, Vec::new(), Vec::new())).collect();
+    for (e, tri) in mesh.element_triangles() {
+        let (_, verts, tris) = &mut out[mesh.element_object(e as usize)];
+        let t = tri.map(|v| {
+            if local[v as usize] == u32::MAX {
+                local[v as usize] = verts.len() as u32;
+                verts.push(v);
+            }
+            local[v as usize]
+        });
+        tris.push(t);
+    }
+    out.retain(|(_, v, _)| !v.is_empty());
+    out
+}
+
+/// Appends `bytes` to `blob`, padded to 4 bytes, and returns the buffer view's JSON.
+fn push_view(blob: &mut Vec<u8>, bytes: &[u8], target: u32) -> Value {
+    let offset = blob.len();
+    blob.extend_from_slice(bytes);
+    while !blob.len().is_multiple_of(4) {
+        blob.push(0);
+    }
+    json!({ "buffer": 0, "byteOffset": offset, "byteLength": bytes.len(), "target": target })
+}
+
+/// The glTF document (JSON) and its binary buffer for `mesh` with `colours` per vertex.
+/// With `uri`, the buffer is referenced by it (a data URI for `.gltf`); without, it is the
+/// GLB's own chunk.
+fn gltf_document(mesh: &Mesh, colours: &[Rgb], radiosity: &[Rgb], mode: VertexColours) -> (Value, Vec<u8>) {
+    const ARRAY_BUFFER: u32 = 34962;
+    const ELEMENT_ARRAY_BUFFER: u32 = 34963;
+    const FLOAT: u32 = 5126;
+    const UNSIGNED_INT: u32 = 5125;
+    let mut blob = Vec::new();
+    let (mut views, mut accessors, mut meshes, mut nodes) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for (object, verts, tris) in objects_of(mesh) {
+        let mut pos = Vec::with_capacity(verts.len() * 12);
+        let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+        for &v in &verts {
+            let p = mesh.positions[v as usize].as_vec3().to_array();
+            for c in 0..3 {
+                lo[c] = lo[c].min(p[c]);
+                hi[c] = hi[c].max(p[c]);
+                pos.extend_from_slice(&p[c].to_le_bytes());
+            }
+        }
+        let mut col = Vec::with_capacity(verts.len() * 12);
+        for &v in &verts {
+            for c in colours[v as usize].to_array() {
+                // glTF colours are linear and non-negative; a tiny negative from round-off is 0.
+                col.extend_from_slice(&(c.max(0.0) as f32).to_le_bytes());
+            }
+        }
+        let mut rad = Vec::with_capacity(verts.len() * 12);
+        for &v in &verts {
+            for c in radiosity[v as usize].to_array() {
+                rad.extend_from_slice(&(c as f32).to_le_bytes());
+            }
+        }
+        let idx: Vec<u8> = tris.iter().flatten().flat_map(|i| i.to_le_bytes()).collect();
+        let base = accessors.len();
+        views.push(push_view(&mut blob, &pos, ARRAY_BUFFER));
+        accessors.push(json!({ "bufferView": views.len() - 1, "componentType": FLOAT, "count": verts.len(),
+            "type": "VEC3", "min": lo, "max": hi }));
+        views.push(push_view(&mut blob, &col, ARRAY_BUFFER));
+        accessors.push(json!({ "bufferView": views.len() - 1, "componentType": FLOAT, "count": verts.len(),
+            "type": "VEC3" }));
+        views.push(push_view(&mut blob, &rad, ARRAY_BUFFER));
+        accessors.push(json!({ "bufferView": views.len() - 1, "componentType": FLOAT, "count": verts.len(),
+            "type": "VEC3" }));
+        views.push(push_view(&mut blob, &idx, ELEMENT_ARRAY_BUFFER));
+        accessors.push(json!({ "bufferView": views.len() - 1, "componentType": UNSIGNED_INT,
+            "count": tris.len() * 3, "type": "SCALAR" }));
+        let name = &mesh.object_names[object];
+        meshes.push(json!({ "name": name, "primitives": [{
+            "attributes": { "POSITION": base, "COLOR_0": base + 1, "_RADIOSITY": base + 2 }, "indices": base + 3,
+            "material": 0 }] }));
+        nodes.push(json!({ "name": name, "mesh": meshes.len() - 1 }));
+    }
+    let colours_are = match mode {
+        VertexColours::Linear { exposure_ev } => {
+            format!("linear radiance B/pi x 2^EV clamped to [0, 1], exposure {exposure_ev:+.3} EV")
+        }
+        VertexColours::Display(t) => {
+            format!("display colour (tone mapped {}, exposure {:+.3} EV)", t.operator, t.exposure_ev)
+        }
+    };
+    let doc = json!({
+        "asset": { "version": "2.0", "generator": concat!("radiosity ", env!("CARGO_PKG_VERSION")),
+            "extras": { "COLOR_0": colours_are, "_RADIOSITY": "radiosity B, W/unit^2, linear, unclamped" } },
+        "extensionsUsed": ["KHR_materials_unlit"],
+        "scene": 0,
+        "scenes": [{ "nodes": (0..nodes.len()).collect::<Vec<_>>() }],
+        "nodes": nodes,
+        "meshes": meshes,
+        "materials": [{ "name": "baked", "pbrMetallicRoughness": { "baseColorFactor": [1.0, 1.0, 1.0, 1.0],
+            "metallicFactor": 0.0, "roughnessFactor": 1.0 }, "extensions": { "KHR_materials_unlit": {} } }],
+        "accessors": accessors,
+        "bufferViews": views,
+        "buffers": [{ "byteLength": blob.len() }],
+    });
+    (doc, blob)
+}
+
+/// Standard base64 with padding (RFC 4648), for the `.gltf` data URI.
+fn base64(bytes: &[u8]) -> String {
+    const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut s = String::with_capacity(bytes.len().div_ceil(3) * 4);
+    for chunk in bytes.chunks(3) {
+        let n = (chunk[0] as u32) << 16
+            | (*chunk.get(1).unwrap_or(&0) as u32) << 8
+            | *chunk.get(2).unwrap_or(&0) as u32;
+        for k in 0..4 {
+            if k <= chunk.len() {
+                s.push(A[(n >> (18 - 6 * k) & 63) as usize] as char);
+            } else {
+                s.push('=');
+            }
+        }
+    }
+    s
+}
+
+/// A `.gltf` file (JSON, buffer embedded as a base64 data URI) of the lit mesh.
+pub fn gltf_text(mesh: &Mesh, solution: &Solution, mode: VertexColours) -> String {
+    let colours = vertex_colours(solution, mode);
+    let (mut doc, blob) = gltf_document(mesh, &colours, &solution.vertex_radiosity, mode);
+    doc["buffers"][0]["uri"] =
+        Value::String(format!("data:application/octet-stream;base64,{}", base64(&blob)));
+    let mut text = serde_json::to_string(&doc).expect("a JSON value always serialises");
+    text.push('\n');
+    text
+}
+
+/// A `.glb` file (binary glTF: JSON chunk and BIN chunk) of the lit mesh.
+pub fn glb_bytes(mesh: &Mesh, solution: &Solution, mode: VertexColours) -> Vec<u8> {
+    let colours = vertex_colours(solution, mode);
+    let (doc, blob) = gltf_document(mesh, &colours, &solution.vertex_radiosity, mode);
+    let mut json = serde_json::to_vec(&doc).expect("a JSON value always serialises");
+    // Chunks are 4-byte aligned: JSON padded with spaces, BIN (already padded) with zeros.
+    while !json.len().is_multiple_of(4) {
+        json.push(b' ');
+    }
+    let total = 12 + 8 + json.len() + 8 + blob.len();
+    let mut out = Vec::with_capacity(total);
+    out.extend_from_slice(b"glTF");
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&(total as u32).to_le_bytes());
+    out.extend_from_slice(&(json.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&json);
+    out.extend_from_slice(&(blob.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"BIN\0");
+    out.extend_from_slice(&blob);
+    out
+}
+
+/// A binary little-endian PLY of the element mesh: display colour as `uchar` and linear
+/// radiosity as `float` per vertex; `display` sets the tone mapping of the former.
+pub fn ply_bytes(mesh: &Mesh, solution: &Solution, display: ToneParams) -> Vec<u8> {
+    let shown = vertex_colours(solution, VertexColours::Display(display));
+    let mut header = String::new();
+    let _ = write!(
+        header,
+        "ply\nformat binary_little_endian 1.0\ncomment radiosity {}: red green blue = display colour \
+         (sRGB, tone mapped {}, exposure {:+.3} EV), radiosity_* = linear radiosity W/unit^2\n\
+         element vertex {}\nproperty float x\nproperty float y\nproperty float z\n\
+         property uchar red\nproperty uchar green\nproperty uchar blue\n\
+         property float radiosity_r\nproperty float radiosity_g\nproperty float radiosity_b\n\
+         element face {}\nproperty list uchar uint vertex_indices\nend_header\n",
+        env!("CARGO_PKG_VERSION"),
+        display.operator,
+        display.exposure_ev,
+        mesh.positions.len(),
+        mesh.elements.len()
+    );
+    let mut out = header.into_bytes();
+    for (v, p) in mesh.positions.iter().enumerate() {
+        for c in p.as_vec3().to_array() {
+            out.extend_from_slice(&c.to_le_bytes());
+        }
+        out.extend_from_slice(&encode_srgb(shown[v]));
+        for c in solution.vertex_radiosity[v].to_array() {
+            out.extend_from_slice(&(c as f32).to_le_bytes());
+        }
+    }
+    for e in &mesh.elements {
+        out.push(e.vertex_count);
+        for &i in e.vertex_indices() {
+            out.extend_from_slice(&i.to_le_bytes());
+        }
+    }
+    out
+}
+
+/// Texels along each side of one element's cell in a lightmap.
+pub const LIGHTMAP_CELL_TEXELS: u32 = 8;
+
+/// One object's lightmap: its image and, per element of the object, the texture coordinates of
+/// its corners (in the element's vertex order).
+#[derive(Clone, Debug)]
+pub struct Lightmap {
+    /// Object index in the mesh.
+    pub object: usize,
+    /// Linear radiosity B per texel, W per unit².
+    pub image: HdrImage,
+    /// `(element, uv of each corner)`; `v` counts down from the top row (glTF's convention;
+    /// OBJ's `vt` is 1 − v).
+    pub charts: Vec<(usize, Vec<[f64; 2]>)>,
+}
+
+/// Per-object lightmaps: each element of an object gets its own square cell of
+/// [`LIGHTMAP_CELL_TEXELS`]² texels in the object's atlas, cells in rows in element order (the
+/// simplest chart packing: no texel is shared, so no seam bleeds from one element into
+/// another; a triangle uses half its cell). Corners map to the centres of the cell's corner
+/// texels, and each texel holds the radiosity interpolated from the element's vertex
+/// radiosity at its centre (bilinear over a quad, barycentric over a triangle), so the map
+/// shades as smoothly as the vertex colours.
+pub fn lightmaps(mesh: &Mesh, solution: &Solution) -> Vec<Lightmap> {
+    let k = LIGHTMAP_CELL_TEXELS;
+    let mut by_object: Vec<Vec<usize>> = vec![Vec::new(); mesh.object_names.len()];
+    for e in 0..mesh.elements.len() {
+        by_object[mesh.element_object(e)].push(e);
+    }
+    let mut out = Vec::new();
+    for (object, elements) in by_object.into_iter().enumerate() {
+        if elements.is_empty() {
+            continue;
+        }
+        let columns = (elements.len() as f64).sqrt().ceil() as u32;
+        let rows = (elements.len() as u32).div_ceil(columns);
+        let (w, h) = (columns * k, rows * k);
+        let mut image = HdrImage::new(w, h);
+        let mut charts = Vec::with_capacity(elements.len());
+        for (n, &e) in elements.iter().enumerate() {
+            let (cx, cy) = ((n as u32 % columns) * k, (n as u32 / columns) * k);
+            let el = &mesh.elements[e];
+            let b: Vec<Rgb> =
+                el.vertex_indices().iter().map(|&v| solution.vertex_radiosity[v as usize]).collect();
+            // Cell parameters (s, t) in [0, 1] at texel centres 0 and k−1.
+            let param = |i: u32| i as f64 / (k - 1) as f64;
+            for ty in 0..k {
+                for tx in 0..k {
+                    let (s, t) = (param(tx), param(ty));
+                    let value = if b.len() == 4 {
+                        b[0] * ((1.0 - s) * (1.0 - t))
+                            + b[1] * (s * (1.0 - t))
+                            + b[2] * (s * t)
+                            + b[3] * ((1.0 - s) * t)
+                    } else {
+                        // Outside the triangle (s + t > 1) the texel is never sampled inside the
+                        // chart; it takes the nearest edge value so filtering there is harmless.
+                        let sum = (s + t).max(1.0);
+                        let (s, t) = (s / sum, t / sum);
+                        b[0] * (1.0 - s - t) + b[1] * s + b[2] * t
+                    };
+                    image.set_pixel(cx + tx, cy + ty, value);
+                }
+            }
+            let uv = |s: f64, t: f64| {
+                [
+                    (cx as f64 + 0.5 + s * (k - 1) as f64) / w as f64,
+                    (cy as f64 + 0.5 + t * (k - 1) as f64) / h as f64,
+                ]
+            };
+            let corners = if b.len() == 4 {
+                vec![uv(0.0, 0.0), uv(1.0, 0.0), uv(1.0, 1.0), uv(0.0, 1.0)]
+            } else {
+                vec![uv(0.0, 0.0), uv(1.0, 0.0), uv(0.0, 1.0)]
+            };
+            charts.push((e, corners));
+        }
+        out.push(Lightmap { object, image, charts });
+    }
+    out
+}
+
+/// A file-name-safe version of an object name (`/` and other separators become `_`).
+pub fn file_stem_for(name: &str) -> String {
+    let s: String =
+        name.chars().map(|c| if c.is_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect();
+    if s.is_empty() { "object".into() } else { s }
+}
+
+/// Writes [`lightmaps`] into `dir` as `<object>.exr` (linear radiosity), with `lightmapped.obj`
+/// and `lightmapped.mtl` mapping them (`map_Kd`, texture coordinates per element corner) so a
+/// modelling tool shows the baked light. Returns the paths written.
+///
+/// # Errors
+/// The folder or a file cannot be written.
+pub fn write_lightmaps(dir: &Path, mesh: &Mesh, solution: &Solution) -> Result<Vec<PathBuf>, String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: cannot create the folder: {e}", dir.display()))?;
+    let maps = lightmaps(mesh, solution);
+    let mut stems: Vec<String> = maps.iter().map(|m| file_stem_for(&mesh.object_names[m.object])).collect();
+    crate::model::unique_names(&mut stems);
+    let mut written = Vec::new();
+    let mut obj = String::from(
+        "# radiosity lightmaps: one material and one EXR (linear radiosity) per object\nmtllib lightmapped.mtl\n",
+    );
+    let mut mtl = String::new();
+    let (mut nv, mut nt) = (0usize, 0usize);
+    for (map, stem) in maps.iter().zip(&stems) {
+        let path = dir.join(format!("{stem}.exr"));
+        radiosity_image::write_exr(&path, &map.image).map_err(|e| e.to_string())?;
+        written.push(path);
+        let _ = writeln!(mtl, "newmtl {stem}\nKd 1 1 1\nmap_Kd {stem}.exr\n");
+        let _ = writeln!(obj, "o {stem}\nusemtl {stem}");
+        for (e, uvs) in &map.charts {
+            let el = &mesh.elements[*e];
+            for (&v, uv) in el.vertex_indices().iter().zip(uvs) {
+                let p = mesh.positions[v as usize];
+                let _ = writeln!(obj, "v {} {} {}\nvt {} {}", p.x, p.y, p.z, uv[0], 1.0 - uv[1]);
+            }
+            let corners: Vec<String> =
+                (0..uvs.len()).map(|k| format!("{}/{}", nv + k + 1, nt + k + 1)).collect();
+            let _ = writeln!(obj, "f {}", corners.join(" "));
+            nv += uvs.len();
+            nt += uvs.len();
+        }
+    }
+    for (name, text) in [("lightmapped.obj", obj), ("lightmapped.mtl", mtl)] {
+        let path = dir.join(name);
+        std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+        written.push(path);
+    }
+    Ok(written)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn base64_matches_rfc_4648_vectors() {
+        for (raw, enc) in [("", ""), ("f", "Zg=="), ("fo", "Zm8="), ("foo", "Zm9v"), ("foobar", "Zm9vYmFy")] {
+            assert_eq!(base64(raw.as_bytes()), enc);
+        }
+    }
+
+    #[test]
+    fn file_stems_are_safe() {
+        assert_eq!(file_stem_for("statue/head 2"), "statue_head_2");
+        assert_eq!(file_stem_for(""), "object");
+    }
+}

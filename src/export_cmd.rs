@@ -1,0 +1,104 @@
+//! `radiosity export`: solve a scene (or a model file) and write the lit mesh as glTF, GLB or
+//! PLY with baked vertex colours, and optionally per-object lightmaps.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use clap::Args;
+use radiosity_image::{HdrImage, ToneOperator, ToneParams};
+use radiosity_io::{ExportFormat, VertexColours};
+
+use crate::prepare::{InputError, SolveOpts, check_writable, prepare, run_solver};
+use crate::render_cmd::ToneOpts;
+
+/// Arguments of `radiosity export`.
+#[derive(Args)]
+pub struct ExportArgs {
+    /// Scene file (.toml), model file (.obj, .gltf, .glb) or built-in name.
+    pub scene: String,
+    /// Lit mesh to write: .glb, .gltf (buffer embedded) or .ply (binary little endian).
+    #[arg(short = 'o', long = "output")]
+    pub output: PathBuf,
+    /// glTF COLOR_0: the tone-mapped display colour (see --exposure, --tonemap) instead of
+    /// exposed linear radiance clamped to 1. Exact radiosity is always in _RADIOSITY (glTF) or
+    /// radiosity_r/g/b (PLY).
+    #[arg(long)]
+    pub tonemapped: bool,
+    /// Also write per-object lightmaps (linear EXR) and an OBJ mapping them into this folder.
+    #[arg(long)]
+    pub lightmap: Option<PathBuf>,
+    #[command(flatten)]
+    pub tone: ToneOpts,
+    /// Overwrite existing output files.
+    #[arg(long)]
+    pub force: bool,
+    #[command(flatten)]
+    pub solve: SolveOpts,
+}
+
+/// Runs `export`.
+///
+/// # Errors
+/// Bad scene or options, an unknown output extension, an existing output without --force
+/// (exit code 2), or a file that cannot be written.
+pub fn run(a: ExportArgs) -> Result<()> {
+    let format = ExportFormat::from_path(&a.output).ok_or_else(|| {
+        InputError(format!("{}: unknown output format; expected .glb, .gltf or .ply", a.output.display()))
+    })?;
+    // Refuse before solving, so a long solve is not lost to an existing file.
+    check_writable(&a.output, a.force)?;
+    if let Some(dir) = &a.lightmap
+        && dir.join("lightmapped.obj").exists()
+        && !a.force
+    {
+        return Err(InputError(format!(
+            "{} already holds lightmaps; pass --force to overwrite them",
+            dir.display()
+        ))
+        .into());
+    }
+    let prepared = prepare(&a.scene, &a.solve)?;
+    let (solver, report) = run_solver(&prepared)?;
+    let solution = solver.solution();
+    let mesh = &prepared.mesh;
+
+    // The exposure for display colours: fixed, or the log-average radiance over the elements
+    // mapped to middle grey (there is no picture to measure, so the scene itself is used).
+    let radiance = HdrImage::from_pixels(
+        solution.element_radiosity.len() as u32,
+        1,
+        solution.element_radiosity.iter().map(|&b| b / std::f64::consts::PI).collect(),
+    );
+    let ev = a.tone.exposure.ev_for(&radiance);
+    let tone = ToneParams::new(ev, a.tone.tonemap.into());
+    let mode =
+        if a.tonemapped { VertexColours::Display(tone) } else { VertexColours::Linear { exposure_ev: ev } };
+    let bytes = match format {
+        ExportFormat::Glb => radiosity_io::glb_bytes(mesh, &solution, mode),
+        ExportFormat::Gltf => radiosity_io::gltf_text(mesh, &solution, mode).into_bytes(),
+        ExportFormat::Ply => radiosity_io::ply_bytes(mesh, &solution, tone),
+    };
+    std::fs::write(&a.output, bytes).with_context(|| format!("cannot write {}", a.output.display()))?;
+    eprintln!(
+        "{}: {} patches, {} elements, {} shots, unshot {:.4} %",
+        prepared.scene.name,
+        mesh.patches.len(),
+        mesh.elements.len(),
+        report.total_shots,
+        report.unshot_fraction * 100.0
+    );
+    let colours = match (format, a.tonemapped) {
+        (ExportFormat::Ply, _) => format!(
+            "display colours ({}, {ev:+.2} EV) and linear radiosity",
+            ToneOperator::from(a.tone.tonemap)
+        ),
+        (_, true) => format!("display colours ({}, {ev:+.2} EV)", ToneOperator::from(a.tone.tonemap)),
+        (_, false) => format!("linear colours ({ev:+.2} EV) and radiosity"),
+    };
+    eprintln!("wrote {} ({} vertices, {colours})", a.output.display(), mesh.positions.len());
+    if let Some(dir) = &a.lightmap {
+        let written = radiosity_io::write_lightmaps(dir, mesh, &solution).map_err(anyhow::Error::msg)?;
+        eprintln!("wrote {} lightmap files into {}", written.len(), dir.display());
+    }
+    Ok(())
+}
