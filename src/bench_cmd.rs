@@ -1,21 +1,31 @@
 //! `radiosity bench`: fixed, seeded cases printed as a table and as JSON.
 //!
-//! Figures, not tests: the machines are shared and noisy, so each case prints its own rates
-//! and the solve cases also print a ratio against the source document's figure.
+//! Figures, not tests: the machines are shared and noisy, so where a baseline exists it runs
+//! in the same process and the case prints the ratio (the solver's reference path against
+//! its fast path; the source document's minute).
+//!
+//! Cases: (a) occlusion rays on a ~100 k-triangle Cornell box (finely tessellated blocks and
+//! two spheres), incoherent surface-to-surface segments, 1 thread and all threads;
+//! (b) the source document's case, ≥ 100 facets × 1000 shots; (c) the Cornell box at ~10 k
+//! elements (fast and reference path) and ~100 k elements to unshot 1e-3; (d) the peak heap
+//! of every solve case and the bytes per element.
 
+use std::f64::consts::PI;
+use std::io::Write;
 use std::sync::Arc;
 use std::time::Instant;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use clap::Args;
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use radiosity_accel::{Bvh, RayQuery};
-use radiosity_core::{Mesh, MeshParams};
+use radiosity_core::{Mesh, MeshParams, Scene, Shape};
 use radiosity_solver::{Solver, SolverParams, occluder_triangles};
 use rayon::prelude::*;
 use serde_json::json;
 
-use crate::prepare::write_output;
+use crate::alloc;
+use crate::prepare::{check_writable, write_output};
 
 /// Arguments of `radiosity bench`.
 #[derive(Args)]
@@ -23,60 +33,147 @@ pub struct BenchArgs {
     /// Also write the figures as JSON here (`-` for stdout).
     #[arg(long)]
     pub json: Option<String>,
-    /// Overwrite an existing JSON file.
+    /// Overwrite existing output files.
     #[arg(long)]
     pub force: bool,
-    /// Element size of the Cornell case, mm (17 gives ~10 k elements).
-    #[arg(long, default_value_t = 17.0)]
-    pub cornell_element_size: f64,
+    /// Leave out the ~100 k-element solve (it takes the longest).
+    #[arg(long)]
+    pub skip_large: bool,
+    /// Write the triangles and segments of the ray case here (binary, for
+    /// `scripts/embree_bench.py`, which traces the same rays with Embree).
+    #[arg(long)]
+    pub dump_rays: Option<String>,
 }
 
-fn solve_case(name: &str, mesh: Mesh, params: SolverParams) -> Result<serde_json::Value> {
-    let mesh = Arc::new(mesh);
-    let accel = Arc::new(Bvh::new(&occluder_triangles(&mesh)));
-    let (patches, elements) = (mesh.patches.len(), mesh.elements.len());
-    let mut solver = Solver::new(mesh, accel, params)?;
-    let r = solver.solve();
-    let secs = r.elapsed.as_secs_f64();
-    println!(
-        "{name:<34} {patches:>7} patches {elements:>8} elements {:>6} shots {secs:>9.3} s {:>7.2} M rays/s  unshot {:.2e} ({})",
-        r.total_shots,
-        r.rays as f64 / secs.max(1e-9) / 1e6,
-        r.unshot_fraction,
-        r.stop_reason.map_or("running", |s| s.as_str())
-    );
-    Ok(
-        json!({"case": name, "patches": patches, "elements": elements, "shots": r.total_shots, "seconds": secs,
-        "rays": r.rays, "unshot_fraction": r.unshot_fraction}),
-    )
+/// A small deterministic generator (xorshift64): the cases must not change between runs.
+struct XorShift(u64);
+
+impl XorShift {
+    fn next(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
 }
 
-/// Runs `bench`.
-pub fn run(a: BenchArgs) -> Result<()> {
-    let threads = rayon::current_num_threads();
-    println!("radiosity bench ({threads} threads)");
-    let cornell = radiosity_io::resolve_scene("cornell")?;
-    let mut cases = Vec::new();
-
-    // (a) Occlusion rays: incoherent segments between random points on Cornell surfaces.
-    let mesh = Mesh::build(&cornell, &MeshParams::try_new(100.0, 25.0)?)?;
-    let tris = occluder_triangles(&mesh);
-    let bvh = Bvh::new(&tris);
-    let mut state = 0x2545_F491_4F6C_DD1Du64;
-    let mut next = || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f32 / (1u64 << 53) as f32
+/// Triangles of a UV sphere with `stacks × slices` cells.
+fn uv_sphere(centre: DVec3, radius: f64, stacks: usize, slices: usize) -> Vec<[DVec3; 3]> {
+    let at = |i: usize, j: usize| {
+        let (theta, phi) = (PI * i as f64 / stacks as f64, 2.0 * PI * j as f64 / slices as f64);
+        centre + radius * DVec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin())
     };
-    let elements = &mesh.elements;
-    let segments: Vec<(Vec3, Vec3)> = (0..400_000)
+    let mut out = Vec::with_capacity(2 * stacks * slices);
+    for i in 0..stacks {
+        for j in 0..slices {
+            let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+            if i + 1 < stacks {
+                out.push([a, b, c]);
+            }
+            if i > 0 {
+                out.push([a, c, d]);
+            }
+        }
+    }
+    out
+}
+
+/// The Cornell box for the ray case: its walls and light as they are, each block face cut
+/// into `n × n` quads (two triangles each), and two finely tessellated spheres.
+fn ray_scene(cornell: &Scene, n: usize) -> Vec<[DVec3; 3]> {
+    let mut tris = Vec::new();
+    for object in &cornell.objects {
+        let Shape::Polygons(polys) = &object.shape else { continue };
+        for poly in polys {
+            let v = poly.vertices();
+            if object.name.contains("block") && v.len() == 4 {
+                let at = |u: f64, w: f64| {
+                    v[0] * ((1.0 - u) * (1.0 - w))
+                        + v[1] * (u * (1.0 - w))
+                        + v[2] * (u * w)
+                        + v[3] * ((1.0 - u) * w)
+                };
+                let s = n as f64;
+                for i in 0..n {
+                    for j in 0..n {
+                        let (u0, u1, w0, w1) =
+                            (i as f64 / s, (i + 1) as f64 / s, j as f64 / s, (j + 1) as f64 / s);
+                        tris.push([at(u0, w0), at(u1, w0), at(u1, w1)]);
+                        tris.push([at(u0, w0), at(u1, w1), at(u0, w1)]);
+                    }
+                }
+            } else {
+                tris.extend((1..v.len() - 1).map(|k| [v[0], v[k], v[k + 1]]));
+            }
+        }
+    }
+    tris.extend(uv_sphere(DVec3::new(400.0, 90.0, 120.0), 80.0, 120, 160));
+    tris.extend(uv_sphere(DVec3::new(130.0, 420.0, 300.0), 70.0, 120, 160));
+    tris
+}
+
+/// `count` segments between area-uniform random points of `tris`, lifted off their surfaces
+/// along the normals: radiosity-like rays, from everywhere to everywhere.
+fn random_segments(tris: &[[DVec3; 3]], count: usize, lift: f64) -> Vec<(Vec3, Vec3)> {
+    let mut cdf = Vec::with_capacity(tris.len());
+    let mut total = 0.0;
+    for t in tris {
+        total += 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
+        cdf.push(total);
+    }
+    let mut rng = XorShift(0x2545_F491_4F6C_DD1D);
+    let point = |rng: &mut XorShift| {
+        let k = cdf.partition_point(|&c| c < rng.next() * total).min(tris.len() - 1);
+        let t = &tris[k];
+        let (s, v) = (rng.next().sqrt(), rng.next());
+        let p = t[0] * (1.0 - s) + t[1] * (s * (1.0 - v)) + t[2] * (s * v);
+        let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
+        (p, n)
+    };
+    (0..count)
         .map(|_| {
-            let a = &elements[(next() * elements.len() as f32) as usize % elements.len()];
-            let b = &elements[(next() * elements.len() as f32) as usize % elements.len()];
-            ((a.centre + a.normal * 1e-3).as_vec3(), (b.centre + b.normal * 1e-3).as_vec3())
+            let ((a, na), (b, nb)) = (point(&mut rng), point(&mut rng));
+            // Lift each end towards the other so it leaves its own surface on the open side.
+            let side = |n: DVec3, d: DVec3| if n.dot(d) >= 0.0 { n } else { -n };
+            ((a + side(na, b - a) * lift).as_vec3(), (b + side(nb, a - b) * lift).as_vec3())
         })
-        .collect();
+        .collect()
+}
+
+/// Writes the ray case for `scripts/embree_bench.py`: little-endian u32 triangle count,
+/// u32 segment count, then 9 f32 per triangle and 6 f32 per segment.
+fn dump_rays(path: &str, tris: &[[Vec3; 3]], segments: &[(Vec3, Vec3)], force: bool) -> Result<()> {
+    check_writable(std::path::Path::new(path), force)?;
+    let mut out = std::io::BufWriter::new(
+        std::fs::File::create(path).with_context(|| format!("{path}: cannot create"))?,
+    );
+    out.write_all(&(tris.len() as u32).to_le_bytes())?;
+    out.write_all(&(segments.len() as u32).to_le_bytes())?;
+    for v in tris.iter().flatten() {
+        for c in v.to_array() {
+            out.write_all(&c.to_le_bytes())?;
+        }
+    }
+    for (a, b) in segments {
+        for c in a.to_array().into_iter().chain(b.to_array()) {
+            out.write_all(&c.to_le_bytes())?;
+        }
+    }
+    out.flush().with_context(|| format!("{path}: cannot write"))?;
+    Ok(())
+}
+
+/// Case (a): occlusion rays per second on one thread and on all.
+fn occlusion_case(cornell: &Scene, dump: Option<&str>, force: bool) -> Result<serde_json::Value> {
+    let tris64 = ray_scene(cornell, 40);
+    let tris: Vec<[Vec3; 3]> = tris64.iter().map(|t| t.map(|p| p.as_vec3())).collect();
+    let t = Instant::now();
+    let bvh = Bvh::new(&tris);
+    let build = t.elapsed().as_secs_f64();
+    let segments = random_segments(&tris64, 1_000_000, 1e-3);
+    if let Some(path) = dump {
+        dump_rays(path, &tris, &segments, force)?;
+    }
     let time_rays = |parallel: bool| {
         let t = Instant::now();
         let blocked: usize = if parallel {
@@ -88,18 +185,66 @@ pub fn run(a: BenchArgs) -> Result<()> {
     };
     let (one, blocked) = time_rays(false);
     let (all, _) = time_rays(true);
+    let threads = rayon::current_num_threads();
     println!(
-        "occlusion rays (Cornell, {} triangles)   1 thread {:.2} M rays/s, {threads} threads {:.2} M rays/s ({:.2}×), {:.0} % blocked",
-        bvh.triangle_count(),
+        "(a) occlusion rays, {} triangles (BVH build {build:.2} s): 1 thread {:.2} M rays/s, {threads} threads {:.2} M rays/s ({:.2}×); {:.1} % of {} segments blocked",
+        tris.len(),
         one / 1e6,
         all / 1e6,
         all / one,
-        100.0 * blocked as f64 / segments.len() as f64
+        100.0 * blocked as f64 / segments.len() as f64,
+        segments.len()
     );
-    cases.push(
-        json!({"case": "occlusion_rays", "triangles": bvh.triangle_count(), "rays_per_s_1_thread": one,
-        "rays_per_s_all_threads": all, "threads": threads}),
+    Ok(json!({"case": "occlusion_rays", "triangles": tris.len(), "segments": segments.len(),
+        "blocked": blocked, "bvh_build_seconds": build, "rays_per_s_1_thread": one,
+        "rays_per_s_all_threads": all, "threads": threads}))
+}
+
+/// Meshes, solves and prints one line: time, shots, rays, and the peak heap of the whole
+/// case (mesh, BVH and solver state) above what was live before it.
+fn solve_case(
+    name: &str,
+    mesh: impl FnOnce() -> Result<Mesh>,
+    params: SolverParams,
+) -> Result<serde_json::Value> {
+    alloc::reset_peak();
+    let before = alloc::live();
+    let mesh = Arc::new(mesh()?);
+    let accel = Arc::new(Bvh::new(&occluder_triangles(&mesh)));
+    let (patches, elements) = (mesh.patches.len(), mesh.elements.len());
+    let mut solver = Solver::new(mesh, accel, params)?;
+    let r = solver.solve();
+    let peak = alloc::peak().saturating_sub(before);
+    let secs = r.elapsed.as_secs_f64();
+    println!(
+        "{name:<40} {patches:>6} patches {elements:>7} elements {:>5} shots {secs:>8.3} s {:>6.2} M rays/s  unshot {:.2e} ({})  peak heap {:.1} MB ({:.0} B/element)",
+        r.total_shots,
+        r.rays as f64 / secs.max(1e-9) / 1e6,
+        r.unshot_fraction,
+        r.stop_reason.map_or("running", |s| s.as_str()),
+        peak as f64 / 1e6,
+        peak as f64 / elements as f64,
     );
+    Ok(json!({"case": name, "patches": patches, "elements": elements, "shots": r.total_shots,
+        "seconds": secs, "rays": r.rays, "unshot_fraction": r.unshot_fraction,
+        "peak_heap_bytes": peak, "bytes_per_element": peak as f64 / elements as f64}))
+}
+
+/// The Cornell box meshed with its own patch size and elements of `element_size` mm.
+fn cornell_mesh(cornell: &Scene, element_size: f64) -> Result<Mesh> {
+    let patch = cornell.mesh_params().patch_size.max(element_size);
+    Ok(Mesh::build(cornell, &MeshParams::try_new(patch, element_size)?)?)
+}
+
+/// Runs `bench`.
+pub fn run(a: BenchArgs) -> Result<()> {
+    if let Some(path) = a.json.as_deref().filter(|p| *p != "-") {
+        check_writable(std::path::Path::new(path), a.force)?;
+    }
+    let threads = rayon::current_num_threads();
+    println!("radiosity bench ({threads} threads)");
+    let cornell = radiosity_io::resolve_scene("cornell")?;
+    let mut cases = vec![occlusion_case(&cornell, a.dump_rays.as_deref(), a.force)?];
 
     // (b) The source document's case: ~100 facets, 1000 shots (it took about a minute).
     let seed = radiosity_io::resolve_scene("seed-room")?;
@@ -113,17 +258,31 @@ pub fn run(a: BenchArgs) -> Result<()> {
         seed_mesh = Mesh::build(&seed, &params)?;
     }
     let p = SolverParams { max_shots: Some(1000), unshot_threshold: 1e-12, ..SolverParams::default() };
-    let t = Instant::now();
-    let mut v = solve_case("source document (≥100 facets, 1000 shots)", seed_mesh, p)?;
-    let secs = t.elapsed().as_secs_f64();
-    println!("  vs the document's ~60 s: {:.0}× faster", 60.0 / secs);
+    let mut v = solve_case("(b) source document (≥100 facets, 1000 shots)", || Ok(seed_mesh), p)?;
+    let secs = v["seconds"].as_f64().unwrap_or(f64::NAN);
+    println!("    vs the document's ~60 s: {:.0}× faster", 60.0 / secs);
     v["speedup_vs_document"] = json!(60.0 / secs);
     cases.push(v);
 
-    // (c) Cornell at ~10 k elements to unshot 1e-3.
-    let m =
-        Mesh::build(&cornell, &MeshParams::try_new(4.0 * a.cornell_element_size, a.cornell_element_size)?)?;
-    cases.push(solve_case("Cornell to unshot 1e-3", m, SolverParams::default())?);
+    // (c) Cornell at ~10 k elements, fast path against the reference path in this process.
+    let fast =
+        solve_case("(c) Cornell ~10 k elements", || cornell_mesh(&cornell, 18.0), SolverParams::default())?;
+    let reference = solve_case(
+        "    same, reference path (no shortcuts)",
+        || cornell_mesh(&cornell, 18.0),
+        SolverParams { reference_path: true, ..SolverParams::default() },
+    )?;
+    let ratio =
+        reference["seconds"].as_f64().unwrap_or(f64::NAN) / fast["seconds"].as_f64().unwrap_or(f64::NAN);
+    println!("    fast path {ratio:.2}× faster than the reference path");
+    cases.push(json!({"fast": fast, "reference": reference, "speedup": ratio}));
+    if !a.skip_large {
+        cases.push(solve_case(
+            "(c) Cornell ~100 k elements",
+            || cornell_mesh(&cornell, 5.7),
+            SolverParams::default(),
+        )?);
+    }
 
     if let Some(path) = &a.json {
         write_output(

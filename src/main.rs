@@ -1,5 +1,6 @@
 //! `radiosity`: solve, render, view and export diffuse global illumination by progressive shooting.
 
+mod alloc;
 mod bench_cmd;
 mod export_cmd;
 mod info_cmd;
@@ -11,6 +12,10 @@ mod view_cmd;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+
+/// Counts heap bytes so `radiosity bench` can report peak memory per case.
+#[global_allocator]
+static HEAP: alloc::Counting = alloc::Counting;
 
 /// Progressive-refinement radiosity renderer (the shooting method).
 #[derive(Parser)]

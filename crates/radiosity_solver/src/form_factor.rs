@@ -68,6 +68,10 @@ fn angle(y: f64, x: f64) -> f64 {
 /// polygon (any winding), ignoring occlusion. Parts of the polygon behind the receiver's
 /// tangent plane are clipped away, so the result is in [0, 1].
 pub fn point_to_polygon(p: DVec3, n: DVec3, polygon: &[DVec3]) -> f64 {
+    // Most polygons lie wholly in front: check the heights first and skip the copy.
+    if polygon.iter().all(|v| n.dot(*v - p) >= 0.0) {
+        return point_to_polygon_in_front(p, n, polygon);
+    }
     let mut clipped = [DVec3::ZERO; 8];
     let k = clip_to_hemisphere(p, n, polygon, &mut clipped);
     if k < 3 {
@@ -77,19 +81,21 @@ pub fn point_to_polygon(p: DVec3, n: DVec3, polygon: &[DVec3]) -> f64 {
 }
 
 /// [`point_to_polygon`] for a polygon known to lie wholly in front of the receiver's tangent
-/// plane, so the clipping can be skipped: the same sum in the same order, so the same bits.
+/// plane, so the clipping can be skipped (clipping such a polygon returns it unchanged, so
+/// both give the same bits).
 pub fn point_to_polygon_in_front(p: DVec3, n: DVec3, polygon: &[DVec3]) -> f64 {
-    let k = polygon.len();
+    let Some(last) = polygon.last() else { return 0.0 };
     let mut sum = 0.0;
-    for i in 0..k {
-        let (ra, rb) = (polygon[i] - p, polygon[(i + 1) % k] - p);
+    // Edges (k−1, 0), (0, 1), …: no index arithmetic in the hot loop.
+    let mut ra = *last - p;
+    for v in polygon {
+        let rb = *v - p;
         let c = ra.cross(rb);
         let len = c.length();
-        if len <= 1e-300 {
-            continue;
+        if len > 1e-300 {
+            sum += angle(len, ra.dot(rb)) * n.dot(c) / len;
         }
-        let gamma = angle(len, ra.dot(rb));
-        sum += gamma * n.dot(c) / len;
+        ra = rb;
     }
     (sum / (2.0 * PI)).abs().min(1.0)
 }
@@ -139,6 +145,13 @@ const DUNAVANT4: [(f64, f64, f64); 2] = [
 /// Calls `f(point, weight)` for the quadrature points of `rule` on an `n × n` subdivision of
 /// a triangle or a convex planar quad; the weights sum to 1.
 pub fn for_each_point(poly: &[DVec3], n: u32, rule: Rule, mut f: impl FnMut(DVec3, f64)) {
+    if n == 1 && rule == Rule::Midpoint {
+        // The one-cell midpoint rule: the centre of the bilinear map (the vertex mean, for a
+        // quad and a triangle alike) with the whole weight; the most common call by far.
+        let centre = poly.iter().copied().sum::<DVec3>() / poly.len() as f64;
+        f(centre, 1.0);
+        return;
+    }
     let nf = n as f64;
     if poly.len() == 4 {
         let at = |u: f64, v: f64| {

@@ -1,0 +1,104 @@
+//! Criterion benchmarks of the solver's hot kernels: `cargo bench -p radiosity_solver`.
+//!
+//! Per-call figures for the exact form factor (far, clipped, integrated over a receiver),
+//! occlusion rays through the BVH and through a shaft's candidate list, and one whole shot
+//! on a furnace box, so a change to a kernel shows up here before it shows up in
+//! `radiosity bench`.
+
+use std::hint::black_box;
+use std::sync::Arc;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use glam::{DVec3, Vec3};
+use radiosity_accel::{BruteForce, Bvh, RayQuery};
+use radiosity_core::{Mesh, MeshParams, furnace_box};
+use radiosity_solver::form_factor::{Rule, for_each_point, point_to_polygon, point_to_polygon_in_front};
+use radiosity_solver::{Solver, SolverParams, StepBudget, occluder_triangles};
+
+fn square(z: f64, size: f64) -> Vec<DVec3> {
+    vec![
+        DVec3::new(0.0, 0.0, z),
+        DVec3::new(size, 0.0, z),
+        DVec3::new(size, size, z),
+        DVec3::new(0.0, size, z),
+    ]
+}
+
+fn form_factors(c: &mut Criterion) {
+    let shooter = square(1.0, 0.2);
+    let p = DVec3::new(0.4, 0.3, 0.0);
+    c.bench_function("point_to_polygon far", |b| {
+        b.iter(|| point_to_polygon(black_box(p), DVec3::Z, black_box(&shooter)))
+    });
+    c.bench_function("point_to_polygon_in_front far", |b| {
+        b.iter(|| point_to_polygon_in_front(black_box(p), DVec3::Z, black_box(&shooter)))
+    });
+    // A receiver perpendicular to the shooter and touching it: clipping does real work.
+    let wall = [DVec3::new(0.0, 0.0, 0.0), DVec3::new(0.0, 0.2, 0.0), DVec3::new(0.0, 0.2, 1.0)];
+    c.bench_function("point_to_polygon clipped", |b| {
+        b.iter(|| point_to_polygon(black_box(DVec3::new(0.05, 0.1, 0.1)), DVec3::Z, black_box(&wall)))
+    });
+    let receiver = square(0.0, 0.05);
+    c.bench_function("area_to_polygon gauss 4x4", |b| {
+        b.iter(|| {
+            let mut f = 0.0;
+            for_each_point(black_box(&receiver), 4, Rule::Gauss, |q, w| {
+                f += w * point_to_polygon(q, DVec3::Z, &shooter)
+            });
+            f
+        })
+    });
+}
+
+/// Deterministic points for ray benchmarks.
+fn points(n: usize, seed: u64) -> Vec<Vec3> {
+    let mut s = seed;
+    let mut next = move || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        (s >> 40) as f32 / (1u64 << 24) as f32
+    };
+    (0..n).map(|_| Vec3::new(next(), next(), next()) * 10.0).collect()
+}
+
+fn rays(c: &mut Criterion) {
+    let corners = points(3000, 0x9e37_79b9_7f4a_7c15);
+    let tris: Vec<[Vec3; 3]> = corners
+        .chunks(3)
+        .map(|t| [t[0], t[0] + (t[1] - Vec3::splat(5.0)) * 0.1, t[0] + (t[2] - Vec3::splat(5.0)) * 0.1])
+        .collect();
+    let ends = points(2048, 7);
+    let bvh = Bvh::new(&tris);
+    c.bench_function("bvh occluded (1000 triangles)", |b| {
+        let mut i = 0;
+        b.iter(|| {
+            i = (i + 2) % ends.len();
+            bvh.occluded(ends[i], ends[i + 1])
+        })
+    });
+    let few: Vec<u32> = (0..12).collect();
+    let brute = BruteForce::new(&tris);
+    c.bench_function("candidate list occluded (12 triangles)", |b| {
+        let mut i = 0;
+        b.iter(|| {
+            i = (i + 2) % ends.len();
+            brute.occluded_by(ends[i], ends[i + 1], black_box(&few))
+        })
+    });
+}
+
+fn shots(c: &mut Criterion) {
+    let scene = furnace_box(0.7, 1.0);
+    let mesh = Arc::new(Mesh::build(&scene, &MeshParams::try_new(0.25, 0.05).unwrap()).unwrap());
+    let accel = Arc::new(Bvh::new(&occluder_triangles(&mesh)));
+    let elements = mesh.elements.len();
+    let mut solver =
+        Solver::new(mesh, accel, SolverParams { unshot_threshold: 1e-12, ..Default::default() }).unwrap();
+    c.bench_function(&format!("one shot, furnace box, {elements} elements"), |b| {
+        b.iter(|| solver.step(StepBudget::Shots(1)))
+    });
+}
+
+criterion_group!(benches, form_factors, rays, shots);
+criterion_main!(benches);
