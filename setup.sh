@@ -9,6 +9,7 @@
 #   libx11-6, libx11-xcb1, libxcursor1, libxrandr2, libxi6, libxkbcommon-x11-0
 #                          X11 client libraries winit opens at run time (dlopen)
 #   imagemagick            to inspect screenshots by hand (identify, compare)
+#   nodejs, npm            (only when npm is missing) to install and run the glTF validator
 set -euo pipefail
 
 packages=(
@@ -26,13 +27,29 @@ for p in "${packages[@]}"; do
   fi
 done
 
-if [ ${#missing[@]} -eq 0 ]; then
-  echo "setup.sh: all system packages present"
-  exit 0
+if [ "$(id -u)" -eq 0 ]; then sudo=(); else sudo=(sudo); fi
+export DEBIAN_FRONTEND=noninteractive
+
+# Node.js and npm, for the Khronos glTF validator below (a distribution's nodejs with npm, or
+# one that bundles npm, both do).
+if ! command -v npm >/dev/null 2>&1; then
+  missing+=(nodejs npm)
 fi
 
-if [ "$(id -u)" -eq 0 ]; then sudo=(); else sudo=(sudo); fi
-echo "setup.sh: installing ${missing[*]}"
-export DEBIAN_FRONTEND=noninteractive
-"${sudo[@]}" apt-get update -q
-"${sudo[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup.sh: all system packages present"
+else
+  echo "setup.sh: installing ${missing[*]}"
+  "${sudo[@]}" apt-get update -q
+  "${sudo[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"
+fi
+
+# The Khronos glTF validator (npm package gltf-validator, version pinned by the lock file):
+# tests/export.rs runs it on exported files, and fails in CI when it is missing.
+validator_dir="$(dirname "$0")/scripts/gltf-validator"
+if [ -d "$validator_dir/node_modules/gltf-validator" ]; then
+  echo "setup.sh: gltf-validator present"
+else
+  echo "setup.sh: installing gltf-validator (npm)"
+  npm ci --prefix "$validator_dir" --no-audit --no-fund
+fi

@@ -1,10 +1,13 @@
 //! Scene files in, for the `radiosity` renderer: the TOML scene format (described in
-//! `docs/ARCHITECTURE.md` and `DESIGN.md`, "Scene file"), and the built-in scenes.
+//! `docs/ARCHITECTURE.md` and `DESIGN.md`, "Scene file"), model files (OBJ + MTL, glTF / GLB:
+//! [`load_model`], or `type = "mesh"` objects of a scene file), and the built-in scenes; lit
+//! meshes out ([`glb_bytes`], [`gltf_text`], [`ply_bytes`], [`write_lightmaps`]).
 //!
 //! Loading has two stages. First the text becomes plain serde data (`SceneDesc`, private)
 //! with unknown keys rejected; then that data becomes a core [`Scene`] through the core's
 //! validating constructors. Every error is a [`LoadError`] whose message is one line:
-//! `<file>:<line>:<column>: <key path>: <what is wrong and what was expected>`.
+//! `<file>:<line>:<column>: <key path>: <what is wrong and what was expected>` for scene
+//! files, `<file>[:<line>]: <element>: <what is wrong>` for model files.
 //!
 //! ```
 //! let scene = radiosity_io::parse_scene(
@@ -37,7 +40,7 @@ pub use export::{
     ExportFormat, LIGHTMAP_CELL_TEXELS, Lightmap, VertexColours, file_stem_for, glb_bytes, gltf_text,
     lightmaps, ply_bytes, vertex_colours, write_lightmaps,
 };
-pub use model::{DEFAULT_GREY, Model, ModelFormat, ModelPart, Transform, load_model};
+pub use model::{DEFAULT_GREY, Model, ModelFormat, ModelPart, Transform, load_model, parse_model};
 pub use scene_file::{LoadedScene, load_scene, load_scene_warned, parse_scene, parse_scene_warned};
 
 use radiosity_core::Scene;

@@ -129,13 +129,31 @@ pub fn load_model(path: &Path, transform: &Transform) -> Result<Model, LoadError
     })?;
     let base = path.parent().unwrap_or(Path::new("."));
     match ModelFormat::from_path(path) {
-        Some(ModelFormat::Obj) => crate::obj::parse_obj(&bytes, &origin, Some(base), transform),
-        Some(ModelFormat::Gltf) => crate::gltf_in::parse_gltf(&bytes, &origin, Some(base), transform),
+        Some(format) => parse_model(&bytes, &origin, Some(base), format, transform),
         None => Err(LoadError::Model {
             origin,
             line: None,
             message: "unknown model format; expected a .obj, .gltf or .glb file".into(),
         }),
+    }
+}
+
+/// Parses a model file's bytes in `format`; MTL libraries, glTF buffers and images that the
+/// file names are read from `base` (without one, an OBJ's faces are grey and a glTF may only
+/// use embedded data). `origin` names the file in messages.
+///
+/// # Errors
+/// As [`load_model`].
+pub fn parse_model(
+    bytes: &[u8],
+    origin: &str,
+    base: Option<&Path>,
+    format: ModelFormat,
+    transform: &Transform,
+) -> Result<Model, LoadError> {
+    match format {
+        ModelFormat::Obj => crate::obj::parse_obj(bytes, origin, base, transform),
+        ModelFormat::Gltf => crate::gltf_in::parse_gltf(bytes, origin, base, transform),
     }
 }
 

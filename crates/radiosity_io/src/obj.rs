@@ -93,7 +93,12 @@ fn mtl_line(text: &str, name: &str, key: &str) -> Option<usize> {
     for (l, line) in text.lines().enumerate() {
         let mut words = line.split_whitespace();
         match words.next() {
-            Some("newmtl") => in_material = words.collect::<Vec<_>>().join(" ") == name,
+            Some("newmtl") => {
+                in_material = words.collect::<Vec<_>>().join(" ") == name;
+                if in_material && key == "newmtl" {
+                    return Some(l + 1);
+                }
+            }
             Some(k) if in_material && k == key => return Some(l + 1),
             _ => {}
         }
