@@ -94,6 +94,74 @@ fn mean_linear_colour(image: &gltf::image::Data) -> Option<[f64; 3]> {
     (n > 0).then(|| sum.map(|s| s / n as f64))
 }
 
+/// Splits a GLB container into its JSON chunk and optional BIN chunk. Done here rather than by
+/// `gltf::Glb`, whose header check underflows on a declared length below 12.
+fn split_glb(bytes: &[u8]) -> Result<(&[u8], Option<Vec<u8>>), String> {
+    let word =
+        |at: usize| -> Option<u32> { Some(u32::from_le_bytes(bytes.get(at..at + 4)?.try_into().ok()?)) };
+    let (Some(version), Some(length)) = (word(4), word(8)) else {
+        return Err("GLB: the file ends inside its 12-byte header".into());
+    };
+    if version != 2 {
+        return Err(format!("GLB: version {version}, expected 2"));
+    }
+    let length = length as usize;
+    if length > bytes.len() || length < 12 {
+        return Err(format!("GLB: the header declares {length} bytes, the file has {}", bytes.len()));
+    }
+    let mut at = 12;
+    let mut json = None;
+    let mut bin = None;
+    while at + 8 <= length {
+        let (Some(size), Some(kind)) = (word(at), word(at + 4)) else { break };
+        let start = at + 8;
+        let Some(end) = start.checked_add(size as usize).filter(|&e| e <= length) else {
+            return Err(format!("GLB: chunk at byte {at} declares {size} bytes past the end of the file"));
+        };
+        match &kind.to_le_bytes() {
+            b"JSON" if json.is_none() => json = Some(&bytes[start..end]),
+            b"BIN\0" if bin.is_none() => bin = Some(bytes[start..end].to_vec()),
+            _ => {}
+        }
+        at = end;
+    }
+    let json = json.ok_or_else(|| "GLB: no JSON chunk".to_owned())?;
+    Ok((json, bin))
+}
+
+/// The validated document and the GLB's binary chunk.
+///
+/// The JSON is parsed and its mesh attribute indices checked before `gltf` validates it: its
+/// validation indexes the accessor list with the `POSITION` index unchecked (a panic on a bad
+/// index in gltf-json 1.4.1).
+fn read_document(bytes: &[u8]) -> Result<(gltf::Document, Option<Vec<u8>>), String> {
+    let (json, blob) = if bytes.starts_with(b"glTF") { split_glb(bytes)? } else { (bytes, None) };
+    let root = gltf::json::Root::from_slice(json).map_err(|e| e.to_string())?;
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            for index in prim.attributes.values().chain(prim.indices.iter()) {
+                if index.value() >= root.accessors.len() {
+                    return Err(format!(
+                        "meshes[{m}].primitives[{p}]: accessor {} does not exist (the file has {})",
+                        index.value(),
+                        root.accessors.len()
+                    ));
+                }
+            }
+        }
+    }
+    let document = gltf::Document::from_json(root).map_err(|e| match e {
+        // The crate lists every problem; the first few make one readable line.
+        gltf::Error::Validation(list) => {
+            let shown: Vec<String> = list.iter().take(3).map(|(path, e)| format!("{path}: {e}")).collect();
+            let more = if list.len() > 3 { format!(" (and {} more)", list.len() - 3) } else { String::new() };
+            format!("invalid glTF: {}{more}", shown.join("; "))
+        }
+        other => other.to_string(),
+    })?;
+    Ok((document, blob))
+}
+
 /// Parses glTF or GLB bytes; external buffers and images are read from `base`.
 ///
 /// # Errors
@@ -105,8 +173,7 @@ pub(crate) fn parse_gltf(
     transform: &Transform,
 ) -> Result<Model, LoadError> {
     let err = |message: String| model_error(origin, None, message);
-    let gltf::Gltf { document, blob } =
-        gltf::Gltf::from_slice(bytes).map_err(|e| err(format!("glTF: {e}")))?;
+    let (document, blob) = read_document(bytes).map_err(|m| err(format!("glTF: {m}")))?;
     let buffers =
         gltf::import_buffers(&document, base, blob).map_err(|e| err(format!("glTF buffers: {e}")))?;
     let mut warnings = Vec::new();
@@ -139,6 +206,15 @@ pub(crate) fn parse_gltf(
                     "{origin}: primitives without a material are default grey ({DEFAULT_GREY}), not glTF's white (ρ = 1 never converges)"
                 ));
                 model_material(origin, None, "default", [DEFAULT_GREY; 3], [0.0; 3])?
+            }
+            Some(i) if m.unlit() => {
+                // An unlit material (as `radiosity export` writes) shows a baked colour; it says
+                // nothing about how the surface reflects.
+                let name = m.name().map_or_else(|| format!("material{i}"), str::to_owned);
+                warnings.push(format!(
+                    "{origin}: material '{name}' is unlit (KHR_materials_unlit), not a reflectance; default grey ({DEFAULT_GREY}) used"
+                ));
+                model_material(origin, None, &name, [DEFAULT_GREY; 3], [0.0; 3])?
             }
             Some(i) => {
                 let name = m.name().map_or_else(|| format!("material{i}"), str::to_owned);
