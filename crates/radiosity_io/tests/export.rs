@@ -23,8 +23,17 @@ fn solved() -> (Arc<Mesh>, Solution) {
     (mesh, solver.solution())
 }
 
+/// What a reloaded file holds, all primitives in node order.
+struct Reloaded {
+    positions: Vec<[f32; 3]>,
+    colours: Vec<[f32; 3]>,
+    radiosity: Vec<[f32; 3]>,
+    indices: usize,
+    names: Vec<String>,
+}
+
 /// Reads back every primitive: positions, COLOR_0, _RADIOSITY and the index count.
-fn reload(bytes: &[u8]) -> (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<[f32; 3]>, usize, Vec<String>) {
+fn reload(bytes: &[u8]) -> Reloaded {
     let (doc, buffers, _) = gltf::import_slice(bytes).expect("the gltf crate reads our file");
     let (mut pos, mut col, mut rad, mut indices, mut names) =
         (Vec::new(), Vec::new(), Vec::new(), 0, Vec::new());
@@ -49,7 +58,7 @@ fn reload(bytes: &[u8]) -> (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<[f32; 3]>, usize, 
             indices += r.read_indices().unwrap().into_u32().count();
         }
     }
-    (pos, col, rad, indices, names)
+    Reloaded { positions: pos, colours: col, radiosity: rad, indices, names }
 }
 
 fn close(a: [f32; 3], b: Rgb, rel: f64) -> bool {
@@ -71,7 +80,7 @@ fn glb_and_gltf_reload_with_the_same_vertices_and_colours() {
             gltf_text(&mesh, &solution, VertexColours::Display(tone)).into_bytes(),
         ),
     ] {
-        let (pos, col, rad, indices, names) = reload(&bytes);
+        let Reloaded { positions: pos, colours: col, radiosity: rad, indices, names } = reload(&bytes);
         assert_eq!(pos.len(), mesh.positions.len(), "same vertex count");
         assert_eq!(indices, 3 * triangles);
         assert_eq!(names, mesh.object_names);
