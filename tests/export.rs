@@ -1,0 +1,175 @@
+//! `radiosity export` end to end: model files in, lit glTF / GLB / PLY and lightmaps out; the
+//! Khronos glTF validator finds no error in what we write; bad input is one line, exit code 2.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn radiosity(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_radiosity")).args(args).output().expect("run radiosity")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Runs the Khronos glTF validator (`scripts/gltf-validator/validate.mjs`) on `files`.
+///
+/// Never a silent skip: without node or the npm package the test fails under CI (`CI` set,
+/// where `setup.sh` installs both), and elsewhere says loudly what it did not check and how
+/// to install it.
+fn validate(files: &[&Path]) {
+    let script = root().join("scripts/gltf-validator/validate.mjs");
+    let package = root().join("scripts/gltf-validator/node_modules/gltf-validator");
+    let node = Command::new("node").arg("--version").output();
+    let missing = match (&node, package.is_dir()) {
+        (Err(e), _) => Some(format!("node cannot be run ({e})")),
+        (Ok(_), false) => {
+            Some(format!("the npm package gltf-validator is not installed in {}", package.display()))
+        }
+        (Ok(_), true) => None,
+    };
+    if let Some(why) = missing {
+        let msg = format!(
+            "glTF VALIDATION NOT RUN: {why}; install it with ./setup.sh (or: npm ci --prefix scripts/gltf-validator)"
+        );
+        assert!(std::env::var_os("CI").is_none(), "{msg} — required in CI");
+        eprintln!("{msg}");
+        return;
+    }
+    let mut cmd = Command::new("node");
+    cmd.arg(&script).args(files);
+    let o = cmd.output().expect("run node");
+    let out = String::from_utf8_lossy(&o.stdout);
+    eprintln!("{out}{}", stderr(&o));
+    assert!(o.status.success(), "the glTF validator reports errors:\n{out}{}", stderr(&o));
+    assert_eq!(out.matches(": 0 errors").count(), files.len(), "{out}");
+}
+
+/// The GLB's JSON chunk.
+fn glb_json(bytes: &[u8]) -> serde_json::Value {
+    assert_eq!(&bytes[..4], b"glTF");
+    let len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    assert_eq!(&bytes[16..20], b"JSON");
+    serde_json::from_slice(&bytes[20..20 + len]).unwrap()
+}
+
+/// Vertices written: the sum of the POSITION accessors' counts.
+fn vertex_count(doc: &serde_json::Value) -> u64 {
+    doc["meshes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| {
+            let a = m["primitives"][0]["attributes"]["POSITION"].as_u64().unwrap();
+            doc["accessors"][a as usize]["count"].as_u64().unwrap()
+        })
+        .sum()
+}
+
+#[test]
+fn obj_round_trip_to_glb_gltf_and_ply_passes_the_validator() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = root().join("scenes/cornell.obj");
+    let (glb, gltf, ply) =
+        (dir.path().join("lit.glb"), dir.path().join("lit.gltf"), dir.path().join("lit.ply"));
+    let quick = ["--max-shots", "150"];
+    let run = |out: &Path, extra: &[&str]| {
+        let mut args = vec!["export", obj.to_str().unwrap(), "-o", out.to_str().unwrap()];
+        args.extend_from_slice(&quick);
+        args.extend_from_slice(extra);
+        let o = radiosity(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        stderr(&o)
+    };
+    let said = run(&glb, &[]);
+    assert!(said.contains("wrote") && said.contains("lit.glb"), "{said}");
+    run(&gltf, &["--tonemapped", "--tonemap", "reinhard"]);
+    run(&ply, &[]);
+
+    // The info command counts the same mesh the export wrote.
+    let info = radiosity(&["info", obj.to_str().unwrap()]);
+    let info = String::from_utf8_lossy(&info.stdout).into_owned();
+    let doc = glb_json(&std::fs::read(&glb).unwrap());
+    assert_eq!(doc["meshes"].as_array().unwrap().len(), 16, "one mesh per object");
+    assert_eq!(doc["meshes"][0]["name"], "floor");
+    assert!(said.contains(&format!("({} vertices", vertex_count(&doc))), "{said}");
+    let elements: u64 =
+        info.lines().find_map(|l| l.strip_prefix("elements")).unwrap().trim().parse().unwrap();
+    assert!(elements > 0);
+    let gltf_doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&gltf).unwrap()).unwrap();
+    assert_eq!(vertex_count(&gltf_doc), vertex_count(&doc));
+    assert!(gltf_doc["asset"]["extras"]["COLOR_0"].as_str().unwrap().contains("reinhard"));
+    let ply_bytes = std::fs::read(&ply).unwrap();
+    assert!(ply_bytes.starts_with(b"ply\nformat binary_little_endian 1.0\n"));
+    assert!(
+        String::from_utf8_lossy(&ply_bytes[..600])
+            .contains(&format!("element vertex {}\n", vertex_count(&doc)))
+    );
+
+    validate(&[&glb, &gltf]);
+}
+
+#[test]
+fn gltf_scene_exports_with_lightmaps() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("lit.glb");
+    let maps = dir.path().join("maps");
+    let gltf = root().join("scenes/cornell.gltf");
+    let args =
+        ["export", gltf.to_str().unwrap(), "-o", out.to_str().unwrap(), "--lightmap", maps.to_str().unwrap()];
+    let o = radiosity(&[&args[..], &["--max-shots", "100"]].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    for f in ["floor.exr", "light.exr", "lightmapped.obj", "lightmapped.mtl"] {
+        assert!(maps.join(f).is_file(), "{f} written");
+    }
+    // Nothing is overwritten without --force: neither the mesh nor the lightmaps.
+    std::fs::remove_file(&out).unwrap();
+    let o = radiosity(&[&args[..], &["--max-shots", "100"]].concat());
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("pass --force"), "{}", stderr(&o));
+    let o = radiosity(&[&args[..], &["--max-shots", "100", "--force"]].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    validate(&[&out]);
+}
+
+#[test]
+fn existing_output_and_bad_input_are_one_line_errors_with_exit_code_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("lit.glb");
+    std::fs::write(&out, "precious").unwrap();
+    let o = radiosity(&["export", "cornell", "-o", out.to_str().unwrap(), "--max-shots", "5"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "precious");
+    let o = radiosity(&["export", "cornell", "-o", out.to_str().unwrap(), "--max-shots", "5", "--force"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+
+    let bad = dir.path().join("bad.obj");
+    std::fs::write(&bad, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\n").unwrap();
+    let fbx = dir.path().join("lit.fbx");
+    let x = dir.path().join("x.glb");
+    let cases: [(&[&str], &str); 3] = [
+        (
+            &["export", bad.to_str().unwrap(), "-o", x.to_str().unwrap()],
+            "bad.obj:5: face 2: vertex index 9 out of range (file has 3 vertices)",
+        ),
+        (&["solve", bad.to_str().unwrap()], "bad.obj:5: face 2"),
+        (
+            &["export", "cornell", "-o", fbx.to_str().unwrap()],
+            "unknown output format; expected .glb, .gltf or .ply",
+        ),
+    ];
+    for (args, needle) in cases {
+        let o = radiosity(args);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+    }
+    let o = radiosity(&["solve", dir.path().join("missing.gltf").to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("missing.gltf: cannot read the model file"), "{}", stderr(&o));
+}
