@@ -9,7 +9,7 @@
 #![forbid(unsafe_code)]
 
 use glam::{Vec3, Vec3A};
-use obvhs::{BvhBuildParams, cwbvh::CwBvh, ray::Ray, triangle::Triangle};
+use obvhs::{BvhBuildParams, cwbvh::CwBvh, ray::Ray, rt_triangle::RtTriangle, triangle::Triangle};
 
 /// A ray hit: distance and the hit triangle with barycentric coordinates.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -80,6 +80,9 @@ fn segment_ray(from: Vec3, to: Vec3) -> Ray {
 pub struct Bvh {
     bvh: CwBvh,
     triangles: Vec<Triangle>,
+    /// The triangles in leaf order with their edges and normal precomputed, so a leaf test
+    /// reads one contiguous record instead of following an index and rebuilding edges.
+    leaves: Vec<RtTriangle>,
 }
 
 impl Bvh {
@@ -95,11 +98,8 @@ impl Bvh {
                 &mut std::time::Duration::default(),
             )
         };
-        Self { bvh, triangles }
-    }
-
-    fn tri(&self, id: usize) -> &Triangle {
-        &self.triangles[self.bvh.primitive_indices[id] as usize]
+        let leaves = bvh.primitive_indices.iter().map(|&i| RtTriangle::from(&triangles[i as usize])).collect();
+        Self { bvh, triangles, leaves }
     }
 }
 
@@ -108,7 +108,7 @@ impl RayQuery for Bvh {
         if self.triangles.is_empty() {
             return false;
         }
-        !self.bvh.ray_traverse_miss(segment_ray(from, to), |ray, id| self.tri(id).intersect(ray))
+        !self.bvh.ray_traverse_miss(segment_ray(from, to), |ray, id| self.leaves[id].intersect(ray))
     }
 
     fn closest_hit(&self, origin: Vec3, direction: Vec3, t_max: f32) -> Option<Hit> {
@@ -118,7 +118,7 @@ impl RayQuery for Bvh {
         let ray = Ray::new(Vec3A::from(origin), nudge(Vec3A::from(direction)), 0.0, t_max);
         let mut hit = obvhs::ray::RayHit::none();
         if !self.bvh.ray_traverse(ray, &mut hit, |ray, id| {
-            let t = self.tri(id).intersect(ray);
+            let t = self.leaves[id].intersect(ray);
             if t > 0.0 { t } else { f32::INFINITY }
         }) {
             return None;
