@@ -183,7 +183,14 @@ pub(crate) fn parse_gltf(
     let needs_images =
         document.materials().any(|m| m.pbr_metallic_roughness().base_color_texture().is_some());
     let images = if needs_images {
-        match gltf::import_images(&document, base, &buffers) {
+        // The crate wants a folder even for embedded images; without one, only embedded
+        // images (data URIs, buffer views) can be read, and any folder will do for those.
+        let embedded = document.images().all(|i| match i.source() {
+            gltf::image::Source::View { .. } => true,
+            gltf::image::Source::Uri { uri, .. } => uri.starts_with("data:"),
+        });
+        let image_base = base.or_else(|| embedded.then_some(Path::new(".")));
+        match gltf::import_images(&document, image_base, &buffers) {
             Ok(images) => images,
             Err(e) => {
                 warnings.push(format!("{origin}: textures not read ({e}); base colour factors used alone"));

@@ -346,3 +346,39 @@ fn a_hundred_thousand_triangles_load_in_seconds() {
     // Seconds, not minutes: a generous bound for a loaded 2-core machine.
     assert!(load < 20.0 && build < 20.0, "load {load} s, mesh {build} s");
 }
+
+/// Node transforms are applied, and a base colour texture's mean (decoded from sRGB) scales
+/// the base colour factor.
+#[test]
+fn gltf_node_transforms_and_texture_means() {
+    let tri = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+    // A 2×1 texture: sRGB 255 and 0 in red, 188 in green (linear ≈ 0.5029), 0 in blue.
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("t.png");
+    let image = radiosity_image::SrgbImage { width: 2, height: 1, pixels: vec![[255, 188, 0], [0, 188, 0]] };
+    radiosity_image::write_png(&png, &image).unwrap();
+    let uri = format!("data:image/png;base64,{}", base64(&std::fs::read(&png).unwrap()));
+    let textured = r#"{"name":"painted","pbrMetallicRoughness":{"baseColorFactor":[0.8,0.8,0.8,1],"baseColorTexture":{"index":0}},"emissiveFactor":[0.5,0.5,0.5],"extensions":{"KHR_materials_emissive_strength":{"emissiveStrength":4}}}"#;
+    let text = gltf_with(&tri, &[0, 1, 2], textured)
+        .replacen(
+            "{\"name\":\"tri\",\"mesh\":0}",
+            "{\"name\":\"tri\",\"mesh\":0,\"translation\":[10,0,0],\"scale\":[2,2,2]}",
+            1,
+        )
+        .replacen(
+            "\"materials\":",
+            &format!("\"textures\":[{{\"source\":0}}],\"images\":[{{\"uri\":\"{uri}\"}}],\"materials\":"),
+            1,
+        );
+    let m = gltf_result(&text).unwrap();
+    let p = m.parts[0].mesh.positions();
+    assert_eq!(p[1], radiosity_core::glam::DVec3::new(12.0, 0.0, 0.0));
+    let rho = m.materials[0].reflectance;
+    let green = radiosity_image::srgb_decode(188.0 / 255.0);
+    assert!(
+        (rho - Rgb::new(0.8 * 0.5, 0.8 * green, 0.0)).max_channel().abs() < 1e-6,
+        "{rho:?} {:?}",
+        m.warnings
+    );
+    assert_eq!(m.materials[0].emission, Rgb::splat(2.0));
+}
