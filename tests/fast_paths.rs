@@ -1,14 +1,14 @@
 //! Every shortcut of the solver that is meant to change only its speed gives the same answer
 //! as the reference path (`SolverParams::reference_path`): per-patch shaft culling with
-//! candidate lists, per-patch quadrature decisions, and unclipped form factors for patches
-//! that face the shooter.
+//! candidate lists, per-patch quadrature decisions, unclipped form factors for patches that
+//! face the shooter, and the four-lane f32 form factor for far, facing patches.
 //!
-//! Tolerance: the shortcuts choose the same quadrature and the same rays as the reference and
-//! evaluate them the same way, so the solutions agree to round-off. The one thing that can
-//! differ is a ray that grazes a triangle edge: the tree's node tests and the candidate list
-//! may then disagree on it, and that element's share of one shot moves by a quarter of the
-//! visibility (4 rays). So: every element within 1e-9 relative, except at most 0.1 % of
-//! elements, none of them off by more than 5 %; per-object means within 1e-4.
+//! Tolerance: the shortcuts choose the same quadrature and the same rays as the reference. The
+//! f32 kernel is within 1e-7 absolute and ~3e-7 relative in total of the f64 one (its own
+//! test), so elements agree to 1e-5 relative. A ray that grazes a triangle edge may come out
+//! differently in the tree and in a candidate list, moving that element's share of one shot
+//! by a quarter of the visibility (4 rays). So: every element within 1e-5 relative, except at
+//! most 0.1 % of elements, none of them off by more than 5 %; per-object means within 1e-4.
 
 use std::sync::Arc;
 
@@ -33,7 +33,7 @@ fn compare(name: &str, scene: &Scene, max_shots: u64) {
     for (e, (a, b)) in fast.element_radiosity.iter().zip(&reference.element_radiosity).enumerate() {
         for (x, y) in [(a.r, b.r), (a.g, b.g), (a.b, b.b)] {
             let d = (x - y).abs() / y.abs().max(1e-300);
-            if d > 1e-9 {
+            if d > 1e-5 {
                 assert!(d < 0.05, "{name}: element {e}: {x} vs reference {y}");
                 off += 1;
                 break;

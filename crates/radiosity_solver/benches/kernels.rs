@@ -12,7 +12,9 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{DVec3, Vec3};
 use radiosity_accel::{BruteForce, Bvh, RayQuery};
 use radiosity_core::{Mesh, MeshParams, furnace_box};
-use radiosity_solver::form_factor::{Rule, for_each_point, point_to_polygon, point_to_polygon_in_front};
+use radiosity_solver::form_factor::{
+    Rule, for_each_point, point_to_polygon, point_to_polygon_in_front, point_to_polygon_in_front_x4,
+};
 use radiosity_solver::{Solver, SolverParams, StepBudget, occluder_triangles};
 
 fn square(z: f64, size: f64) -> Vec<DVec3> {
@@ -32,6 +34,9 @@ fn form_factors(c: &mut Criterion) {
     });
     c.bench_function("point_to_polygon_in_front far", |b| {
         b.iter(|| point_to_polygon_in_front(black_box(p), DVec3::Z, black_box(&shooter)))
+    });
+    c.bench_function("point_to_polygon_in_front_x4 far (f32 lanes)", |b| {
+        b.iter(|| point_to_polygon_in_front_x4(black_box(p), DVec3::Z, black_box(&shooter)))
     });
     // A receiver perpendicular to the shooter and touching it: clipping does real work.
     let wall = [DVec3::new(0.0, 0.0, 0.0), DVec3::new(0.0, 0.2, 0.0), DVec3::new(0.0, 0.2, 1.0)];

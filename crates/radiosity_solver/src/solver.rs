@@ -22,6 +22,7 @@ use thiserror::Error;
 
 use crate::form_factor::{
     Rule, distance_to_polygon, for_each_point, point_to_point, point_to_polygon, point_to_polygon_in_front,
+    point_to_polygon_in_front_x4,
 };
 use crate::occluders::OccluderBoxes;
 use crate::sampling::{Rng, point_on, stratified};
@@ -722,7 +723,11 @@ fn receive(shot: &Shot, plan: &PatchPlan, e: usize) -> (f64, u32) {
                 quadrature(el_radius, gap, params.max_quadrature)
             };
             let mut f = 0.0;
-            if plan.facing {
+            if plan.facing && plan.far && !params.reference_path {
+                // One midpoint, nothing to clip: the four-lane kernel (see its notes).
+                let centre = receiver.iter().copied().sum::<DVec3>() / receiver.len() as f64;
+                f = point_to_polygon_in_front_x4(centre, el.normal, corners);
+            } else if plan.facing {
                 for_each_point(receiver, n, rule, |p, w| {
                     f += w * point_to_polygon_in_front(p, el.normal, corners)
                 });
