@@ -98,7 +98,8 @@ impl Bvh {
                 &mut std::time::Duration::default(),
             )
         };
-        let leaves = bvh.primitive_indices.iter().map(|&i| RtTriangle::from(&triangles[i as usize])).collect();
+        let leaves =
+            bvh.primitive_indices.iter().map(|&i| RtTriangle::from(&triangles[i as usize])).collect();
         Self { bvh, triangles, leaves }
     }
 }
