@@ -49,13 +49,28 @@ pub fn run(a: SolveArgs) -> Result<()> {
         stop
     );
     if a.json.as_deref() != Some("-") {
-        println!(
-            "{:<24} {:>12} {:>36} {:>36}",
+        // Written, not printed: `radiosity solve … | head` closes the pipe early, and a
+        // reader that has seen enough is not an error (println! would panic).
+        let mut table = format!(
+            "{:<24} {:>12} {:>36} {:>36}\n",
             "object", "area", "emitted power [r g b]", "mean radiosity [r g b]"
         );
         for o in &objects {
             let f = |c: radiosity_core::Rgb| format!("{:>11.4e} {:>11.4e} {:>11.4e}", c.r, c.g, c.b);
-            println!("{:<24} {:>12.4e} {:>36} {:>36}", o.name, o.area, f(o.emitted_power), f(o.radiosity));
+            table += &format!(
+                "{:<24} {:>12.4e} {:>36} {:>36}\n",
+                o.name,
+                o.area,
+                f(o.emitted_power),
+                f(o.radiosity)
+            );
+        }
+        let mut out = std::io::stdout().lock();
+        match std::io::Write::write_all(&mut out, table.as_bytes())
+            .and_then(|()| std::io::Write::flush(&mut out))
+        {
+            Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => return Err(e.into()),
+            _ => {}
         }
     }
     if let Some(path) = &a.json {

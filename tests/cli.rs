@@ -159,3 +159,21 @@ fn render_furnace_pfm_holds_linear_radiance() {
     }
     assert!(png.exists());
 }
+
+/// A reader that closes the pipe early (`radiosity solve … | head -1`) is not an error: no
+/// panic, exit 0.
+#[test]
+fn a_closed_stdout_pipe_is_not_a_crash() {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_radiosity"))
+        .args(["solve", "cornell", "--max-shots", "20"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("run radiosity");
+    // Close our end before the solve is done, so its first write meets a closed pipe.
+    drop(child.stdout.take());
+    let out = child.wait_with_output().expect("wait");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "exit {:?}: {stderr}", out.status);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
