@@ -6,6 +6,14 @@
 //! within it) and never across surfaces (so light never leaks round a corner). Lattice points
 //! are computed with one formula per surface, so shared points are bit-identical and are
 //! merged exactly, never by a distance tolerance.
+//!
+//! A surface is one input polygon, one sphere, or — for a [`PolygonMesh`] from a model file —
+//! one group of coplanar triangles connected through shared edges with the same subdivision
+//! steps; there, points on an edge are computed from the edge's lower vertex index, so the two
+//! triangles on it place them identically. A pair of triangles that forms a convex quad is
+//! meshed as that quad (exporters split every quad so), larger faces each as their own
+//! polygon. Triangles that differ in steps start a new surface: a shading seam there, the
+//! price of keeping every lattice exact.
 
 use std::collections::HashMap;
 use std::ops::Range;
