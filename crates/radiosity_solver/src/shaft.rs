@@ -20,6 +20,9 @@ use crate::occluders::blocking_triangles;
 /// pair then goes to the caller's ray structure.
 const SCAN_LIMIT: usize = 512;
 
+/// Triangles per cluster box.
+const CLUSTER: usize = 16;
+
 /// Candidate lists longer than this go to the caller's ray structure instead.
 pub(crate) const FEW: usize = 48;
 
@@ -51,6 +54,9 @@ pub(crate) struct Pair<'a> {
 /// The blocking triangles of a mesh with their bounding boxes, for shaft tests.
 pub(crate) struct Blockers {
     boxes: Vec<(DVec3, DVec3)>,
+    /// Runs of `CLUSTER` consecutive triangles (neighbours, as meshes come) with the box
+    /// around each run: a shaft that misses the run's box skips all its triangles.
+    clusters: Vec<(DVec3, DVec3)>,
     brute: BruteForce,
     /// Absolute slack for the single-precision rounding of ray ends and triangles.
     slack: f64,
@@ -59,17 +65,26 @@ pub(crate) struct Blockers {
 impl Blockers {
     pub(crate) fn new(mesh: &Mesh) -> Self {
         let tris: Vec<[Vec3; 3]> = blocking_triangles(mesh).iter().map(|t| t.map(|p| p.as_vec3())).collect();
+        let (lo, hi) = mesh.bounds();
+        let scale = lo.abs().max(hi.abs()).max_element().max(f64::MIN_POSITIVE);
+        Self::from_triangles(&tris, 1e-6 * scale)
+    }
+
+    /// Blockers over single-precision triangles, with `slack` for their rounding.
+    pub(crate) fn from_triangles(tris: &[[Vec3; 3]], slack: f64) -> Self {
         // Boxes of the single-precision triangles the rays are really tested against.
-        let boxes = tris
+        let boxes: Vec<(DVec3, DVec3)> = tris
             .iter()
             .map(|t| {
                 let (a, b, c) = (t[0].as_dvec3(), t[1].as_dvec3(), t[2].as_dvec3());
                 (a.min(b).min(c), a.max(b).max(c))
             })
             .collect();
-        let (lo, hi) = mesh.bounds();
-        let scale = lo.abs().max(hi.abs()).max_element().max(f64::MIN_POSITIVE);
-        Self { boxes, brute: BruteForce::new(&tris), slack: 1e-6 * scale }
+        let clusters = boxes
+            .chunks(CLUSTER)
+            .map(|c| c.iter().fold(c[0], |(lo, hi), (a, b)| (lo.min(*a), hi.max(*b))))
+            .collect();
+        Self { boxes, clusters, brute: BruteForce::new(tris), slack }
     }
 
     /// True when the per-patch scan is affordable.
@@ -93,9 +108,18 @@ impl Blockers {
         let base = base_planes(a, na, b, nb, margin);
         // Box and base planes first; the side planes cost more and matter only when
         // something is left.
-        for (i, (tlo, thi)) in self.boxes.iter().enumerate() {
-            if tlo.cmple(hi).all() && lo.cmple(*thi).all() && !self.outside(i, &base) {
-                out.push(i as u32);
+        let meets = |(tlo, thi): &(DVec3, DVec3)| {
+            tlo.cmple(hi).all() && lo.cmple(*thi).all() && !outside(tlo, thi, &base)
+        };
+        for (c, cluster) in self.clusters.iter().enumerate() {
+            if !meets(cluster) {
+                continue;
+            }
+            let first = c * CLUSTER;
+            for (i, b) in self.boxes[first..(first + CLUSTER).min(self.boxes.len())].iter().enumerate() {
+                if meets(b) {
+                    out.push((first + i) as u32);
+                }
             }
         }
         if !out.is_empty() {
@@ -137,14 +161,19 @@ impl Blockers {
     /// points with `n·x ≥ d`).
     fn outside(&self, i: usize, planes: &[(DVec3, f64)]) -> bool {
         let (lo, hi) = &self.boxes[i];
-        // The box corner furthest along n bounds the triangle's highest point.
-        planes.iter().any(|(n, d)| n.dot(DVec3::select(n.cmpge(DVec3::ZERO), *hi, *lo)) < *d)
+        outside(lo, hi, planes)
     }
 
     /// The full query's answer for a segment that only the triangles at `indices` can meet.
     pub(crate) fn occluded_by(&self, from: Vec3, to: Vec3, indices: &[u32]) -> bool {
         self.brute.occluded_by(from, to, indices)
     }
+}
+
+/// True when the box `[lo, hi]` lies wholly outside one of `planes` (each `(n, d)` keeps the
+/// points with `n·x ≥ d`): the box corner furthest along n bounds everything inside it.
+fn outside(lo: &DVec3, hi: &DVec3, planes: &[(DVec3, f64)]) -> bool {
+    planes.iter().any(|(n, d)| n.dot(DVec3::select(n.cmpge(DVec3::ZERO), *hi, *lo)) < *d)
 }
 
 /// Axis-aligned bounds of some points.
@@ -234,14 +263,7 @@ mod tests {
             let b = quad(cb, v() * 0.4, v() * 0.4);
             let normal = |p: &[DVec3]| (p[1] - p[0]).cross(p[3] - p[0]).normalize();
             let (na, nb) = (normal(&a), normal(&b));
-            let boxes = tris
-                .iter()
-                .map(|t| {
-                    let (x, y, z) = (t[0].as_dvec3(), t[1].as_dvec3(), t[2].as_dvec3());
-                    (x.min(y).min(z), x.max(y).max(z))
-                })
-                .collect();
-            let blockers = Blockers { boxes, brute: BruteForce::new(&tris), slack: 1e-6 };
+            let blockers = Blockers::from_triangles(&tris, 1e-6);
             let mut out = Vec::new();
             let vis = blockers.gather(Pair { a: &a, na, b: &b, nb, offset: 0.0 }, &mut out);
             if vis == Visibility::Tree {
@@ -277,19 +299,14 @@ mod tests {
         let a = quad(DVec3::ZERO, DVec3::X * 0.1, DVec3::Y * 0.1);
         let b = quad(DVec3::new(1.0, 1.0, 1.0), DVec3::X * 0.1, DVec3::Y * 0.1);
         let tri = [DVec3::new(0.9, 0.1, 0.5), DVec3::new(0.95, 0.1, 0.5), DVec3::new(0.9, 0.15, 0.55)];
-        let tris = [tri.map(|p| p.as_vec3())];
-        let boxes = vec![(tri[0].min(tri[1]).min(tri[2]), tri[0].max(tri[1]).max(tri[2]))];
-        let blockers = Blockers { boxes, brute: BruteForce::new(&tris), slack: 1e-9 };
+        let blockers = Blockers::from_triangles(&[tri.map(|p| p.as_vec3())], 1e-9);
         let mut out = Vec::new();
         assert_eq!(
             blockers.gather(Pair { a: &a, na: DVec3::Z, b: &b, nb: -DVec3::Z, offset: 0.0 }, &mut out),
             Visibility::Clear
         );
         let on_line = [DVec3::splat(0.45), DVec3::new(0.55, 0.45, 0.5), DVec3::new(0.5, 0.55, 0.5)];
-        let boxes =
-            vec![(on_line[0].min(on_line[1]).min(on_line[2]), on_line[0].max(on_line[1]).max(on_line[2]))];
-        let blockers =
-            Blockers { boxes, brute: BruteForce::new(&[on_line.map(|p| p.as_vec3())]), slack: 1e-9 };
+        let blockers = Blockers::from_triangles(&[on_line.map(|p| p.as_vec3())], 1e-9);
         assert_eq!(
             blockers.gather(Pair { a: &a, na: DVec3::Z, b: &b, nb: -DVec3::Z, offset: 0.0 }, &mut out),
             Visibility::Few

@@ -242,6 +242,10 @@ pub struct Solver {
     stop: Option<StopReason>,
     // Per-shot scratch, kept to avoid allocating in the loop.
     plans: Vec<PatchPlan>,
+    /// Plans depend on geometry only, so each shooter's row is kept for its next shots
+    /// (a patch is shot several times), up to [`PLAN_CACHE_ENTRIES`] in all.
+    plan_rows: Vec<Option<Box<[PatchPlan]>>>,
+    plan_entries: usize,
     factors: Vec<(f64, u32)>,
     shooter_cdf: Vec<f64>,
     shooter_elements: Vec<ShooterElement>,
@@ -339,6 +343,8 @@ impl Solver {
         let mut s = Self {
             patch_unshot_power: vec![Rgb::ZERO; mesh.patches.len()],
             plans: vec![PatchPlan::default(); mesh.patches.len()],
+            plan_rows: vec![None; mesh.patches.len()],
+            plan_entries: 0,
             shooter_cdf: Vec::new(),
             shooter_elements: Vec::new(),
             factors: vec![(0.0, 0); n],
@@ -526,7 +532,8 @@ impl Solver {
             |pts: &[DVec3], c: DVec3, n: DVec3| pts.iter().any(|p| n.dot(*p - c) > 1e-12 * patch.area.sqrt());
         let (blockers, offset, reference) = (&self.blockers, self.ray_offset, self.params.reference_path);
         let radius = &self.patch_element_radius;
-        for_each_maybe_parallel(&mut self.plans, |q, plan| {
+        let cached = self.plan_rows[shooter].is_some();
+        for_each_maybe_parallel(if cached { &mut [] } else { &mut self.plans }, |q, plan| {
             let r = &mesh.patches[q];
             plan.live = q != shooter
                 && in_front(r.corners(), patch.centre, patch.normal)
@@ -551,6 +558,11 @@ impl Solver {
                 &mut plan.candidates,
             );
         });
+        let entries = self.plans.len() + self.plans.iter().map(|p| p.candidates.len()).sum::<usize>();
+        if !cached && self.plan_entries + entries <= PLAN_CACHE_ENTRIES {
+            self.plan_entries += entries;
+            self.plan_rows[shooter] = Some(self.plans.clone().into_boxed_slice());
+        }
 
         // Where on the shooter the light is: ray ends are drawn from its elements in proportion
         // to their unshot power, so a patch lit on one part only (half under a block, half in
@@ -594,7 +606,7 @@ impl Solver {
             offset: self.ray_offset,
             index: self.shots,
         };
-        let plans = &self.plans;
+        let plans: &[PatchPlan] = self.plan_rows[shooter].as_deref().unwrap_or(&self.plans);
         for_each_maybe_parallel(&mut self.factors, |e, out| {
             let plan = &plans[mesh.elements[e].patch as usize];
             *out = if plan.live { receive(&shot, plan, e) } else { (0.0, 0) };
@@ -635,6 +647,10 @@ impl Solver {
     }
 }
 
+/// Most plan entries (receiving patches plus candidate triangles) kept across shots: about
+/// 40 MB, every shooter's row for a scene of a thousand patches.
+const PLAN_CACHE_ENTRIES: usize = 1 << 20;
+
 /// Below this many items a loop runs on the calling thread: handing a job to the pool and
 /// waiting for it costs tens of microseconds, more than a few dozen receivers take (the
 /// source document's 145 facets are still worth two threads: 0.24 s against 0.38 s).
@@ -643,7 +659,7 @@ const PARALLEL_MIN: usize = 64;
 /// `f(index, item)` for every item, on the thread pool when there are enough items. Each item
 /// is written by exactly one call, so the result is the same either way.
 fn for_each_maybe_parallel<T: Send>(items: &mut [T], f: impl Fn(usize, &mut T) + Sync + Send) {
-    if items.len() < PARALLEL_MIN {
+    if items.len() < PARALLEL_MIN || rayon::current_num_threads() == 1 {
         items.iter_mut().enumerate().for_each(|(i, x)| f(i, x));
     } else {
         items.par_iter_mut().enumerate().with_min_len(64).for_each(|(i, x)| f(i, x));
