@@ -242,7 +242,13 @@ impl PartBuilder {
                 }
             }
             Err(SceneError::NonConvexPolygon { .. }) => {
-                for t in ear_clip(&pts) {
+                let ears = ear_clip(&pts);
+                // A polygon that is not simple leaves part of itself unclipped: counted as
+                // dropped, so the user hears of the missing area.
+                if ears.len() < pts.len() - 2 {
+                    self.dropped += 1;
+                }
+                for t in ears {
                     self.triangle(t.map(|k| f[k]));
                 }
             }
@@ -275,8 +281,8 @@ impl PartBuilder {
 }
 
 /// Triangles (as indices into `pts`) of a simple planar polygon, by ear clipping in the plane
-/// of its Newell normal. A polygon that is not simple gives what ears it can; the rest is left
-/// out (and counted by the caller as dropped area only through missing triangles).
+/// of its Newell normal. A polygon that is not simple gives what ears it can (fewer than
+/// `pts.len() - 2`); the rest is left out.
 fn ear_clip(pts: &[DVec3]) -> Vec<[usize; 3]> {
     let mut n = DVec3::ZERO;
     for (i, &a) in pts.iter().enumerate() {
@@ -334,6 +340,18 @@ mod tests {
         assert_eq!(tris.len(), 4);
         let area: f64 = tris.iter().map(|t| 0.5 * (l[t[1]] - l[t[0]]).cross(l[t[2]] - l[t[0]]).z).sum();
         assert!((area - 3.0).abs() < 1e-12, "{area}");
+    }
+
+    #[test]
+    fn a_concave_obj_face_becomes_triangles_of_its_area() {
+        let mut b = PartBuilder::new(DMat4::IDENTITY);
+        let l = [(0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (1.0, 1.0), (1.0, 2.0), (0.0, 2.0)];
+        let f = l.map(|(x, y)| b.vertex(DVec3::new(x, y, 0.0)).unwrap()).to_vec();
+        b.face(f);
+        assert_eq!(b.dropped, 0);
+        let m = b.build().unwrap();
+        assert_eq!(m.faces().len(), 4);
+        assert!((m.area() - 3.0).abs() < 1e-12);
     }
 
     #[test]
