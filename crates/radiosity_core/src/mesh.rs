@@ -12,8 +12,10 @@
 //! steps; there, points on an edge are computed from the edge's lower vertex index, so the two
 //! triangles on it place them identically. A pair of triangles that forms a convex quad is
 //! meshed as that quad (exporters split every quad so), larger faces each as their own
-//! polygon. Triangles that differ in steps start a new surface: a shading seam there, the
-//! price of keeping every lattice exact.
+//! polygon. A coplanar set whose triangles need step counts within a factor 2 of each other is
+//! one surface meshed with the largest steps; in a set with a wider range, triangles that
+//! differ in steps start a new surface: a shading seam there, the price of keeping every
+//! lattice exact without subdividing small triangles far below the element size.
 
 use std::collections::HashMap;
 use std::ops::Range;
@@ -383,8 +385,9 @@ impl UnionFind {
 ///
 /// Two triangles join one group when they share an edge (by vertex index) used by no other
 /// face, are coplanar (normals within ~1e-4 rad, the far vertex within 1e-6 of the longest
-/// edge off the plane) and — unless the pair is exactly a convex quad — get the same patch and
-/// element steps, so the lattice points on their common edge coincide bit for bit.
+/// edge off the plane) and either their whole coplanar set needs step counts within a factor
+/// 2 of each other (then all are meshed with the set's largest steps) or they need the same
+/// steps; either way the lattice points on a common edge coincide bit for bit.
 fn group_mesh_faces(m: &PolygonMesh, params: &MeshParams) -> Vec<Vec<u32>> {
     let faces = m.faces();
     let polys = m.polygons();
@@ -431,15 +434,25 @@ fn group_mesh_faces(m: &PolygonMesh, params: &MeshParams) -> Vec<Vec<u32>> {
     for &(a, b) in &pairs {
         all.union(a, b);
     }
+    // Per set: its size and the least and most lattice steps (np · ne) of its triangles.
     let mut size = vec![0u32; faces.len()];
+    let mut step_range = vec![(usize::MAX, 0usize); faces.len()];
     for f in 0..faces.len() as u32 {
-        let r = all.find(f);
-        size[r as usize] += 1;
+        let r = all.find(f) as usize;
+        size[r] += 1;
+        if is_tri(f as usize) {
+            let (np, ne) = steps(f as usize);
+            step_range[r] = (step_range[r].0.min(np * ne), step_range[r].1.max(np * ne));
+        }
     }
     let mut same_steps = UnionFind((0..faces.len() as u32).collect());
     for &(a, b) in &pairs {
-        let pair_only = size[all.find(a) as usize] == 2;
-        if pair_only || steps(a as usize) == steps(b as usize) {
+        let r = all.find(a) as usize;
+        // A set whose triangles need at most twice as many steps as each other is meshed
+        // whole with the largest steps (at most 2× finer per edge than each one needs, the
+        // common case of an n-gon split by an exporter); otherwise only equal steps join.
+        let whole = size[r] == 2 || step_range[r].1 <= 2 * step_range[r].0;
+        if whole || steps(a as usize) == steps(b as usize) {
             same_steps.union(a, b);
         }
     }
@@ -846,6 +859,31 @@ mod tests {
         }
         assert_eq!(mesh.positions.len() as i64 - edges.len() as i64 + mesh.elements.len() as i64, 1);
         check_mesh(&mesh, 16.0, &params);
+    }
+
+    #[test]
+    fn an_exporters_split_of_an_l_shaped_face_is_one_surface() {
+        // An L fanned into four triangles as an exporter splits an n-gon: the two on the long
+        // arm need 8 steps per edge, the two on the short arm 6 — one surface, 8 steps.
+        let positions = [(0.0, 0.0), (3.0, 0.0), (3.0, 1.0), (1.0, 1.0), (1.0, 2.0), (0.0, 2.0)]
+            .map(|(x, y)| DVec3::new(x, y, 0.0))
+            .to_vec();
+        let faces = vec![vec![0, 1, 2], vec![0, 2, 3], vec![0, 3, 4], vec![0, 4, 5]];
+        let l = PolygonMesh::try_new(positions, faces).unwrap();
+        let params = MeshParams::try_new(1.0, 0.5).unwrap();
+        let mesh = Mesh::build(&scene_of(Shape::Mesh(l)), &params).unwrap();
+        assert_eq!(mesh.surfaces.len(), 1);
+        assert_eq!(mesh.elements.len(), 4 * 8 * 8);
+        check_mesh(&mesh, 4.0, &params);
+        let mut edges = std::collections::HashSet::new();
+        for e in &mesh.elements {
+            let v = e.vertex_indices();
+            for k in 0..v.len() {
+                edges.insert((v[k].min(v[(k + 1) % v.len()]), v[k].max(v[(k + 1) % v.len()])));
+            }
+        }
+        // A disc (V − E + F = 1) only when the fan's shared diagonals merged exactly.
+        assert_eq!(mesh.positions.len() as i64 - edges.len() as i64 + mesh.elements.len() as i64, 1);
     }
 
     #[test]
