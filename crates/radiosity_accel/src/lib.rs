@@ -138,12 +138,17 @@ impl RayQuery for Bvh {
 /// Tests every triangle for every ray: slow, obviously correct; the reference for tests.
 pub struct BruteForce {
     triangles: Vec<Triangle>,
+    /// The same triangles with edges and normal precomputed: the BVH's leaf test, so both
+    /// structures answer a segment with the same arithmetic.
+    rt: Vec<RtTriangle>,
 }
 
 impl BruteForce {
     /// Stores the triangles.
     pub fn new(triangles: &[[Vec3; 3]]) -> Self {
-        Self { triangles: to_triangles(triangles) }
+        let triangles = to_triangles(triangles);
+        let rt = triangles.iter().map(RtTriangle::from).collect();
+        Self { triangles, rt }
     }
 }
 
@@ -156,15 +161,21 @@ impl BruteForce {
     /// Haines & Wallace 1991) and tests a handful of triangles per ray instead of walking a
     /// tree.
     pub fn occluded_by(&self, from: Vec3, to: Vec3, indices: &[u32]) -> bool {
+        self.first_blocker(from, to, indices).is_some()
+    }
+
+    /// Like [`BruteForce::occluded_by`], and says which entry of `indices` blocked: callers
+    /// test that triangle first for the next, nearby segment (the last-occluder cache).
+    pub fn first_blocker(&self, from: Vec3, to: Vec3, indices: &[u32]) -> Option<usize> {
         let ray = segment_ray(from, to);
-        indices.iter().any(|&i| self.triangles[i as usize].intersect(&ray).is_finite())
+        indices.iter().position(|&i| self.rt[i as usize].intersect(&ray).is_finite())
     }
 }
 
 impl RayQuery for BruteForce {
     fn occluded(&self, from: Vec3, to: Vec3) -> bool {
         let ray = segment_ray(from, to);
-        self.triangles.iter().any(|t| t.intersect(&ray).is_finite())
+        self.rt.iter().any(|t| t.intersect(&ray).is_finite())
     }
 
     fn closest_hit(&self, origin: Vec3, direction: Vec3, t_max: f32) -> Option<Hit> {

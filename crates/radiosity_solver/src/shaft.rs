@@ -165,8 +165,22 @@ impl Blockers {
     }
 
     /// The full query's answer for a segment that only the triangles at `indices` can meet.
+    #[cfg(test)]
     pub(crate) fn occluded_by(&self, from: Vec3, to: Vec3, indices: &[u32]) -> bool {
         self.brute.occluded_by(from, to, indices)
+    }
+
+    /// [`Blockers::occluded_by`] that moves the blocking triangle to the front of `indices`,
+    /// so the next ray of the same element, which likely meets it too, tests it first. The
+    /// answer does not depend on the order.
+    pub(crate) fn occluded_by_reordering(&self, from: Vec3, to: Vec3, indices: &mut [u32]) -> bool {
+        match self.brute.first_blocker(from, to, indices) {
+            Some(k) => {
+                indices.swap(0, k);
+                true
+            }
+            None => false,
+        }
     }
 }
 

@@ -783,7 +783,7 @@ fn receive(shot: &Shot, plan: &PatchPlan, e: usize) -> (f64, u32) {
     if kept == 0 {
         return (unoccluded, 0);
     }
-    let candidates = &narrowed[..kept];
+    let candidates = &mut narrowed[..kept];
     // Visibility: stratified jittered rays between the element and the shooter.
     let k = params.visibility_rays;
     let mut rng = Rng::for_task(params.seed, index, e as u64);
@@ -794,7 +794,11 @@ fn receive(shot: &Shot, plan: &PatchPlan, e: usize) -> (f64, u32) {
         let (u, v) = stratified(i, k, &mut rng);
         let to = shooter_point(shooter_cdf, shooter_elements, u, v) + shooter.normal * offset;
         let (from, to) = (from.as_vec3(), to.as_vec3());
-        let blocked = if few { blockers.occluded_by(from, to, candidates) } else { accel.occluded(from, to) };
+        let blocked = if few {
+            blockers.occluded_by_reordering(from, to, candidates)
+        } else {
+            accel.occluded(from, to)
+        };
         if !blocked {
             visible += 1;
         }
