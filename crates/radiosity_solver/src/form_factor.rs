@@ -104,10 +104,10 @@ pub fn point_to_polygon_in_front(p: DVec3, n: DVec3, polygon: &[DVec3]) -> f64 {
 /// four single-precision lanes of a SIMD register (SSE2, glam's `Vec4`).
 ///
 /// The edge vectors are formed in double precision and only then rounded, so the lanes see
-/// differences of nearby points (no cancellation); what is left is f32 round-off, about 1e-6
-/// of the result (checked against the double-precision form in the tests). The solver uses it
-/// for patches far from the shooter and facing it, where one midpoint per element is all the
-/// quadrature and this kernel is the whole form factor.
+/// differences of nearby points (no cancellation); what is left is f32 round-off, under 3e-7
+/// absolute and about 4e-7 of the total (checked against the double-precision form in the
+/// tests, near and far). The solver's fast path uses it for every receiver point of a patch
+/// that strictly faces the shooter (no clipping).
 pub fn point_to_polygon_in_front_x4(p: DVec3, n: DVec3, polygon: &[DVec3]) -> f64 {
     use glam::Vec4;
     let k = polygon.len();
@@ -386,7 +386,7 @@ mod tests {
         let (mut worst, mut total_error, mut total) = (0.0f64, 0.0, 0.0);
         for case in 0..20_000 {
             let size = 0.05 + next();
-            let z = 0.2 + 3.0 * next();
+            let z = if case % 4 < 2 { 0.2 + 3.0 * next() } else { 0.002 + 0.1 * next() };
             let poly: Vec<DVec3> = if case % 2 == 0 {
                 square(z, size, true)
             } else {
@@ -404,9 +404,9 @@ mod tests {
             total += exact;
         }
         // The edge terms are first order in the polygon's angular size and their sum second
-        // order, so f32 round-off is relative to the terms: ~1e-7 absolute at worst, and
-        // ~1e-6 of the total.
-        assert!(worst < 2e-7, "worst absolute difference {worst:e}");
+        // order, so f32 round-off is relative to the terms: measured 2.9e-7 absolute at worst
+        // (points 0.002 above the polygon's plane) and 4.3e-7 of the total.
+        assert!(worst < 5e-7, "worst absolute difference {worst:e}");
         assert!(total_error < 2e-6 * total, "total relative difference {:e}", total_error / total);
     }
 
