@@ -203,6 +203,7 @@ fn occlusion_case(cornell: &Scene, dump: Option<&str>, force: bool) -> Result<se
 /// Meshes, solves and prints one line: time, shots, rays, and the peak heap of the whole
 /// case (mesh, BVH and solver state) above what was live before it.
 fn solve_case(
+    id: &str,
     name: &str,
     mesh: impl FnOnce() -> Result<Mesh>,
     params: SolverParams,
@@ -225,7 +226,7 @@ fn solve_case(
         peak as f64 / 1e6,
         peak as f64 / elements as f64,
     );
-    Ok(json!({"case": name, "patches": patches, "elements": elements, "shots": r.total_shots,
+    Ok(json!({"case": id, "patches": patches, "elements": elements, "shots": r.total_shots,
         "seconds": secs, "rays": r.rays, "unshot_fraction": r.unshot_fraction,
         "peak_heap_bytes": peak, "bytes_per_element": peak as f64 / elements as f64}))
 }
@@ -258,16 +259,22 @@ pub fn run(a: BenchArgs) -> Result<()> {
         seed_mesh = Mesh::build(&seed, &params)?;
     }
     let p = SolverParams { max_shots: Some(1000), unshot_threshold: 1e-12, ..SolverParams::default() };
-    let mut v = solve_case("(b) source document (≥100 facets, 1000 shots)", || Ok(seed_mesh), p)?;
+    let mut v =
+        solve_case("source_document", "(b) source document (≥100 facets, 1000 shots)", || Ok(seed_mesh), p)?;
     let secs = v["seconds"].as_f64().unwrap_or(f64::NAN);
     println!("    vs the document's ~60 s: {:.0}× faster", 60.0 / secs);
     v["speedup_vs_document"] = json!(60.0 / secs);
     cases.push(v);
 
     // (c) Cornell at ~10 k elements, fast path against the reference path in this process.
-    let fast =
-        solve_case("(c) Cornell ~10 k elements", || cornell_mesh(&cornell, 18.0), SolverParams::default())?;
+    let fast = solve_case(
+        "cornell_10k",
+        "(c) Cornell ~10 k elements",
+        || cornell_mesh(&cornell, 18.0),
+        SolverParams::default(),
+    )?;
     let reference = solve_case(
+        "cornell_10k_reference",
         "    same, reference path (no shortcuts)",
         || cornell_mesh(&cornell, 18.0),
         SolverParams { reference_path: true, ..SolverParams::default() },
@@ -275,9 +282,11 @@ pub fn run(a: BenchArgs) -> Result<()> {
     let ratio =
         reference["seconds"].as_f64().unwrap_or(f64::NAN) / fast["seconds"].as_f64().unwrap_or(f64::NAN);
     println!("    fast path {ratio:.2}× faster than the reference path");
-    cases.push(json!({"fast": fast, "reference": reference, "speedup": ratio}));
+    cases.push(json!({"case": "cornell_10k_fast_vs_reference", "fast": fast, "reference": reference,
+        "speedup": ratio}));
     if !a.skip_large {
         cases.push(solve_case(
+            "cornell_100k",
             "(c) Cornell ~100 k elements",
             || cornell_mesh(&cornell, 5.7),
             SolverParams::default(),
