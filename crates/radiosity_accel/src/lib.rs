@@ -167,8 +167,27 @@ impl BruteForce {
     /// Like [`BruteForce::occluded_by`], and says which entry of `indices` blocked: callers
     /// test that triangle first for the next, nearby segment (the last-occluder cache).
     pub fn first_blocker(&self, from: Vec3, to: Vec3, indices: &[u32]) -> Option<usize> {
-        let ray = segment_ray(from, to);
-        indices.iter().position(|&i| self.rt[i as usize].intersect(&ray).is_finite())
+        // The ray of `segment_ray` without its inverse direction (three divisions only the
+        // tree's box tests need), and obvhs's `RtTriangle::intersect` written out with the
+        // same operations in the same order, so the answers are the same bit for bit.
+        let (origin, direction) = (Vec3A::from(from), nudge(Vec3A::from(to - from)));
+        let (tmin, tmax) = (SEGMENT_MARGIN, 1.0 - SEGMENT_MARGIN);
+        indices.iter().position(|&i| {
+            let tri = &self.rt[i as usize];
+            let c = tri.v0 - origin;
+            let r = direction.cross(c);
+            let inv_det = 1.0 / tri.ng.dot(direction);
+            let u = r.dot(tri.e2) * inv_det;
+            let v = r.dot(tri.e1) * inv_det;
+            let w = 1.0 - u - v;
+            let hit = u.to_bits() | v.to_bits() | w.to_bits();
+            if inv_det != 0.0 && hit & 0x8000_0000 == 0 {
+                let t = tri.ng.dot(c) * inv_det;
+                t >= tmin && t <= tmax
+            } else {
+                false
+            }
+        })
     }
 }
 
@@ -228,11 +247,15 @@ mod tests {
         let mut rng = XorShift(0x9e3779b97f4a7c15);
         let tris = random_scene(&mut rng, 500);
         let (bvh, brute) = (Bvh::new(&tris), BruteForce::new(&tris));
+        let all: Vec<u32> = (0..tris.len() as u32).collect();
         let mut blocked = 0;
         for _ in 0..4000 {
             let (a, b) = (rng.point(), rng.point());
             let expected = brute.occluded(a, b);
             assert_eq!(bvh.occluded(a, b), expected, "segment {a} -> {b}");
+            // The candidate-list test (its own copy of the triangle arithmetic) on every
+            // triangle gives the same answer.
+            assert_eq!(brute.occluded_by(a, b, &all), expected, "segment {a} -> {b}");
             blocked += usize::from(expected);
             let (h1, h2) = (bvh.closest_hit(a, b - a, 1.0), brute.closest_hit(a, b - a, 1.0));
             assert_eq!(h1.map(|h| h.triangle), h2.map(|h| h.triangle));
