@@ -177,3 +177,25 @@ fn a_closed_stdout_pipe_is_not_a_crash() {
     assert!(out.status.success(), "exit {:?}: {stderr}", out.status);
     assert!(!stderr.contains("panicked"), "{stderr}");
 }
+
+/// `radiosity bench` runs its fixed cases and writes their figures as JSON (values are not
+/// checked against times: benchmarks are not tests; only that every case ran and counted).
+#[test]
+fn bench_writes_every_case_as_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("bench.json");
+    let out = radiosity(&["bench", "--skip-large", "--json", json.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let cases = v["cases"].as_array().unwrap();
+    let ids: Vec<&str> = cases.iter().map(|c| c["case"].as_str().unwrap()).collect();
+    assert_eq!(ids, ["occlusion_rays", "source_document", "cornell_10k_fast_vs_reference"]);
+    assert!(cases[0]["triangles"].as_u64().unwrap() > 100_000);
+    assert_eq!(cases[1]["shots"].as_u64(), Some(1000));
+    assert!(cases[1]["elements"].as_u64().unwrap() >= 100);
+    let (fast, reference) = (&cases[2]["fast"], &cases[2]["reference"]);
+    // Both paths solve the same mesh to the same stop with the same shots.
+    assert_eq!(fast["elements"], reference["elements"]);
+    assert_eq!(fast["shots"], reference["shots"]);
+    assert!(fast["peak_heap_bytes"].as_u64().unwrap() > 0);
+}
