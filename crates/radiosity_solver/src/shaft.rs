@@ -14,8 +14,6 @@ use glam::{DVec3, Vec3};
 use radiosity_accel::BruteForce;
 use radiosity_core::Mesh;
 
-use crate::occluders::blocking_triangles;
-
 /// Above this many blocking triangles the per-patch scan costs more than it saves; every
 /// pair then goes to the caller's ray structure.
 const SCAN_LIMIT: usize = 512;
@@ -63,8 +61,9 @@ pub(crate) struct Blockers {
 }
 
 impl Blockers {
-    pub(crate) fn new(mesh: &Mesh) -> Self {
-        let tris: Vec<[Vec3; 3]> = blocking_triangles(mesh).iter().map(|t| t.map(|p| p.as_vec3())).collect();
+    /// Blockers over `tris` (the mesh's blocking triangles) in single precision.
+    pub(crate) fn new(mesh: &Mesh, tris: &[[DVec3; 3]]) -> Self {
+        let tris: Vec<[Vec3; 3]> = tris.iter().map(|t| t.map(|p| p.as_vec3())).collect();
         let (lo, hi) = mesh.bounds();
         let scale = lo.abs().max(hi.abs()).max_element().max(f64::MIN_POSITIVE);
         Self::from_triangles(&tris, 1e-6 * scale)

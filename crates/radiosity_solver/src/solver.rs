@@ -24,7 +24,7 @@ use crate::form_factor::{
     Rule, distance_to_polygon, for_each_point, point_to_point, point_to_polygon, point_to_polygon_in_front,
     point_to_polygon_in_front_x4,
 };
-use crate::occluders::OccluderBoxes;
+use crate::occluders::{OccluderBoxes, blocking_triangles};
 use crate::sampling::{Rng, point_on, stratified};
 use crate::shaft::{Blockers, FEW, Pair, Visibility, bounds};
 use crate::solution::{Solution, vertex_average};
@@ -331,6 +331,8 @@ impl Solver {
         let mean_reflectance =
             mesh.elements.iter().zip(&reflectance).map(|(el, r)| *r * el.area).sum::<Rgb>() / total_area;
         let (lo, hi) = mesh.bounds();
+        // One scan for both ray-skipping structures (it can cost T × V half-space tests).
+        let blocking = blocking_triangles(&mesh);
         let patch_element_radius = mesh
             .patches
             .iter()
@@ -349,8 +351,8 @@ impl Solver {
             shooter_elements: Vec::new(),
             factors: vec![(0.0, 0); n],
             ray_offset: 1e-6 * (hi - lo).length(),
-            occluder_boxes: OccluderBoxes::new(&mesh),
-            blockers: Blockers::new(&mesh),
+            occluder_boxes: OccluderBoxes::new(&blocking),
+            blockers: Blockers::new(&mesh, &blocking),
             patch_element_radius,
             mesh,
             accel,
@@ -544,7 +546,7 @@ impl Solver {
                 plan.visibility = Visibility::Tree;
                 return;
             }
-            // Each element's own test is 16·r_e < d(c_e) − r_e, and d(c_e) ≥ d(c_q) − r_q for
+            // Each element's own test (`quadrature`) is k·r_e < d(c_e) − r_e, and d(c_e) ≥ d(c_q) − r_q for
             // every element centre c_e of the patch, so this implies it for all of them.
             let patch_radius = r.corners().iter().map(|p| p.distance(r.centre)).fold(0.0, f64::max);
             let strictly = |pts: &[DVec3], c: DVec3, n: DVec3| {
@@ -552,7 +554,8 @@ impl Solver {
             };
             plan.facing = strictly(r.corners(), corners[0], patch.normal)
                 && strictly(corners, mesh.elements[r.elements.start as usize].centre, r.normal);
-            plan.far = 17.0 * radius[q] < distance_to_polygon(r.centre, patch.normal, corners) - patch_radius;
+            plan.far = (MIDPOINT_RATIO + 1.0) * radius[q]
+                < distance_to_polygon(r.centre, patch.normal, corners) - patch_radius;
             plan.visibility = blockers.gather(
                 Pair { a: corners, na: patch.normal, b: r.corners(), nb: r.normal, offset },
                 &mut plan.candidates,
@@ -677,11 +680,14 @@ fn for_each_maybe_parallel<T: Send>(items: &mut [T], f: impl Fn(usize, &mut T) +
 /// inside 0.5 %.
 fn quadrature(el_radius: f64, gap: f64, max: u32) -> (u32, Rule) {
     let gap = gap.max(1e-12 * el_radius);
-    if 16.0 * el_radius < gap {
+    if MIDPOINT_RATIO * el_radius < gap {
         return (1, Rule::Midpoint);
     }
     (((4.0 * el_radius / gap).ceil() as u32).clamp(1, max), Rule::Gauss)
 }
+
+/// An element takes one midpoint when its gap to the shooter exceeds this many of its radii.
+const MIDPOINT_RATIO: f64 = 16.0;
 
 /// What every receiver of one shot reads.
 struct Shot<'a> {
