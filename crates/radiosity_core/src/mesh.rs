@@ -850,15 +850,21 @@ mod tests {
         distinct.dedup();
         assert_eq!(distinct.len(), mesh.positions.len());
         // A disc: V − E + F = 1 only when every shared edge's points merged.
+        assert_eq!(euler_characteristic(&mesh), 1);
+        check_mesh(&mesh, 16.0, &params);
+    }
+
+    /// V − E + F of the element mesh, counting each undirected edge once.
+    fn euler_characteristic(mesh: &Mesh) -> i64 {
         let mut edges = std::collections::HashSet::new();
         for e in &mesh.elements {
             let v = e.vertex_indices();
             for k in 0..v.len() {
-                edges.insert((v[k].min(v[(k + 1) % v.len()]), v[k].max(v[(k + 1) % v.len()])));
+                let (a, b) = (v[k], v[(k + 1) % v.len()]);
+                edges.insert((a.min(b), a.max(b)));
             }
         }
-        assert_eq!(mesh.positions.len() as i64 - edges.len() as i64 + mesh.elements.len() as i64, 1);
-        check_mesh(&mesh, 16.0, &params);
+        mesh.positions.len() as i64 - edges.len() as i64 + mesh.elements.len() as i64
     }
 
     #[test]
@@ -875,15 +881,8 @@ mod tests {
         assert_eq!(mesh.surfaces.len(), 1);
         assert_eq!(mesh.elements.len(), 4 * 8 * 8);
         check_mesh(&mesh, 4.0, &params);
-        let mut edges = std::collections::HashSet::new();
-        for e in &mesh.elements {
-            let v = e.vertex_indices();
-            for k in 0..v.len() {
-                edges.insert((v[k].min(v[(k + 1) % v.len()]), v[k].max(v[(k + 1) % v.len()])));
-            }
-        }
         // A disc (V − E + F = 1) only when the fan's shared diagonals merged exactly.
-        assert_eq!(mesh.positions.len() as i64 - edges.len() as i64 + mesh.elements.len() as i64, 1);
+        assert_eq!(euler_characteristic(&mesh), 1);
     }
 
     #[test]

@@ -8,22 +8,8 @@ use radiosity_io::parse_scene;
 
 const CORNELL: &str = include_str!("../../../scenes/cornell.toml");
 
-/// Marsaglia's xorshift64: tiny, deterministic, good enough to pick mutations.
-struct XorShift(u64);
-
-impl XorShift {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-
-    /// Uniform-ish in `0..n`; `n` must be > 0.
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n as u64) as usize
-    }
-}
+mod common;
+use common::XorShift;
 
 /// Fragments inserted or written over the text: TOML punctuation, the special floats, a
 /// multi-byte character, escapes, headers and keys that shift the structure.

@@ -9,21 +9,8 @@ use radiosity_core::{Mesh, Rgb};
 use radiosity_io::{ModelFormat, Transform, glb_bytes, parse_model, resolve_scene};
 use radiosity_solver::Solution;
 
-/// Marsaglia's xorshift64: tiny, deterministic, good enough to pick mutations.
-struct XorShift(u64);
-
-impl XorShift {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-}
+mod common;
+use common::XorShift;
 
 /// Text fragments that break OBJ and glTF structure and numbers.
 const FRAGMENTS: &[&str] = &[
