@@ -76,9 +76,13 @@ pub struct SolveOpts {
     /// Form factor method.
     #[arg(long, value_enum, default_value_t = FormFactorArg::Exact)]
     pub form_factor: FormFactorArg,
-    /// Visibility rays per receiver and shot.
+    /// Visibility rays per receiver and shooter.
     #[arg(long, default_value_t = 4)]
     pub visibility_rays: u32,
+    /// Memory for keeping each shooter's form factors for its next shots, in MiB (0: keep
+    /// none; the answer is the same, only slower).
+    #[arg(long, default_value_t = 256, value_name = "MIB")]
+    pub row_cache_mib: usize,
     /// Over-relaxation factor ω in [1, 2) (1: plain shooting).
     #[arg(long, default_value_t = 1.0)]
     pub overshoot: f64,
@@ -158,6 +162,7 @@ pub fn settings(scene_arg: &str, o: &SolveOpts) -> Result<Settings> {
         seed: o.seed,
         ambient: if o.ambient { Ambient::On } else { Ambient::Off },
         overshoot: if o.overshoot == 1.0 { Overshoot::Off } else { Overshoot::Relaxation(o.overshoot) },
+        row_cache_bytes: o.row_cache_mib.saturating_mul(1 << 20),
         ..SolverParams::default()
     };
     Ok(Settings { scene, mesh_params, solver_params })

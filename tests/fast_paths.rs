@@ -1,7 +1,9 @@
 //! Every shortcut of the solver that is meant to change only its speed gives the same answer
 //! as the reference path (`SolverParams::reference_path`): per-patch shaft culling with
 //! candidate lists, per-patch quadrature decisions, unclipped form factors for patches that
-//! face the shooter, and the four-lane f32 form factor for far, facing patches.
+//! face the shooter, the four-lane f32 form factor for far, facing patches, and each shooter's
+//! row of form factors kept for its later shots (which must be bit-identical to recomputing
+//! it, whatever the memory budget).
 //!
 //! Tolerance: the shortcuts choose the same quadrature and the same rays as the reference. The
 //! f32 kernel is within 3e-7 absolute and ~4e-7 relative in total of the f64 one (its own
@@ -17,8 +19,11 @@ use radiosity_core::{Mesh, Scene, furnace_box, two_plates, unit_cube_floor_light
 use radiosity_solver::{Solution, Solver, SolverParams, occluder_triangles};
 
 fn solve(mesh: &Arc<Mesh>, reference_path: bool, max_shots: u64) -> Solution {
+    solve_with(mesh, SolverParams { reference_path, max_shots: Some(max_shots), ..SolverParams::default() })
+}
+
+fn solve_with(mesh: &Arc<Mesh>, params: SolverParams) -> Solution {
     let accel = Arc::new(Bvh::new(&occluder_triangles(mesh)));
-    let params = SolverParams { reference_path, max_shots: Some(max_shots), ..SolverParams::default() };
     let mut solver = Solver::new(Arc::clone(mesh), accel, params).unwrap();
     solver.solve();
     solver.solution()
@@ -67,4 +72,23 @@ fn the_cornell_box_solves_the_same_on_both_paths() {
 fn the_seed_room_solves_the_same_on_both_paths() {
     let scene = radiosity_io::builtin_scene("seed-room").unwrap();
     compare("seed-room", &scene, 300);
+}
+
+/// Kept rows are a pure cache: with none kept, all kept, or the budget running out half way
+/// (so some shooters are recomputed and some replayed), every element is bit-identical.
+#[test]
+fn kept_rows_change_nothing_whatever_the_budget() {
+    let scene = radiosity_io::builtin_scene("cornell").unwrap();
+    let mesh = Arc::new(Mesh::build(&scene, &scene.mesh_params()).unwrap());
+    let with = |row_cache_bytes| {
+        solve_with(&mesh, SolverParams { max_shots: Some(400), row_cache_bytes, ..SolverParams::default() })
+    };
+    let all = with(usize::MAX);
+    // One row of the Cornell box is at most 4 bytes per element: this keeps about ten.
+    let some = with(40 * mesh.elements.len());
+    let none = with(0);
+    assert_eq!(all.shots, 400);
+    assert_eq!(all.element_radiosity, none.element_radiosity);
+    assert_eq!(some.element_radiosity, none.element_radiosity);
+    assert_eq!(all.element_unshot, none.element_unshot);
 }

@@ -1,7 +1,7 @@
 //! Seeded random streams and stratified points on patches.
 //!
-//! Every stochastic choice draws from a stream keyed by `(seed, shot, element)`, never by a
-//! thread, so one thread and many give bit-identical results.
+//! Every stochastic choice draws from a stream keyed by `(seed, shooter, element)`, never by
+//! a thread, so one thread and many give bit-identical results.
 
 use glam::DVec3;
 
@@ -17,9 +17,9 @@ fn mix(mut z: u64) -> u64 {
 pub(crate) struct Rng(u64);
 
 impl Rng {
-    /// The stream for one `(seed, shot, element)` task.
-    pub(crate) fn for_task(seed: u64, shot: u64, element: u64) -> Self {
-        Rng(mix(seed ^ mix(shot ^ mix(element))))
+    /// The stream for one `(seed, task, element)` task.
+    pub(crate) fn for_task(seed: u64, task: u64, element: u64) -> Self {
+        Rng(mix(seed ^ mix(task ^ mix(element))))
     }
 
     /// A uniform number in [0, 1).

@@ -7,6 +7,11 @@
 //! F_{j→i} is the area-to-polygon form factor (see [`crate::form_factor`]) times the
 //! fraction of unblocked stratified rays between the element and the patch.
 //!
+//! A patch shoots several times as light comes back to it. Its rays are drawn from a stream
+//! keyed by the shooter (not the shot) and end where its unshot power was at its first shot,
+//! so each of its shots has the same row of form factors F_{j→i}; the row is kept (within
+//! `SolverParams::row_cache_bytes`) and a later shot is one multiply-add per receiver.
+//!
 //! Options: the ambient term of Cohen et al. 1988 §4 for early display, and overshooting by
 //! over-relaxation (Gortler, Cohen & Slusallek 1993, "Radiosity and relaxation methods"):
 //! shoot ω·ΔB_i and leave (1 − ω)·ΔB_i, which may be negative, unshot.
@@ -65,7 +70,7 @@ pub enum Overshoot {
 pub struct SolverParams {
     /// Form factor method. Default [`FormFactorMethod::Exact`].
     pub form_factor: FormFactorMethod,
-    /// Visibility rays per receiving element and shot, ≥ 1. Default 4.
+    /// Visibility rays per receiving element and shooter, ≥ 1. Default 4.
     pub visibility_rays: u32,
     /// Largest receiver quadrature, Gauss cells per side, in 1..=256. Default 2: measured on
     /// the ρ = 0.9 furnaces (box, sphere), the worst element is within 3.7e-5 / 2.0e-5 of
@@ -88,8 +93,16 @@ pub struct SolverParams {
     /// Turns off every shortcut meant to change only the speed, not the answer: per-patch
     /// shaft culling and candidate lists, and per-patch quadrature decisions. Each element
     /// then takes the plain path (its own quadrature choice, rays through the caller's ray
-    /// structure). For tests that the shortcuts give the same answer. Default false.
+    /// structure), and no shooter's row of form factors is kept (see `row_cache_bytes`).
+    /// For tests that the shortcuts give the same answer. Default false.
     pub reference_path: bool,
+    /// Memory for keeping each shooter's row of form factors, in bytes. A patch is shot
+    /// several times (Cornell: ~4), and its form factors and visibility are the same each
+    /// time (its rays are drawn from a stream keyed by the shooter, not by the shot), so a
+    /// kept row turns a later shot into one multiply-add per receiving element. Rows cost
+    /// 4 bytes per receiving element; past the budget rows are recomputed, which gives the
+    /// same numbers, only slower. Default 256 MiB.
+    pub row_cache_bytes: usize,
 }
 
 impl Default for SolverParams {
@@ -105,6 +118,7 @@ impl Default for SolverParams {
             ambient: Ambient::Off,
             overshoot: Overshoot::Off,
             reference_path: false,
+            row_cache_bytes: 256 << 20,
         }
     }
 }
@@ -242,13 +256,35 @@ pub struct Solver {
     stop: Option<StopReason>,
     // Per-shot scratch, kept to avoid allocating in the loop.
     plans: Vec<PatchPlan>,
-    /// Plans depend on geometry only, so each shooter's row is kept for its next shots
-    /// (a patch is shot several times), up to [`PLAN_CACHE_ENTRIES`] in all.
+    /// Plans depend on geometry only, so each shooter's plans are kept for its next shots
+    /// when its form factors are not (see `rows`), up to [`PLAN_CACHE_ENTRIES`] in all.
     plan_rows: Vec<Option<Box<[PatchPlan]>>>,
     plan_entries: usize,
+    /// Each shooter's form factors to its receivers, kept up to `params.row_cache_bytes`.
+    rows: Vec<Option<Row>>,
+    row_bytes: usize,
     factors: Vec<(f64, u32)>,
-    shooter_cdf: Vec<f64>,
+    /// Per element, the cumulative share of its patch's unshot power over the patch's
+    /// elements, fixed at the patch's first shot (see [`Solver::freeze_cdf`]).
+    cdf: Vec<f64>,
+    cdf_frozen: Vec<bool>,
     shooter_elements: Vec<ShooterElement>,
+}
+
+/// One shooter's form factors F_{j→shooter} (visibility included) to the elements of every
+/// patch that can receive from it, as runs of consecutive elements.
+struct Row {
+    /// `(first element, element count)` of each receiving patch, in patch order.
+    spans: Vec<(u32, u32)>,
+    /// The factors, span after span, in f32 (7 digits, far below the visibility noise); a
+    /// row applied fresh is rounded the same way, so keeping it changes nothing.
+    factors: Vec<f32>,
+}
+
+impl Row {
+    fn bytes(&self) -> usize {
+        std::mem::size_of::<Self>() + 8 * self.spans.len() + 4 * self.factors.len()
+    }
 }
 
 /// Corners of one element of the shooter, copied once per shot so ray ends need no lookups.
@@ -347,7 +383,10 @@ impl Solver {
             plans: vec![PatchPlan::default(); mesh.patches.len()],
             plan_rows: vec![None; mesh.patches.len()],
             plan_entries: 0,
-            shooter_cdf: Vec::new(),
+            rows: (0..mesh.patches.len()).map(|_| None).collect(),
+            row_bytes: 0,
+            cdf: vec![0.0; n],
+            cdf_frozen: vec![false; mesh.patches.len()],
             shooter_elements: Vec::new(),
             factors: vec![(0.0, 0); n],
             ray_offset: 1e-6 * (hi - lo).length(),
@@ -517,13 +556,107 @@ impl Solver {
 
     fn shoot(&mut self) {
         let shooter = self.pick_shooter();
-        let mesh = Arc::clone(&self.mesh);
-        let patch = &mesh.patches[shooter];
         let omega = match self.params.overshoot {
             Overshoot::Off => 1.0,
             Overshoot::Relaxation(w) => w,
         };
+        let (row, kept) = match self.rows[shooter].take() {
+            Some(row) => (row, true),
+            None => (self.transfer_row(shooter), false),
+        };
+        self.apply(shooter, &row, omega);
+        let bytes = row.bytes();
+        if kept || (!self.params.reference_path && self.row_bytes + bytes <= self.params.row_cache_bytes) {
+            if !kept {
+                self.row_bytes += bytes;
+                // The plans only serve to compute the row again.
+                if let Some(plans) = self.plan_rows[shooter].take() {
+                    self.plan_entries -= plan_entries(&plans);
+                }
+            }
+            self.rows[shooter] = Some(row);
+        }
+
+        self.shots += 1;
+        let total: f64 = self.patch_unshot_power.iter().map(|p| p.abs().sum()).sum();
+        self.unshot_fraction = total / self.emitted.sum();
+        if self.unshot_fraction < self.best_unshot * (1.0 - 1e-3) {
+            self.best_unshot = self.unshot_fraction;
+            self.shots_since_best = 0;
+        } else {
+            self.shots_since_best += 1;
+        }
+    }
+
+    /// Shoots ω times the shooter's unshot radiosity through its row of form factors.
+    fn apply(&mut self, shooter: usize, row: &Row, omega: f64) {
+        let mesh = Arc::clone(&self.mesh);
+        let patch = &mesh.patches[shooter];
         let shot_b = self.patch_unshot_power[shooter] * (omega / patch.area);
+        // Sequential in element order: the sums are the same for any thread count.
+        let mut received = Rgb::ZERO;
+        let mut offset = 0;
+        for &(first, count) in &row.spans {
+            let (first, count) = (first as usize, count as usize);
+            let mut gained = Rgb::ZERO;
+            for (e, &f) in (first..first + count).zip(&row.factors[offset..offset + count]) {
+                if f == 0.0 {
+                    continue;
+                }
+                let area = mesh.elements[e].area;
+                let incident = shot_b * f64::from(f); // irradiance from this shot, W/unit²
+                let reflected = self.reflectance[e] * incident;
+                self.radiosity[e] += reflected;
+                self.unshot[e] += reflected;
+                gained += reflected * area;
+                received += incident * area;
+                self.absorbed += (incident - reflected) * area;
+            }
+            self.patch_unshot_power[mesh.elements[first].patch as usize] += gained;
+            offset += count;
+        }
+        self.escaped += shot_b * patch.area - received;
+        for e in patch.elements.start..patch.elements.end {
+            self.unshot[e as usize] *= 1.0 - omega;
+        }
+        self.patch_unshot_power[shooter] *= 1.0 - omega;
+    }
+
+    /// Fixes where on `shooter` its rays end, from its elements' unshot power at its first
+    /// shot: a patch lit on one part only (half under a block, half in a shadow) then shoots
+    /// from that part instead of spreading its power over the dark part, whose rays would be
+    /// blocked and its light lost. The share is kept for its later shots, so that they reuse
+    /// the same rays (and its row of form factors); the light a patch receives later comes
+    /// mostly the same way as the first.
+    fn freeze_cdf(&mut self, shooter: usize) {
+        if self.cdf_frozen[shooter] {
+            return;
+        }
+        self.cdf_frozen[shooter] = true;
+        let range = self.mesh.patches[shooter].elements.clone();
+        let (first, end) = (range.start as usize, range.end as usize);
+        let elements = &self.mesh.elements[first..end];
+        let mut acc = 0.0;
+        for ((c, u), el) in self.cdf[first..end].iter_mut().zip(&self.unshot[first..end]).zip(elements) {
+            acc += (*u * el.area).abs().sum();
+            *c = acc;
+        }
+        if acc <= 0.0 || !acc.is_finite() {
+            acc = 0.0;
+            for (c, el) in self.cdf[first..end].iter_mut().zip(elements) {
+                acc += el.area;
+                *c = acc;
+            }
+        }
+        for c in &mut self.cdf[first..end] {
+            *c /= acc;
+        }
+    }
+
+    /// The form factor from every element to `shooter`, visibility included.
+    fn transfer_row(&mut self, shooter: usize) -> Row {
+        let mesh = Arc::clone(&self.mesh);
+        let patch = &mesh.patches[shooter];
         let corners = patch.corners();
 
         // Decide per receiving patch first. A patch receives only if part of it is in front
@@ -561,32 +694,13 @@ impl Solver {
                 &mut plan.candidates,
             );
         });
-        let entries = self.plans.len() + self.plans.iter().map(|p| p.candidates.len()).sum::<usize>();
+        let entries = plan_entries(&self.plans);
         if !cached && self.plan_entries + entries <= PLAN_CACHE_ENTRIES {
             self.plan_entries += entries;
             self.plan_rows[shooter] = Some(self.plans.clone().into_boxed_slice());
         }
 
-        // Where on the shooter the light is: ray ends are drawn from its elements in proportion
-        // to their unshot power, so a patch lit on one part only (half under a block, half in
-        // a shadow) shoots from that part instead of spreading its power over the dark part,
-        // whose rays would be blocked and its light lost.
-        self.shooter_cdf.clear();
-        let mut acc = 0.0;
-        for e in patch.elements.start..patch.elements.end {
-            acc += (self.unshot[e as usize] * mesh.elements[e as usize].area).abs().sum();
-            self.shooter_cdf.push(acc);
-        }
-        if acc <= 0.0 || !acc.is_finite() {
-            self.shooter_cdf.clear();
-            for e in patch.elements.start..patch.elements.end {
-                acc += mesh.elements[e as usize].area;
-                self.shooter_cdf.push(acc);
-            }
-        }
-        for c in &mut self.shooter_cdf {
-            *c /= acc;
-        }
+        self.freeze_cdf(shooter);
         self.shooter_elements.clear();
         for e in patch.elements.start..patch.elements.end {
             let mut corners = [DVec3::ZERO; 4];
@@ -600,14 +714,14 @@ impl Solver {
         let shot = Shot {
             mesh: &mesh,
             shooter: patch,
-            shooter_cdf: &self.shooter_cdf,
+            shooter_cdf: &self.cdf[patch.elements.start as usize..patch.elements.end as usize],
             shooter_elements: &self.shooter_elements,
             accel: &*self.accel,
             boxes: &self.occluder_boxes,
             blockers: &self.blockers,
             params: &self.params,
             offset: self.ray_offset,
-            index: self.shots,
+            stream: shooter as u64,
         };
         let plans: &[PatchPlan] = self.plan_rows[shooter].as_deref().unwrap_or(&self.plans);
         for_each_maybe_parallel(&mut self.factors, |e, out| {
@@ -615,39 +729,24 @@ impl Solver {
             *out = if plan.live { receive(&shot, plan, e) } else { (0.0, 0) };
         });
 
-        // Apply sequentially in element order: the sums are the same for any thread count.
-        let shot_power = shot_b * patch.area;
-        let mut received = Rgb::ZERO;
-        for (e, &(f, rays)) in self.factors.iter().enumerate() {
-            self.rays += u64::from(rays);
-            if f == 0.0 {
+        let mut row = Row { spans: Vec::new(), factors: Vec::new() };
+        for (q, plan) in plans.iter().enumerate() {
+            if !plan.live {
                 continue;
             }
-            let area = mesh.elements[e].area;
-            let incident = shot_b * f; // irradiance from this shot, W/unit²
-            let reflected = self.reflectance[e] * incident;
-            self.radiosity[e] += reflected;
-            self.unshot[e] += reflected;
-            self.patch_unshot_power[mesh.elements[e].patch as usize] += reflected * area;
-            received += incident * area;
-            self.absorbed += (incident - reflected) * area;
+            let range = mesh.patches[q].elements.clone();
+            row.spans.push((range.start, range.end - range.start));
+            let factors = &self.factors[range.start as usize..range.end as usize];
+            row.factors.extend(factors.iter().map(|&(f, _)| f as f32));
+            self.rays += factors.iter().map(|&(_, rays)| u64::from(rays)).sum::<u64>();
         }
-        self.escaped += shot_power - received;
-        for e in patch.elements.start..patch.elements.end {
-            self.unshot[e as usize] *= 1.0 - omega;
-        }
-        self.patch_unshot_power[shooter] *= 1.0 - omega;
-
-        self.shots += 1;
-        let total: f64 = self.patch_unshot_power.iter().map(|p| p.abs().sum()).sum();
-        self.unshot_fraction = total / self.emitted.sum();
-        if self.unshot_fraction < self.best_unshot * (1.0 - 1e-3) {
-            self.best_unshot = self.unshot_fraction;
-            self.shots_since_best = 0;
-        } else {
-            self.shots_since_best += 1;
-        }
+        row
     }
+}
+
+/// Entries of one shooter's plans (receiving patches plus candidate triangles).
+fn plan_entries(plans: &[PatchPlan]) -> usize {
+    plans.len() + plans.iter().map(|p| p.candidates.len()).sum::<usize>()
 }
 
 /// Most plan entries (receiving patches plus candidate triangles) kept across shots: about
@@ -703,8 +802,8 @@ struct Shot<'a> {
     params: &'a SolverParams,
     /// Ray origins and targets are lifted this far off their surfaces.
     offset: f64,
-    /// Shot index, for the random streams.
-    index: u64,
+    /// Key of the random streams: the shooter, so that every shot of it draws the same rays.
+    stream: u64,
 }
 
 /// The point at `(u, v)` ∈ [0,1)² on the shooter, drawn by unshot power: `u` picks the
@@ -726,7 +825,7 @@ fn element_radius(mesh: &Mesh, e: usize) -> f64 {
 
 /// Form factor F_{e→shooter} (with visibility) and the number of rays traced.
 fn receive(shot: &Shot, plan: &PatchPlan, e: usize) -> (f64, u32) {
-    let Shot { mesh, shooter, shooter_cdf, shooter_elements, accel, boxes, blockers, params, offset, index } =
+    let Shot { mesh, shooter, shooter_cdf, shooter_elements, accel, boxes, blockers, params, offset, stream } =
         *shot;
     let el = &mesh.elements[e];
     let mut pts = [DVec3::ZERO; 4];
@@ -796,7 +895,7 @@ fn receive(shot: &Shot, plan: &PatchPlan, e: usize) -> (f64, u32) {
     let candidates = &mut narrowed[..kept];
     // Visibility: stratified jittered rays between the element and the shooter.
     let k = params.visibility_rays;
-    let mut rng = Rng::for_task(params.seed, index, e as u64);
+    let mut rng = Rng::for_task(params.seed, stream, e as u64);
     let mut visible = 0;
     for i in 0..k {
         let (u, v) = stratified(i, k, &mut rng);

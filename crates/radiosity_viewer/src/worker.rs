@@ -571,8 +571,13 @@ mod tests {
             scene,
             light_scale: 1.0,
             mesh_params: MeshParams::try_new(patch, patch / 2.0).unwrap(),
-            // Tight threshold so the solve outlasts the test unless something stops it.
-            solver_params: SolverParams { unshot_threshold: 1e-12, ..SolverParams::preview() },
+            // Tight threshold and no kept rows (a kept row makes a shot take microseconds),
+            // so the solve outlasts the test unless something stops it.
+            solver_params: SolverParams {
+                unshot_threshold: 1e-12,
+                row_cache_bytes: 0,
+                ..SolverParams::preview()
+            },
         }
     }
 
