@@ -268,6 +268,12 @@ pub struct Solver {
     /// elements, fixed at the patch's first shot (see [`Solver::freeze_cdf`]).
     cdf: Vec<f64>,
     cdf_frozen: Vec<bool>,
+    /// Per element, its unshot radiosity over its patch's mean at the patch's first shot;
+    /// kept for patches where it strays from 1 (see [`Solver::freeze_cdf`]).
+    density: Vec<f64>,
+    nonuniform: Vec<bool>,
+    clusters: Vec<Cluster>,
+    cluster_order: Vec<u32>,
     shooter_elements: Vec<ShooterElement>,
 }
 
@@ -292,12 +298,72 @@ impl Row {
 struct ShooterElement {
     corners: [DVec3; 4],
     count: u8,
+    centre: DVec3,
+    /// Circumradius about `centre`.
+    radius: f64,
+    area: f64,
 }
 
 impl ShooterElement {
     fn corners(&self) -> &[DVec3] {
         &self.corners[..self.count as usize]
     }
+
+    /// Form factor from a differential area at `p` (normal `n`) to this element of a shooter
+    /// with normal `ns`: the exact polygon formula up close, else the point-to-point one,
+    /// cos θ cos θ' A / (π r²), which is within ~2 % beyond four radii (Cohen & Wallace
+    /// §4.9's "five times rule" is the same trade).
+    fn factor_from(&self, p: DVec3, n: DVec3, ns: DVec3) -> f64 {
+        if self.centre.distance_squared(p) < 16.0 * self.radius * self.radius {
+            point_to_polygon(p, n, self.corners())
+        } else {
+            point_to_point(p, n, self.centre, ns, self.area)
+        }
+    }
+}
+
+/// Up to [`CLUSTER`] nearby elements of an uneven shooter, so that a receiver needs to visit
+/// the elements of only the clusters it is close to (see [`density_weight`]).
+#[derive(Clone, Debug)]
+struct Cluster {
+    /// Its elements, as a range of `Solver::cluster_order`.
+    members: std::ops::Range<usize>,
+    centre: DVec3,
+    /// Radius about `centre` that holds all its elements.
+    radius: f64,
+    area: f64,
+    /// Area-weighted mean density of its elements.
+    density: f64,
+}
+
+/// Most elements in one [`Cluster`].
+const CLUSTER: usize = 16;
+
+/// Cuts `order` (indices into `elements`) by median splits along the longest extent of the
+/// element centres until each piece holds at most [`CLUSTER`] elements; appends the pieces.
+fn build_clusters(
+    order: &mut [u32],
+    base: usize,
+    elements: &[ShooterElement],
+    density: &[f64],
+    out: &mut Vec<Cluster>,
+) {
+    let el = |k: &u32| &elements[*k as usize];
+    if order.len() > CLUSTER {
+        let (lo, hi) = bounds(order.iter().map(|k| &el(k).centre));
+        let axis = (hi - lo).max_position();
+        let mid = order.len() / 2;
+        order.select_nth_unstable_by(mid, |a, b| el(a).centre[axis].total_cmp(&el(b).centre[axis]));
+        let (left, right) = order.split_at_mut(mid);
+        build_clusters(left, base, elements, density, out);
+        build_clusters(right, base + mid, elements, density, out);
+        return;
+    }
+    let area: f64 = order.iter().map(|k| el(k).area).sum();
+    let centre = order.iter().map(|k| el(k).centre * el(k).area).sum::<DVec3>() / area;
+    let radius = order.iter().map(|k| el(k).centre.distance(centre) + el(k).radius).fold(0.0, f64::max);
+    let density = order.iter().map(|k| density[*k as usize] * el(k).area).sum::<f64>() / area;
+    out.push(Cluster { members: base..base + order.len(), centre, radius, area, density });
 }
 
 /// What one shot decides once for a whole receiving patch, so its elements need not.
@@ -310,6 +376,9 @@ struct PatchPlan {
     /// The patch lies strictly in front of the shooter's plane and the shooter strictly in
     /// front of the patch's, so no receiver point needs hemisphere clipping.
     facing: bool,
+    /// The patch and the shooter are live but not strictly facing: they meet or cross each
+    /// other's planes (a wall on the floor, a block standing on it). Set on both paths.
+    touching: bool,
     /// How its rays are answered.
     visibility: Visibility,
     /// The blocking triangles that may meet its rays, when `visibility` is `Few`.
@@ -318,7 +387,14 @@ struct PatchPlan {
 
 impl Default for PatchPlan {
     fn default() -> Self {
-        Self { live: false, far: false, facing: false, visibility: Visibility::Tree, candidates: Vec::new() }
+        Self {
+            live: false,
+            far: false,
+            facing: false,
+            touching: false,
+            visibility: Visibility::Tree,
+            candidates: Vec::new(),
+        }
     }
 }
 
@@ -387,6 +463,10 @@ impl Solver {
             row_bytes: 0,
             cdf: vec![0.0; n],
             cdf_frozen: vec![false; mesh.patches.len()],
+            density: vec![1.0; n],
+            nonuniform: vec![false; mesh.patches.len()],
+            clusters: Vec::new(),
+            cluster_order: Vec::new(),
             shooter_elements: Vec::new(),
             factors: vec![(0.0, 0); n],
             ray_offset: 1e-6 * (hi - lo).length(),
@@ -651,6 +731,16 @@ impl Solver {
         for c in &mut self.cdf[first..end] {
             *c /= acc;
         }
+        // Density of each element's share against an even spread: share_k · A_p / A_k.
+        let area = self.mesh.patches[shooter].area;
+        let mut below = 0.0;
+        let mut nonuniform = false;
+        for ((d, &c), el) in self.density[first..end].iter_mut().zip(&self.cdf[first..end]).zip(elements) {
+            *d = (c - below) * area / el.area;
+            below = c;
+            nonuniform |= (*d - 1.0).abs() > NONUNIFORM;
+        }
+        self.nonuniform[shooter] = nonuniform;
     }
 
     /// The form factor from every element to `shooter`, visibility included.
@@ -673,20 +763,23 @@ impl Solver {
             plan.live = q != shooter
                 && in_front(r.corners(), patch.centre, patch.normal)
                 && in_front(corners, r.centre, r.normal);
+            let strictly = |pts: &[DVec3], c: DVec3, n: DVec3| {
+                pts.iter().all(|p| n.dot(*p - c) > 1e-9 * patch.area.sqrt())
+            };
+            let facing = plan.live
+                && strictly(r.corners(), corners[0], patch.normal)
+                && strictly(corners, mesh.elements[r.elements.start as usize].centre, r.normal);
+            plan.touching = plan.live && !facing;
             if !plan.live || reference {
                 plan.far = false;
                 plan.facing = false;
                 plan.visibility = Visibility::Tree;
                 return;
             }
+            plan.facing = facing;
             // Each element's own test (`quadrature`) is k·r_e < d(c_e) − r_e, and d(c_e) ≥ d(c_q) − r_q for
             // every element centre c_e of the patch, so this implies it for all of them.
             let patch_radius = r.corners().iter().map(|p| p.distance(r.centre)).fold(0.0, f64::max);
-            let strictly = |pts: &[DVec3], c: DVec3, n: DVec3| {
-                pts.iter().all(|p| n.dot(*p - c) > 1e-9 * patch.area.sqrt())
-            };
-            plan.facing = strictly(r.corners(), corners[0], patch.normal)
-                && strictly(corners, mesh.elements[r.elements.start as usize].centre, r.normal);
             plan.far = (MIDPOINT_RATIO + 1.0) * radius[q]
                 < distance_to_polygon(r.centre, patch.normal, corners) - patch_radius;
             plan.visibility = blockers.gather(
@@ -708,14 +801,29 @@ impl Solver {
                 *slot = p;
             }
             let count = mesh.elements[e as usize].vertex_count;
-            self.shooter_elements.push(ShooterElement { corners, count });
+            let centre = mesh.elements[e as usize].centre;
+            let radius = element_radius(&mesh, e as usize);
+            let area = mesh.elements[e as usize].area;
+            self.shooter_elements.push(ShooterElement { corners, count, centre, radius, area });
         }
 
+        let density = &self.density[patch.elements.start as usize..patch.elements.end as usize];
+        self.clusters.clear();
+        self.cluster_order.clear();
+        if self.nonuniform[shooter] {
+            self.cluster_order.extend(0..self.shooter_elements.len() as u32);
+            build_clusters(&mut self.cluster_order, 0, &self.shooter_elements, density, &mut self.clusters);
+        }
         let shot = Shot {
             mesh: &mesh,
             shooter: patch,
             shooter_cdf: &self.cdf[patch.elements.start as usize..patch.elements.end as usize],
             shooter_elements: &self.shooter_elements,
+            uneven: self.nonuniform[shooter].then_some(Uneven {
+                density,
+                clusters: &self.clusters,
+                order: &self.cluster_order,
+            }),
             accel: &*self.accel,
             boxes: &self.occluder_boxes,
             blockers: &self.blockers,
@@ -748,6 +856,15 @@ impl Solver {
 fn plan_entries(plans: &[PatchPlan]) -> usize {
     plans.len() + plans.iter().map(|p| p.candidates.len()).sum::<usize>()
 }
+
+/// A shooter with an element whose unshot density strays from the mean by more than this
+/// share weights the form factors of the receivers that touch it (see `receive`). The density
+/// is fixed at the shooter's first shot, so only strong, lasting structure is trusted:
+/// shadows and contact lines (a block standing on the patch: dark under it on every shot),
+/// not the gentle gradients of indirect light, which change from shot to shot. Measured: at
+/// 0.05 the ρ = 0.5 furnace's elements drift 2.4 % from E/(1 − ρ); at 0.5 they stay within
+/// its 0.5 % test, and the Cornell box's coarse patches match 35 mm shooters to 0.8 % RMS.
+const NONUNIFORM: f64 = 0.5;
 
 /// Most plan entries (receiving patches plus candidate triangles) kept across shots: about
 /// 40 MB, every shooter's row for a scene of a thousand patches.
@@ -796,6 +913,8 @@ struct Shot<'a> {
     shooter_cdf: &'a [f64],
     /// The shooter's elements, in the order of `shooter_cdf`.
     shooter_elements: &'a [ShooterElement],
+    /// How the shooter's unshot radiosity is spread, when it is uneven.
+    uneven: Option<Uneven<'a>>,
     accel: &'a dyn RayQuery,
     boxes: &'a OccluderBoxes,
     blockers: &'a Blockers,
@@ -825,8 +944,19 @@ fn element_radius(mesh: &Mesh, e: usize) -> f64 {
 
 /// Form factor F_{e→shooter} (with visibility) and the number of rays traced.
 fn receive(shot: &Shot, plan: &PatchPlan, e: usize) -> (f64, u32) {
-    let Shot { mesh, shooter, shooter_cdf, shooter_elements, accel, boxes, blockers, params, offset, stream } =
-        *shot;
+    let Shot {
+        mesh,
+        shooter,
+        shooter_cdf,
+        shooter_elements,
+        uneven,
+        accel,
+        boxes,
+        blockers,
+        params,
+        offset,
+        stream,
+    } = *shot;
     let el = &mesh.elements[e];
     let mut pts = [DVec3::ZERO; 4];
     for (k, p) in mesh.element_corners(e).enumerate() {
@@ -854,6 +984,18 @@ fn receive(shot: &Shot, plan: &PatchPlan, e: usize) -> (f64, u32) {
             } else if plan.facing {
                 let eval = if fast { point_to_polygon_in_front_x4 } else { point_to_polygon_in_front };
                 for_each_point(receiver, n, rule, |p, w| f += w * eval(p, el.normal, corners));
+            } else if let Some(uneven) = uneven.filter(|_| plan.touching) {
+                // A receiver on or across the shooter's plane sees only part of it (a block side
+                // sees the floor in front of it, not under it), so the shooter's mean unshot
+                // radiosity is wrong for it when that radiosity is uneven: the transfer is
+                // Σ_k ΔB_k F_{j→k} = ΔB̄ Σ_k d_k F_{j→k}, d_k = ΔB_k/ΔB̄. The form factor keeps
+                // its quadrature; the density's weighting is taken at the element's centre.
+                for_each_point(receiver, n, rule, |p, w| {
+                    if shooter.normal.dot(p - corners[0]) > 0.0 {
+                        f += w * point_to_polygon(p, el.normal, corners);
+                    }
+                });
+                f *= density_weight(el.centre, el.normal, shooter.normal, &uneven, shooter_elements);
             } else {
                 // Clipped polygons keep the f64 loop: their receivers sit next to the shooter,
                 // where nearly parallel edge vectors make f32 lose digits.
@@ -896,13 +1038,36 @@ fn receive(shot: &Shot, plan: &PatchPlan, e: usize) -> (f64, u32) {
     // Visibility: stratified jittered rays between the element and the shooter.
     let k = params.visibility_rays;
     let mut rng = Rng::for_task(params.seed, stream, e as u64);
+    // The form factor counts only the part of the shooter in front of the receiver point
+    // (and receiver points in front of the shooter), so the visibility must be the fraction
+    // of *that* part that is unblocked. A ray to a shooter point behind the receiver's plane
+    // would pass through the receiver's own object and count as blocked: the light of a
+    // lamp half behind a block's side, say, would be cut twice (the block sides of the
+    // Cornell box lost up to 60 % of their direct light that way). Such pairs are redrawn.
+    let clipped = !plan.facing;
+    let ahead =
+        |from: DVec3, to: DVec3| el.normal.dot(to - from) > 0.0 && shooter.normal.dot(from - to) > 0.0;
     let mut visible = 0;
+    let mut traced = 0;
     for i in 0..k {
         let (u, v) = stratified(i, k, &mut rng);
-        let from = point_on(receiver, u, v) + el.normal * offset;
+        let mut from = point_on(receiver, u, v);
         let (u, v) = stratified(i, k, &mut rng);
-        let to = shooter_point(shooter_cdf, shooter_elements, u, v) + shooter.normal * offset;
-        let (from, to) = (from.as_vec3(), to.as_vec3());
+        let mut to = shooter_point(shooter_cdf, shooter_elements, u, v);
+        if clipped && !ahead(from, to) {
+            let mut tries = 0;
+            while !ahead(from, to) && tries < REDRAWS {
+                from = point_on(receiver, rng.next_f64(), rng.next_f64());
+                to = shooter_point(shooter_cdf, shooter_elements, rng.next_f64(), rng.next_f64());
+                tries += 1;
+            }
+            if !ahead(from, to) {
+                continue;
+            }
+        }
+        let from = (from + el.normal * offset).as_vec3();
+        let to = (to + shooter.normal * offset).as_vec3();
+        traced += 1;
         let blocked = if few {
             blockers.occluded_by_reordering(from, to, candidates)
         } else {
@@ -912,5 +1077,43 @@ fn receive(shot: &Shot, plan: &PatchPlan, e: usize) -> (f64, u32) {
             visible += 1;
         }
     }
-    (unoccluded * f64::from(visible) / f64::from(k), k)
+    if traced == 0 {
+        // The part of each that faces the other is too small to hit: take it as unblocked.
+        return (unoccluded, 0);
+    }
+    (unoccluded * f64::from(visible) / f64::from(traced), traced)
 }
+
+/// Σ_k d_k F_{p→k} / Σ_k F_{p→k} over the shooter's elements k: how much brighter than its
+/// mean the shooter looks from `p`; 1 when `p` sees none of it.
+/// Clusters more than four radii away count as one element.
+fn density_weight(p: DVec3, n: DVec3, ns: DVec3, uneven: &Uneven, elements: &[ShooterElement]) -> f64 {
+    let (mut weighted, mut plain) = (0.0, 0.0);
+    for c in uneven.clusters {
+        if c.centre.distance_squared(p) >= 16.0 * c.radius * c.radius {
+            let f = point_to_point(p, n, c.centre, ns, c.area);
+            weighted += c.density * f;
+            plain += f;
+            continue;
+        }
+        for &k in &uneven.order[c.members.clone()] {
+            let f = elements[k as usize].factor_from(p, n, ns);
+            weighted += uneven.density[k as usize] * f;
+            plain += f;
+        }
+    }
+    if plain > 0.0 { weighted / plain } else { 1.0 }
+}
+
+/// How an uneven shooter's unshot radiosity is spread over its elements.
+#[derive(Clone, Copy)]
+struct Uneven<'a> {
+    /// Per shooter element, its unshot radiosity over the shooter's mean.
+    density: &'a [f64],
+    clusters: &'a [Cluster],
+    /// Shooter element indices, cluster after cluster.
+    order: &'a [u32],
+}
+
+/// Random redraws of a ray whose ends do not face each other, before it is given up.
+const REDRAWS: u32 = 16;
