@@ -7,8 +7,8 @@
 //! Cases: (a) occlusion rays on a ~100 k-triangle Cornell box (finely tessellated blocks and
 //! two spheres), incoherent surface-to-surface segments, 1 thread and all threads;
 //! (b) the source document's case, ≥ 100 facets × 1000 shots; (c) the Cornell box at ~10 k
-//! elements (fast and reference path) and ~100 k elements to unshot 1e-3; (d) the peak heap
-//! of every solve case and the bytes per element.
+//! elements (fast and reference path), ~15 k on one thread and ~100 k elements to unshot
+//! 1e-3; (d) the peak heap of every solve case and the bytes per element.
 
 use std::f64::consts::PI;
 use std::io::Write;
@@ -284,6 +284,16 @@ pub fn run(a: BenchArgs) -> Result<()> {
     println!("    fast path {ratio:.2}× faster than the reference path");
     cases.push(json!({"case": "cornell_10k_fast_vs_reference", "fast": fast, "reference": reference,
         "speedup": ratio}));
+    // The single-core target: ~15 k elements on one thread.
+    let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
+    cases.push(one_thread.install(|| {
+        solve_case(
+            "cornell_15k_1_thread",
+            "(c) Cornell ~15 k elements, 1 thread",
+            || cornell_mesh(&cornell, 14.3),
+            SolverParams::default(),
+        )
+    })?);
     if !a.skip_large {
         cases.push(solve_case(
             "cornell_100k",

@@ -189,7 +189,10 @@ fn bench_writes_every_case_as_json() {
     let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     let cases = v["cases"].as_array().unwrap();
     let ids: Vec<&str> = cases.iter().map(|c| c["case"].as_str().unwrap()).collect();
-    assert_eq!(ids, ["occlusion_rays", "source_document", "cornell_10k_fast_vs_reference"]);
+    assert_eq!(
+        ids,
+        ["occlusion_rays", "source_document", "cornell_10k_fast_vs_reference", "cornell_15k_1_thread"]
+    );
     assert!(cases[0]["triangles"].as_u64().unwrap() > 100_000);
     assert_eq!(cases[1]["shots"].as_u64(), Some(1000));
     assert!(cases[1]["elements"].as_u64().unwrap() >= 100);
@@ -198,4 +201,5 @@ fn bench_writes_every_case_as_json() {
     assert_eq!(fast["elements"], reference["elements"]);
     assert_eq!(fast["shots"], reference["shots"]);
     assert!(fast["peak_heap_bytes"].as_u64().unwrap() > 0);
+    assert!(cases[3]["elements"].as_u64().unwrap() > 14_000);
 }
