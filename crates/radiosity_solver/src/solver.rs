@@ -274,6 +274,7 @@ pub struct Solver {
     nonuniform: Vec<bool>,
     clusters: Vec<Cluster>,
     cluster_order: Vec<u32>,
+    guide: Vec<u32>,
     shooter_elements: Vec<ShooterElement>,
 }
 
@@ -467,6 +468,7 @@ impl Solver {
             nonuniform: vec![false; mesh.patches.len()],
             clusters: Vec::new(),
             cluster_order: Vec::new(),
+            guide: Vec::new(),
             shooter_elements: Vec::new(),
             factors: vec![(0.0, 0); n],
             ray_offset: 1e-6 * (hi - lo).length(),
@@ -808,6 +810,8 @@ impl Solver {
         }
 
         let density = &self.density[patch.elements.start as usize..patch.elements.end as usize];
+        let shooter_cdf = &self.cdf[patch.elements.start as usize..patch.elements.end as usize];
+        ShooterCdf::build_guide(shooter_cdf, &mut self.guide);
         self.clusters.clear();
         self.cluster_order.clear();
         if self.nonuniform[shooter] {
@@ -817,7 +821,7 @@ impl Solver {
         let shot = Shot {
             mesh: &mesh,
             shooter: patch,
-            shooter_cdf: &self.cdf[patch.elements.start as usize..patch.elements.end as usize],
+            shooter_cdf: ShooterCdf { cdf: shooter_cdf, guide: &self.guide },
             shooter_elements: &self.shooter_elements,
             uneven: self.nonuniform[shooter].then_some(Uneven {
                 density,
@@ -910,7 +914,7 @@ struct Shot<'a> {
     mesh: &'a Mesh,
     shooter: &'a radiosity_core::Patch,
     /// Cumulative share of the shooter's unshot power over its elements, ending at 1.
-    shooter_cdf: &'a [f64],
+    shooter_cdf: ShooterCdf<'a>,
     /// The shooter's elements, in the order of `shooter_cdf`.
     shooter_elements: &'a [ShooterElement],
     /// How the shooter's unshot radiosity is spread, when it is uneven.
@@ -928,12 +932,51 @@ struct Shot<'a> {
 /// The point at `(u, v)` ∈ [0,1)² on the shooter, drawn by unshot power: `u` picks the
 /// element from the cumulative shares and, rescaled into that element's share, places the
 /// point within it with `v`, so stratification in `(u, v)` carries over.
-fn shooter_point(cdf: &[f64], elements: &[ShooterElement], u: f64, v: f64) -> DVec3 {
-    let k = cdf.partition_point(|&c| c <= u).min(cdf.len() - 1);
+fn shooter_point(shares: ShooterCdf, elements: &[ShooterElement], u: f64, v: f64) -> DVec3 {
+    let (cdf, k) = (shares.cdf, shares.element(u));
     let below = if k == 0 { 0.0 } else { cdf[k - 1] };
     let share = cdf[k] - below;
     let u = if share > 0.0 { ((u - below) / share).clamp(0.0, 1.0 - f64::EPSILON) } else { 0.5 };
     point_on(elements[k].corners(), u, v)
+}
+
+/// The shooter's cumulative shares with a guide table (Chen & Asau 1974's indexed search):
+/// bucket `b` of `G` holds the first element whose share ends above `b/G`, so a draw starts
+/// its scan there instead of bisecting (a binary search per ray was 16 % of a solve).
+#[derive(Clone, Copy)]
+struct ShooterCdf<'a> {
+    cdf: &'a [f64],
+    guide: &'a [u32],
+}
+
+impl ShooterCdf<'_> {
+    /// Fills `guide` for `cdf`, one bucket per element (at least 16).
+    fn build_guide(cdf: &[f64], guide: &mut Vec<u32>) {
+        let buckets = cdf.len().max(16);
+        guide.clear();
+        let mut k = 0;
+        for b in 0..buckets {
+            let t = b as f64 / buckets as f64;
+            while k + 1 < cdf.len() && cdf[k] <= t {
+                k += 1;
+            }
+            guide.push(k as u32);
+        }
+    }
+
+    /// The first element whose cumulative share exceeds `u` (the last when none does).
+    fn element(&self, u: f64) -> usize {
+        let b = ((u * self.guide.len() as f64) as usize).min(self.guide.len() - 1);
+        let mut k = self.guide[b] as usize;
+        // The bucket's start never passes the answer, except where u·G rounds up.
+        while k > 0 && self.cdf[k - 1] > u {
+            k -= 1;
+        }
+        while k + 1 < self.cdf.len() && self.cdf[k] <= u {
+            k += 1;
+        }
+        k
+    }
 }
 
 /// Circumradius of element `e` about its centre.
@@ -1117,3 +1160,42 @@ struct Uneven<'a> {
 
 /// Random redraws of a ray whose ends do not face each other, before it is given up.
 const REDRAWS: u32 = 16;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The guide table finds the same element as a bisection, for uneven shares (zero shares
+    /// and a share that is nearly all of it included) and draws at and between bucket edges.
+    #[test]
+    fn guided_draws_pick_the_same_element_as_bisection() {
+        let mut rng = Rng::for_task(3, 0, 0);
+        let mut guide = Vec::new();
+        for case in 0..300 {
+            let n = 1 + case % 70;
+            let mut acc = 0.0;
+            let mut cdf: Vec<f64> = (0..n)
+                .map(|i| {
+                    acc += match (case + i) % 5 {
+                        0 => 0.0,
+                        1 => 1e3,
+                        _ => rng.next_f64(),
+                    };
+                    acc
+                })
+                .collect();
+            if acc == 0.0 {
+                continue;
+            }
+            cdf.iter_mut().for_each(|c| *c /= acc);
+            ShooterCdf::build_guide(&cdf, &mut guide);
+            let shares = ShooterCdf { cdf: &cdf, guide: &guide };
+            let edges = (0..=guide.len()).map(|b| b as f64 / guide.len() as f64);
+            for u in edges.chain((0..200).map(|_| rng.next_f64())).chain(cdf.iter().copied()) {
+                let u = u.min(1.0 - f64::EPSILON);
+                let expected = cdf.partition_point(|&c| c <= u).min(n - 1);
+                assert_eq!(shares.element(u), expected, "case {case}, u {u}");
+            }
+        }
+    }
+}
