@@ -79,6 +79,9 @@ pub struct SolveOpts {
     /// Visibility rays per receiver and shooter.
     #[arg(long, default_value_t = 4)]
     pub visibility_rays: u32,
+    /// More rays for a receiver whose first visibility rays disagree (a penumbra); 0: none.
+    #[arg(long, default_value_t = 12)]
+    pub penumbra_rays: u32,
     /// Memory for keeping each shooter's form factors for its next shots, in MiB (0: keep
     /// none; the answer is the same, only slower).
     #[arg(long, default_value_t = 256, value_name = "MIB")]
@@ -156,6 +159,7 @@ pub fn settings(scene_arg: &str, o: &SolveOpts) -> Result<Settings> {
             FormFactorArg::Point => FormFactorMethod::PointToPoint,
         },
         visibility_rays: o.visibility_rays,
+        penumbra_rays: o.penumbra_rays,
         unshot_threshold: o.unshot_threshold.or(scene.solver.unshot_threshold).unwrap_or(1e-3),
         max_shots: o.max_shots.or(scene.solver.max_shots),
         time_limit,
