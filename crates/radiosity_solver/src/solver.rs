@@ -1031,18 +1031,6 @@ fn receive(shot: &Shot, plan: &PatchPlan, e: usize) -> (f64, u32) {
             } else if plan.facing {
                 let eval = if fast { point_to_polygon_in_front_x4 } else { point_to_polygon_in_front };
                 for_each_point(receiver, n, rule, |p, w| f += w * eval(p, el.normal, corners));
-            } else if let Some(uneven) = uneven.filter(|_| plan.touching) {
-                // A receiver on or across the shooter's plane sees only part of it (a block side
-                // sees the floor in front of it, not under it), so the shooter's mean unshot
-                // radiosity is wrong for it when that radiosity is uneven: the transfer is
-                // Σ_k ΔB_k F_{j→k} = ΔB̄ Σ_k d_k F_{j→k}, d_k = ΔB_k/ΔB̄. The form factor keeps
-                // its quadrature; the density's weighting is taken at the element's centre.
-                for_each_point(receiver, n, rule, |p, w| {
-                    if shooter.normal.dot(p - corners[0]) > 0.0 {
-                        f += w * point_to_polygon(p, el.normal, corners);
-                    }
-                });
-                f *= density_weight(el.centre, el.normal, shooter.normal, &uneven, shooter_elements);
             } else {
                 // Clipped polygons keep the f64 loop: their receivers sit next to the shooter,
                 // where nearly parallel edge vectors make f32 lose digits.
@@ -1051,6 +1039,14 @@ fn receive(shot: &Shot, plan: &PatchPlan, e: usize) -> (f64, u32) {
                         f += w * point_to_polygon(p, el.normal, corners);
                     }
                 });
+                if let Some(uneven) = uneven.filter(|_| plan.touching) {
+                    // A receiver on or across the shooter's plane sees only part of it (a block
+                    // side sees the floor in front of it, not under it), so the shooter's mean
+                    // unshot radiosity is wrong for it when that radiosity is uneven: the
+                    // transfer is Σ_k ΔB_k F_{j→k} = ΔB̄ Σ_k d_k F_{j→k}, d_k = ΔB_k/ΔB̄. The
+                    // form factor keeps its quadrature; the weighting is taken at the centre.
+                    f *= density_weight(el.centre, el.normal, shooter.normal, &uneven, shooter_elements);
+                }
             }
             f
         }
