@@ -279,6 +279,7 @@ pub struct Solver {
     clusters: Vec<Cluster>,
     cluster_order: Vec<u32>,
     guide: Vec<u32>,
+    targets: Vec<DVec3>,
     shooter_elements: Vec<ShooterElement>,
 }
 
@@ -473,6 +474,7 @@ impl Solver {
             clusters: Vec::new(),
             cluster_order: Vec::new(),
             guide: Vec::new(),
+            targets: Vec::new(),
             shooter_elements: Vec::new(),
             factors: vec![(0.0, 0); n],
             ray_offset: 1e-6 * (hi - lo).length(),
@@ -816,6 +818,19 @@ impl Solver {
         let density = &self.density[patch.elements.start as usize..patch.elements.end as usize];
         let shooter_cdf = &self.cdf[patch.elements.start as usize..patch.elements.end as usize];
         ShooterCdf::build_guide(shooter_cdf, &mut self.guide);
+        // Ray ends: one jittered point per cell of a TARGETS × TARGETS grid over the unit
+        // square, mapped onto the shooter by unshot power. A ray's stratified (u, v) picks its
+        // cell's point, so the rays keep their stratification and cost a lookup each.
+        let shares = ShooterCdf { cdf: shooter_cdf, guide: &self.guide };
+        let mut rng = Rng::for_task(self.params.seed, shooter as u64, u64::MAX);
+        self.targets.clear();
+        for b in 0..TARGETS {
+            for a in 0..TARGETS {
+                let u = (a as f64 + rng.next_f64()) / TARGETS as f64;
+                let v = (b as f64 + rng.next_f64()) / TARGETS as f64;
+                self.targets.push(shooter_point(shares, &self.shooter_elements, u, v));
+            }
+        }
         self.clusters.clear();
         self.cluster_order.clear();
         if self.nonuniform[shooter] {
@@ -825,7 +840,7 @@ impl Solver {
         let shot = Shot {
             mesh: &mesh,
             shooter: patch,
-            shooter_cdf: ShooterCdf { cdf: shooter_cdf, guide: &self.guide },
+            targets: &self.targets,
             shooter_elements: &self.shooter_elements,
             uneven: self.nonuniform[shooter].then_some(Uneven {
                 density,
@@ -918,8 +933,9 @@ struct Shot<'a> {
     mesh: &'a Mesh,
     shooter: &'a radiosity_core::Patch,
     /// Cumulative share of the shooter's unshot power over its elements, ending at 1.
-    shooter_cdf: ShooterCdf<'a>,
-    /// The shooter's elements, in the order of `shooter_cdf`.
+    /// Ray ends on the shooter, `TARGETS`² of them, row after row (see [`target`]).
+    targets: &'a [DVec3],
+    /// The shooter's elements.
     shooter_elements: &'a [ShooterElement],
     /// How the shooter's unshot radiosity is spread, when it is uneven.
     uneven: Option<Uneven<'a>>,
@@ -942,6 +958,16 @@ fn shooter_point(shares: ShooterCdf, elements: &[ShooterElement], u: f64, v: f64
     let share = cdf[k] - below;
     let u = if share > 0.0 { ((u - below) / share).clamp(0.0, 1.0 - f64::EPSILON) } else { 0.5 };
     point_on(elements[k].corners(), u, v)
+}
+
+/// Ray-end cells per side of the unit square (see `Solver::transfer_row`): 256 points on
+/// each shooter, far more than the 4 to 16 rays of one receiver.
+const TARGETS: usize = 16;
+
+/// The ray end of the cell that holds `(u, v)` ∈ [0,1)².
+fn target(targets: &[DVec3], u: f64, v: f64) -> DVec3 {
+    let cell = |x: f64| ((x * TARGETS as f64) as usize).min(TARGETS - 1);
+    targets[cell(v) * TARGETS + cell(u)]
 }
 
 /// The shooter's cumulative shares with a guide table (Chen & Asau 1974's indexed search):
@@ -994,7 +1020,7 @@ fn receive(shot: &Shot, plan: &PatchPlan, e: usize) -> (f64, u32) {
     let Shot {
         mesh,
         shooter,
-        shooter_cdf,
+        targets,
         shooter_elements,
         uneven,
         accel,
@@ -1097,12 +1123,12 @@ fn receive(shot: &Shot, plan: &PatchPlan, e: usize) -> (f64, u32) {
             let (u, v) = stratified(i, count, rng);
             let mut from = point_on(receiver, u, v);
             let (u, v) = stratified(i, count, rng);
-            let mut to = shooter_point(shooter_cdf, shooter_elements, u, v);
+            let mut to = target(targets, u, v);
             if clipped && !ahead(from, to) {
                 let mut tries = 0;
                 while !ahead(from, to) && tries < REDRAWS {
                     from = point_on(receiver, rng.next_f64(), rng.next_f64());
-                    to = shooter_point(shooter_cdf, shooter_elements, rng.next_f64(), rng.next_f64());
+                    to = target(targets, rng.next_f64(), rng.next_f64());
                     tries += 1;
                 }
                 if !ahead(from, to) {
