@@ -278,7 +278,6 @@ pub struct Solver {
     nonuniform: Vec<bool>,
     clusters: Vec<Cluster>,
     cluster_order: Vec<u32>,
-    guide: Vec<u32>,
     targets: Vec<DVec3>,
     shooter_elements: Vec<ShooterElement>,
 }
@@ -473,7 +472,6 @@ impl Solver {
             nonuniform: vec![false; mesh.patches.len()],
             clusters: Vec::new(),
             cluster_order: Vec::new(),
-            guide: Vec::new(),
             targets: Vec::new(),
             shooter_elements: Vec::new(),
             factors: vec![(0.0, 0); n],
@@ -655,14 +653,15 @@ impl Solver {
         self.apply(shooter, &row, omega);
         let bytes = row.bytes();
         if kept || (!self.params.reference_path && self.row_bytes + bytes <= self.params.row_cache_bytes) {
-            if !kept {
-                self.row_bytes += bytes;
-                // The plans only serve to compute the row again.
-                if let Some(plans) = self.plan_rows[shooter].take() {
-                    self.plan_entries -= plan_entries(&plans);
-                }
-            }
+            self.row_bytes += if kept { 0 } else { bytes };
             self.rows[shooter] = Some(row);
+        } else if self.plan_rows[shooter].is_none() {
+            // The row will be computed again: keep its plans (still in `self.plans`).
+            let entries = plan_entries(&self.plans);
+            if self.plan_entries + entries <= PLAN_CACHE_ENTRIES {
+                self.plan_entries += entries;
+                self.plan_rows[shooter] = Some(self.plans.clone().into_boxed_slice());
+            }
         }
 
         self.shots += 1;
@@ -795,11 +794,6 @@ impl Solver {
                 &mut plan.candidates,
             );
         });
-        let entries = plan_entries(&self.plans);
-        if !cached && self.plan_entries + entries <= PLAN_CACHE_ENTRIES {
-            self.plan_entries += entries;
-            self.plan_rows[shooter] = Some(self.plans.clone().into_boxed_slice());
-        }
 
         self.freeze_cdf(shooter);
         self.shooter_elements.clear();
@@ -817,18 +811,16 @@ impl Solver {
 
         let density = &self.density[patch.elements.start as usize..patch.elements.end as usize];
         let shooter_cdf = &self.cdf[patch.elements.start as usize..patch.elements.end as usize];
-        ShooterCdf::build_guide(shooter_cdf, &mut self.guide);
         // Ray ends: one jittered point per cell of a TARGETS × TARGETS grid over the unit
         // square, mapped onto the shooter by unshot power. A ray's stratified (u, v) picks its
         // cell's point, so the rays keep their stratification and cost a lookup each.
-        let shares = ShooterCdf { cdf: shooter_cdf, guide: &self.guide };
         let mut rng = Rng::for_task(self.params.seed, shooter as u64, u64::MAX);
         self.targets.clear();
         for b in 0..TARGETS {
             for a in 0..TARGETS {
                 let u = (a as f64 + rng.next_f64()) / TARGETS as f64;
                 let v = (b as f64 + rng.next_f64()) / TARGETS as f64;
-                self.targets.push(shooter_point(shares, &self.shooter_elements, u, v));
+                self.targets.push(shooter_point(shooter_cdf, &self.shooter_elements, u, v));
             }
         }
         self.clusters.clear();
@@ -932,7 +924,6 @@ const MIDPOINT_RATIO: f64 = 16.0;
 struct Shot<'a> {
     mesh: &'a Mesh,
     shooter: &'a radiosity_core::Patch,
-    /// Cumulative share of the shooter's unshot power over its elements, ending at 1.
     /// Ray ends on the shooter, `TARGETS`² of them, row after row (see [`target`]).
     targets: &'a [DVec3],
     /// The shooter's elements.
@@ -952,8 +943,8 @@ struct Shot<'a> {
 /// The point at `(u, v)` ∈ [0,1)² on the shooter, drawn by unshot power: `u` picks the
 /// element from the cumulative shares and, rescaled into that element's share, places the
 /// point within it with `v`, so stratification in `(u, v)` carries over.
-fn shooter_point(shares: ShooterCdf, elements: &[ShooterElement], u: f64, v: f64) -> DVec3 {
-    let (cdf, k) = (shares.cdf, shares.element(u));
+fn shooter_point(cdf: &[f64], elements: &[ShooterElement], u: f64, v: f64) -> DVec3 {
+    let k = cdf.partition_point(|&c| c <= u).min(cdf.len() - 1);
     let below = if k == 0 { 0.0 } else { cdf[k - 1] };
     let share = cdf[k] - below;
     let u = if share > 0.0 { ((u - below) / share).clamp(0.0, 1.0 - f64::EPSILON) } else { 0.5 };
@@ -968,45 +959,6 @@ const TARGETS: usize = 16;
 fn target(targets: &[DVec3], u: f64, v: f64) -> DVec3 {
     let cell = |x: f64| ((x * TARGETS as f64) as usize).min(TARGETS - 1);
     targets[cell(v) * TARGETS + cell(u)]
-}
-
-/// The shooter's cumulative shares with a guide table (Chen & Asau 1974's indexed search):
-/// bucket `b` of `G` holds the first element whose share ends above `b/G`, so a draw starts
-/// its scan there instead of bisecting (a binary search per ray was 16 % of a solve).
-#[derive(Clone, Copy)]
-struct ShooterCdf<'a> {
-    cdf: &'a [f64],
-    guide: &'a [u32],
-}
-
-impl ShooterCdf<'_> {
-    /// Fills `guide` for `cdf`, one bucket per element (at least 16).
-    fn build_guide(cdf: &[f64], guide: &mut Vec<u32>) {
-        let buckets = cdf.len().max(16);
-        guide.clear();
-        let mut k = 0;
-        for b in 0..buckets {
-            let t = b as f64 / buckets as f64;
-            while k + 1 < cdf.len() && cdf[k] <= t {
-                k += 1;
-            }
-            guide.push(k as u32);
-        }
-    }
-
-    /// The first element whose cumulative share exceeds `u` (the last when none does).
-    fn element(&self, u: f64) -> usize {
-        let b = ((u * self.guide.len() as f64) as usize).min(self.guide.len() - 1);
-        let mut k = self.guide[b] as usize;
-        // The bucket's start never passes the answer, except where u·G rounds up.
-        while k > 0 && self.cdf[k - 1] > u {
-            k -= 1;
-        }
-        while k + 1 < self.cdf.len() && self.cdf[k] <= u {
-            k += 1;
-        }
-        k
-    }
 }
 
 /// Circumradius of element `e` about its centre.
@@ -1124,16 +1076,14 @@ fn receive(shot: &Shot, plan: &PatchPlan, e: usize) -> (f64, u32) {
             let mut from = point_on(receiver, u, v);
             let (u, v) = stratified(i, count, rng);
             let mut to = target(targets, u, v);
+            let mut tries = 0;
+            while clipped && !ahead(from, to) && tries < REDRAWS {
+                from = point_on(receiver, rng.next_f64(), rng.next_f64());
+                to = target(targets, rng.next_f64(), rng.next_f64());
+                tries += 1;
+            }
             if clipped && !ahead(from, to) {
-                let mut tries = 0;
-                while !ahead(from, to) && tries < REDRAWS {
-                    from = point_on(receiver, rng.next_f64(), rng.next_f64());
-                    to = target(targets, rng.next_f64(), rng.next_f64());
-                    tries += 1;
-                }
-                if !ahead(from, to) {
-                    continue;
-                }
+                continue;
             }
             let from = (from + el.normal * offset).as_vec3();
             let to = (to + shooter.normal * offset).as_vec3();
@@ -1198,42 +1148,3 @@ struct Uneven<'a> {
 
 /// Random redraws of a ray whose ends do not face each other, before it is given up.
 const REDRAWS: u32 = 16;
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The guide table finds the same element as a bisection, for uneven shares (zero shares
-    /// and a share that is nearly all of it included) and draws at and between bucket edges.
-    #[test]
-    fn guided_draws_pick_the_same_element_as_bisection() {
-        let mut rng = Rng::for_task(3, 0, 0);
-        let mut guide = Vec::new();
-        for case in 0..300 {
-            let n = 1 + case % 70;
-            let mut acc = 0.0;
-            let mut cdf: Vec<f64> = (0..n)
-                .map(|i| {
-                    acc += match (case + i) % 5 {
-                        0 => 0.0,
-                        1 => 1e3,
-                        _ => rng.next_f64(),
-                    };
-                    acc
-                })
-                .collect();
-            if acc == 0.0 {
-                continue;
-            }
-            cdf.iter_mut().for_each(|c| *c /= acc);
-            ShooterCdf::build_guide(&cdf, &mut guide);
-            let shares = ShooterCdf { cdf: &cdf, guide: &guide };
-            let edges = (0..=guide.len()).map(|b| b as f64 / guide.len() as f64);
-            for u in edges.chain((0..200).map(|_| rng.next_f64())).chain(cdf.iter().copied()) {
-                let u = u.min(1.0 - f64::EPSILON);
-                let expected = cdf.partition_point(|&c| c <= u).min(n - 1);
-                assert_eq!(shares.element(u), expected, "case {case}, u {u}");
-            }
-        }
-    }
-}
