@@ -10,6 +10,10 @@
 #![forbid(unsafe_code)]
 
 use glam::{Vec3, Vec3A};
+mod packet;
+
+pub use packet::Segments4;
+
 use obvhs::{BvhBuildParams, cwbvh::CwBvh, ray::Ray, rt_triangle::RtTriangle, triangle::Triangle};
 
 /// A ray hit: distance and the hit triangle with barycentric coordinates.

@@ -11,7 +11,7 @@
 //! ray — so the answer of a ray is the same as the full query's.
 
 use glam::{DVec3, Vec3};
-use radiosity_accel::BruteForce;
+use radiosity_accel::{BruteForce, Segments4};
 use radiosity_core::Mesh;
 
 /// Above this many blocking triangles the per-patch scan costs more than it saves; every
@@ -136,26 +136,6 @@ impl Blockers {
         }
     }
 
-    /// Narrows `candidates` to those that may block a segment between polygons `a` and `b`
-    /// (box and the two polygon planes only: cheap enough per element), into `out`; returns
-    /// how many were kept.
-    pub(crate) fn narrow(&self, candidates: &[u32], pair: Pair, out: &mut [u32; FEW]) -> usize {
-        let Pair { a, na, b, nb, offset } = pair;
-        let margin = 2.0 * offset + self.slack;
-        let (lo, hi) = bounds(a.iter().chain(b));
-        let (lo, hi) = (lo - DVec3::splat(margin), hi + DVec3::splat(margin));
-        let planes = base_planes(a, na, b, nb, margin);
-        let mut kept = 0;
-        for &i in candidates {
-            let (tlo, thi) = &self.boxes[i as usize];
-            if tlo.cmple(hi).all() && lo.cmple(*thi).all() && !self.outside(i as usize, &planes) {
-                out[kept] = i;
-                kept += 1;
-            }
-        }
-        kept
-    }
-
     /// True when triangle `i` lies wholly outside one of `planes` (each `(n, d)` keeps the
     /// points with `n·x ≥ d`).
     fn outside(&self, i: usize, planes: &[(DVec3, f64)]) -> bool {
@@ -169,17 +149,12 @@ impl Blockers {
         self.brute.occluded_by(from, to, indices)
     }
 
-    /// [`Blockers::occluded_by`] that moves the blocking triangle to the front of `indices`,
-    /// so the next ray of the same element, which likely meets it too, tests it first. The
-    /// answer does not depend on the order.
-    pub(crate) fn occluded_by_reordering(&self, from: Vec3, to: Vec3, indices: &mut [u32]) -> bool {
-        match self.brute.first_blocker(from, to, indices) {
-            Some(k) => {
-                indices.swap(0, k);
-                true
-            }
-            None => false,
-        }
+    /// Which of up to four segments the triangles at `indices` block (bit `i` for segment
+    /// `i`), the full query's answers; the first blocking triangle moves to the front of
+    /// `indices`, so the next rays of the same element, which likely meet it too, test it
+    /// first. The answer does not depend on the order.
+    pub(crate) fn occluded_x4(&self, segments: &Segments4, indices: &mut [u32]) -> u32 {
+        self.brute.occluded_x4(segments, indices)
     }
 }
 
@@ -282,7 +257,6 @@ mod tests {
             if vis == Visibility::Tree {
                 continue;
             }
-            let mut narrowed = [0; FEW];
             for s in 0..200 {
                 let mut rng = Rng::for_task(case, s, 1);
                 let p = point_on(&a, rng.next_f64(), rng.next_f64());
@@ -293,10 +267,9 @@ mod tests {
                         assert!(out.contains(&(t as u32)), "case {case}: triangle {t} blocks but was culled");
                     }
                 }
-                let kept = blockers.narrow(&out, Pair { a: &a, na, b: &b, nb, offset: 0.0 }, &mut narrowed);
                 let all: Vec<u32> = (0..tris.len() as u32).collect();
                 assert_eq!(
-                    blockers.occluded_by(p.as_vec3(), q.as_vec3(), &narrowed[..kept]),
+                    blockers.occluded_by(p.as_vec3(), q.as_vec3(), &out),
                     blockers.occluded_by(p.as_vec3(), q.as_vec3(), &all),
                     "case {case}"
                 );
