@@ -43,9 +43,60 @@ pub(crate) fn point_on(poly: &[DVec3], u: f64, v: f64) -> DVec3 {
     }
 }
 
-/// Stratum `(i, j)` of a `k × k` grid for sample `index` of `count`, jittered by `rng`.
-pub(crate) fn stratified(index: u32, count: u32, rng: &mut Rng) -> (f64, f64) {
-    let k = (count as f64).sqrt().ceil().max(1.0) as u32;
-    let (i, j) = (index % k, (index / k) % k);
-    ((i as f64 + rng.next_f64()) / k as f64, (j as f64 + rng.next_f64()) / k as f64)
+/// Strata for `count` samples in the unit square: ⌈√count⌉ columns and as many rows as it
+/// takes, so that the rows cover the square (12 samples: 4 × 3). A square `k × k` grid for
+/// every count, as this was once, leaves rows empty whenever `count` is not a square: 12
+/// samples on a 4 × 4 grid never reached the last quarter of either patch.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Strata {
+    columns: u32,
+    rows: u32,
+}
+
+impl Strata {
+    /// The grid for `count` samples (at least one cell).
+    pub(crate) fn new(count: u32) -> Self {
+        let columns = (count as f64).sqrt().ceil().max(1.0) as u32;
+        Self { columns, rows: count.div_ceil(columns).max(1) }
+    }
+
+    /// Sample `index`'s stratum, row after row, jittered by `rng`.
+    pub(crate) fn sample(&self, index: u32, rng: &mut Rng) -> (f64, f64) {
+        let (i, j) = (index % self.columns, (index / self.columns) % self.rows);
+        let u = (i as f64 + rng.next_f64()) / self.columns as f64;
+        (u, (j as f64 + rng.next_f64()) / self.rows as f64)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every row and column of the grid holds a sample, and whole grids hold one per cell.
+    #[test]
+    fn strata_cover_the_square_for_every_count() {
+        let mut rng = Rng::for_task(1, 2, 3);
+        for count in 1..=40u32 {
+            let strata = Strata::new(count);
+            let (c, r) = (strata.columns as usize, strata.rows as usize);
+            let mut cells = vec![0u32; c * r];
+            for index in 0..count {
+                let (u, v) = strata.sample(index, &mut rng);
+                assert!((0.0..1.0).contains(&u) && (0.0..1.0).contains(&v), "count {count}: ({u}, {v})");
+                cells[(v * r as f64) as usize * c + (u * c as f64) as usize] += 1;
+            }
+            for row in 0..r {
+                assert!(
+                    cells[row * c..(row + 1) * c].iter().any(|&n| n > 0),
+                    "count {count}: row {row} empty"
+                );
+            }
+            for col in 0..c.min(count as usize) {
+                assert!((0..r).any(|row| cells[row * c + col] > 0), "count {count}: column {col} empty");
+            }
+            if c * r == count as usize {
+                assert!(cells.iter().all(|&n| n == 1), "count {count}: {cells:?}");
+            }
+        }
+    }
 }

@@ -30,7 +30,7 @@ use crate::form_factor::{
     point_to_polygon_in_front_x4,
 };
 use crate::occluders::{OccluderBoxes, blocking_triangles};
-use crate::sampling::{Rng, point_on, stratified};
+use crate::sampling::{Rng, Strata, point_on};
 use crate::shaft::{Blockers, FEW, Pair, Visibility, bounds};
 use crate::solution::{Solution, vertex_average};
 
@@ -279,6 +279,8 @@ pub struct Solver {
     clusters: Vec<Cluster>,
     cluster_order: Vec<u32>,
     targets: Vec<DVec3>,
+    /// `targets` lifted off the shooter by the ray offset, in single precision: ray ends.
+    lifted_targets: Vec<Vec3>,
     shooter_elements: Vec<ShooterElement>,
 }
 
@@ -477,6 +479,7 @@ impl Solver {
             clusters: Vec::new(),
             cluster_order: Vec::new(),
             targets: Vec::new(),
+            lifted_targets: Vec::new(),
             shooter_elements: Vec::new(),
             factors: vec![(0.0, 0); n],
             ray_offset: 1e-6 * (hi - lo).length(),
@@ -834,6 +837,9 @@ impl Solver {
                 self.targets.push(shooter_point(shooter_cdf, &self.shooter_elements, u, v));
             }
         }
+        let lift = patch.normal * self.ray_offset;
+        self.lifted_targets.clear();
+        self.lifted_targets.extend(self.targets.iter().map(|t| (*t + lift).as_vec3()));
         self.clusters.clear();
         self.cluster_order.clear();
         if self.nonuniform[shooter] {
@@ -844,6 +850,7 @@ impl Solver {
             mesh: &mesh,
             shooter: patch,
             targets: &self.targets,
+            lifted_targets: &self.lifted_targets,
             shooter_elements: &self.shooter_elements,
             uneven: self.nonuniform[shooter].then_some(Uneven {
                 density,
@@ -937,6 +944,8 @@ struct Shot<'a> {
     shooter: &'a radiosity_core::Patch,
     /// Ray ends on the shooter, `TARGETS`² of them, row after row (see [`target`]).
     targets: &'a [DVec3],
+    /// The same points lifted off the shooter by `offset`, as the rays take them.
+    lifted_targets: &'a [Vec3],
     /// The shooter's elements.
     shooter_elements: &'a [ShooterElement],
     /// How the shooter's unshot radiosity is spread, when it is uneven.
@@ -966,10 +975,10 @@ fn shooter_point(cdf: &[f64], elements: &[ShooterElement], u: f64, v: f64) -> DV
 /// each shooter, far more than the 4 to 16 rays of one receiver.
 const TARGETS: usize = 16;
 
-/// The ray end of the cell that holds `(u, v)` ∈ [0,1)².
-fn target(targets: &[DVec3], u: f64, v: f64) -> DVec3 {
+/// Index in the ray-end table of the cell that holds `(u, v)` ∈ [0,1)².
+fn target_cell(u: f64, v: f64) -> usize {
     let cell = |x: f64| ((x * TARGETS as f64) as usize).min(TARGETS - 1);
-    targets[cell(v) * TARGETS + cell(u)]
+    cell(v) * TARGETS + cell(u)
 }
 
 /// Circumradius of element `e` about its centre.
@@ -984,6 +993,7 @@ fn receive(shot: &Shot, plan: &PatchPlan, e: usize) -> (f64, u32) {
         mesh,
         shooter,
         targets,
+        lifted_targets,
         shooter_elements,
         uneven,
         accel,
@@ -1100,22 +1110,25 @@ fn receive(shot: &Shot, plan: &PatchPlan, e: usize) -> (f64, u32) {
     let mut pass = |count: u32, rng: &mut Rng| {
         let (mut visible, mut traced) = (0u32, 0u32);
         let (mut from4, mut to4, mut n) = ([Vec3::ZERO; 4], [Vec3::ZERO; 4], 0);
+        let strata = Strata::new(count);
         for i in 0..count {
-            let (u, v) = stratified(i, count, rng);
+            let (u, v) = strata.sample(i, rng);
             let mut from = point_on(receiver, u, v);
-            let (u, v) = stratified(i, count, rng);
-            let mut to = target(targets, u, v);
-            let mut tries = 0;
-            while clipped && !ahead(from, to) && tries < REDRAWS {
-                from = point_on(receiver, rng.next_f64(), rng.next_f64());
-                to = target(targets, rng.next_f64(), rng.next_f64());
-                tries += 1;
-            }
-            if clipped && !ahead(from, to) {
-                continue;
+            let (u, v) = strata.sample(i, rng);
+            let mut cell = target_cell(u, v);
+            if clipped {
+                let mut tries = 0;
+                while !ahead(from, targets[cell]) && tries < REDRAWS {
+                    from = point_on(receiver, rng.next_f64(), rng.next_f64());
+                    cell = target_cell(rng.next_f64(), rng.next_f64());
+                    tries += 1;
+                }
+                if !ahead(from, targets[cell]) {
+                    continue;
+                }
             }
             from4[n] = (from + el.normal * offset).as_vec3();
-            to4[n] = (to + shooter.normal * offset).as_vec3();
+            to4[n] = lifted_targets[cell];
             n += 1;
             traced += 1;
             if n == 4 {
