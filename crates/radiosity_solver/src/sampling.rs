@@ -3,7 +3,7 @@
 //! Every stochastic choice draws from a stream keyed by `(seed, shooter, element)`, never by
 //! a thread, so one thread and many give bit-identical results.
 
-use glam::DVec3;
+use glam::{DVec3, Vec3A};
 
 /// SplitMix64 finaliser (Steele, Lea & Flood 2014): a strong 64-bit mix.
 fn mix(mut z: u64) -> u64 {
@@ -27,6 +27,14 @@ impl Rng {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         (mix(self.0) >> 11) as f64 / (1u64 << 53) as f64
     }
+
+    /// Two uniform numbers in [0, 1) with 24 bits each, from one draw.
+    pub(crate) fn next_f32_pair(&mut self) -> (f32, f32) {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let bits = mix(self.0);
+        let unit = |b: u64| (b & 0xff_ffff) as f32 / (1u32 << 24) as f32;
+        (unit(bits >> 40), unit(bits >> 8))
+    }
 }
 
 /// The point at `(u, v)` ∈ [0,1)² on a triangle (area-uniform, Shirley's square-to-triangle
@@ -47,24 +55,58 @@ pub(crate) fn point_on(poly: &[DVec3], u: f64, v: f64) -> DVec3 {
 /// takes, so that the rows cover the square (12 samples: 4 × 3). A square `k × k` grid for
 /// every count, as this was once, leaves rows empty whenever `count` is not a square: 12
 /// samples on a 4 × 4 grid never reached the last quarter of either patch.
+///
+/// Samples come row after row; each call to [`Strata::next`] moves to the next stratum
+/// (counters, not a division per sample: rays are cheap enough for that to show).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Strata {
     columns: u32,
     rows: u32,
+    scale: (f32, f32),
+    at: (u32, u32),
 }
 
 impl Strata {
-    /// The grid for `count` samples (at least one cell).
+    /// The grid for `count` samples (at least one cell), at its first stratum.
     pub(crate) fn new(count: u32) -> Self {
         let columns = (count as f64).sqrt().ceil().max(1.0) as u32;
-        Self { columns, rows: count.div_ceil(columns).max(1) }
+        let rows = count.div_ceil(columns).max(1);
+        Self { columns, rows, scale: (1.0 / columns as f32, 1.0 / rows as f32), at: (0, 0) }
     }
 
-    /// Sample `index`'s stratum, row after row, jittered by `rng`.
-    pub(crate) fn sample(&self, index: u32, rng: &mut Rng) -> (f64, f64) {
-        let (i, j) = (index % self.columns, (index / self.columns) % self.rows);
-        let u = (i as f64 + rng.next_f64()) / self.columns as f64;
-        (u, (j as f64 + rng.next_f64()) / self.rows as f64)
+    /// The current stratum's cell `(column, row)`; then moves on to the next.
+    pub(crate) fn next(&mut self) -> (u32, u32) {
+        let cell = self.at;
+        self.at.0 += 1;
+        if self.at.0 == self.columns {
+            self.at = (0, (self.at.1 + 1) % self.rows);
+        }
+        cell
+    }
+
+    /// A jittered point of `cell`, in [0, 1)².
+    pub(crate) fn jitter(&self, cell: (u32, u32), rng: &mut Rng) -> (f32, f32) {
+        let (a, b) = rng.next_f32_pair();
+        let u = ((cell.0 as f32 + a) * self.scale.0).min(ONE_BELOW);
+        (u, ((cell.1 as f32 + b) * self.scale.1).min(ONE_BELOW))
+    }
+}
+
+/// The largest f32 below 1: a jittered coordinate rounded up to 1 is clamped back into its
+/// cell's half-open range.
+const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// The point at `(u, v)` ∈ [0,1)² on a triangle or convex quad in single precision: the map
+/// of [`point_on`], for ray origins that are traced in single precision anyway.
+pub(crate) fn point_on_f32(poly: &[Vec3A], u: f32, v: f32) -> Vec3A {
+    if poly.len() == 4 {
+        poly[0] * ((1.0 - u) * (1.0 - v))
+            + poly[1] * (u * (1.0 - v))
+            + poly[2] * (u * v)
+            + poly[3] * ((1.0 - u) * v)
+    } else {
+        let s = u.sqrt();
+        poly[0] * (1.0 - s) + poly[1] * (s * (1.0 - v)) + poly[2] * (s * v)
     }
 }
 
@@ -77,13 +119,14 @@ mod tests {
     fn strata_cover_the_square_for_every_count() {
         let mut rng = Rng::for_task(1, 2, 3);
         for count in 1..=40u32 {
-            let strata = Strata::new(count);
+            let mut strata = Strata::new(count);
             let (c, r) = (strata.columns as usize, strata.rows as usize);
             let mut cells = vec![0u32; c * r];
-            for index in 0..count {
-                let (u, v) = strata.sample(index, &mut rng);
+            for _ in 0..count {
+                let cell = strata.next();
+                let (u, v) = strata.jitter(cell, &mut rng);
                 assert!((0.0..1.0).contains(&u) && (0.0..1.0).contains(&v), "count {count}: ({u}, {v})");
-                cells[(v * r as f64) as usize * c + (u * c as f64) as usize] += 1;
+                cells[(v * r as f32) as usize * c + (u * c as f32) as usize] += 1;
             }
             for row in 0..r {
                 assert!(
