@@ -27,7 +27,7 @@ use thiserror::Error;
 
 use crate::form_factor::{
     Rule, distance_to_polygon, for_each_point, point_to_point, point_to_polygon, point_to_polygon_in_front,
-    point_to_polygon_in_front_x4,
+    point_to_polygon_in_front_x4, points_to_polygon_in_front_x4,
 };
 use crate::occluders::{OccluderBoxes, blocking_triangles};
 use crate::sampling::{Rng, Strata, point_on, point_on_f32};
@@ -155,6 +155,12 @@ pub enum SolverError {
     /// The mesh has no elements.
     #[error("the mesh has no elements")]
     EmptyMesh,
+    /// The patches do not own consecutive runs of all the elements, in order.
+    #[error("mesh patch {patch}: patches must own consecutive runs of the elements, in order")]
+    BadMesh {
+        /// The first patch out of order (the patch count when elements are left over).
+        patch: usize,
+    },
     /// A parameter is out of range.
     #[error("solver parameter {name} = {value} is out of range: {expected}")]
     BadParameter {
@@ -441,6 +447,18 @@ impl Solver {
         }
         if mesh.elements.is_empty() {
             return Err(SolverError::EmptyMesh);
+        }
+        // Patches own consecutive runs of elements, in order (as `Mesh::build` makes them):
+        // a row is split into one slice per patch.
+        let mut next = 0;
+        for (q, p) in mesh.patches.iter().enumerate() {
+            if p.elements.start != next || p.elements.end < p.elements.start {
+                return Err(SolverError::BadMesh { patch: q });
+            }
+            next = p.elements.end;
+        }
+        if next as usize != mesh.elements.len() {
+            return Err(SolverError::BadMesh { patch: mesh.patches.len() });
         }
         let n = mesh.elements.len();
         let reflectance: Vec<Rgb> = (0..n).map(|e| mesh.element_material(e).reflectance).collect();
@@ -874,10 +892,24 @@ impl Solver {
             stream: shooter as u64,
         };
         let plans: &[PatchPlan] = self.plan_rows[shooter].as_deref().unwrap_or(&self.plans);
-        for_each_maybe_parallel(&mut self.factors, |e, out| {
-            let plan = &plans[mesh.elements[e].patch as usize];
-            *out = if plan.live { receive(&shot, plan, e) } else { Received::default() };
-        });
+        // First pass, patch by patch: each receiving patch writes its own elements' slice.
+        let mut slices: Vec<&mut [Received]> = Vec::with_capacity(mesh.patches.len());
+        let mut rest = &mut self.factors[..];
+        for p in &mesh.patches {
+            let (own, after) = rest.split_at_mut(p.elements.len());
+            slices.push(own);
+            rest = after;
+        }
+        let receive_one = |q: usize, out: &mut &mut [Received]| {
+            receive_patch(&shot, &plans[q], mesh.patches[q].elements.start as usize, out)
+        };
+        if mesh.elements.len() < PARALLEL_MIN || rayon::current_num_threads() == 1 {
+            slices.iter_mut().enumerate().for_each(|(q, out)| receive_one(q, out));
+        } else {
+            // About 64 elements per task, as `for_each_maybe_parallel` takes them.
+            let per_task = (PARALLEL_MIN * mesh.patches.len() / mesh.elements.len()).max(1);
+            slices.par_iter_mut().enumerate().with_min_len(per_task).for_each(|(q, out)| receive_one(q, out));
+        }
         // Penumbrae: more rays where the neighbours' pilot rays disagree.
         let count = self.params.penumbra_rays;
         if count > 0 {
@@ -1142,12 +1174,49 @@ fn receive(shot: &Shot, plan: &PatchPlan, e: usize) -> Received {
             point_to_point(el.centre, el.normal, shooter.centre, shooter.normal, shooter.area)
         }
     };
+    pilot(shot, plan, e, unoccluded)
+}
+
+/// Element `e`'s pilot rays, once its unoccluded form factor is known.
+fn pilot(shot: &Shot, plan: &PatchPlan, e: usize, unoccluded: f64) -> Received {
     if unoccluded <= 0.0 {
         return Received::default();
     }
-    let mut rng = Rng::for_task(params.seed, shot.stream, e as u64);
-    let (visible, traced) = trace(shot, plan, e, params.visibility_rays, &mut rng);
+    let mut rng = Rng::for_task(shot.params.seed, shot.stream, e as u64);
+    let (visible, traced) = trace(shot, plan, e, shot.params.visibility_rays, &mut rng);
     Received { unoccluded, visible, traced }
+}
+
+/// The first pass for the elements of one receiving patch (`first` is its first element,
+/// `out` its slice). A patch that faces the shooter from far away takes its elements' form
+/// factors four at a time (one midpoint each, nothing to clip: the same formula and points
+/// as [`receive`]).
+fn receive_patch(shot: &Shot, plan: &PatchPlan, first: usize, out: &mut [Received]) {
+    if !plan.live {
+        out.fill(Received::default());
+        return;
+    }
+    let params = shot.params;
+    if !(plan.facing && plan.far && !params.reference_path && params.form_factor == FormFactorMethod::Exact) {
+        for (k, r) in out.iter_mut().enumerate() {
+            *r = receive(shot, plan, first + k);
+        }
+        return;
+    }
+    let corners = shot.shooter.corners();
+    for (c, chunk) in out.chunks_mut(4).enumerate() {
+        let base = first + 4 * c;
+        let (mut points, mut normals) = ([DVec3::ZERO; 4], [DVec3::ZERO; 4]);
+        for (k, (p, n)) in points.iter_mut().zip(&mut normals).take(chunk.len()).enumerate() {
+            let el = &shot.mesh.elements[base + k];
+            *p = shot.mesh.element_corners(base + k).sum::<DVec3>() / f64::from(el.vertex_count);
+            *n = el.normal;
+        }
+        let f = points_to_polygon_in_front_x4(&points, &normals, chunk.len(), corners);
+        for (k, r) in chunk.iter_mut().enumerate() {
+            *r = pilot(shot, plan, base + k, f[k]);
+        }
+    }
 }
 
 /// The element (corners `receiver`) and the shooter see each other whole: no clipping, no

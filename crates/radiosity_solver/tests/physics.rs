@@ -265,3 +265,16 @@ fn a_lamp_half_behind_a_wall_lights_it_through_the_half_in_front() {
     }
     assert!(checked > 100, "{checked} wall elements");
 }
+
+/// A hand-built mesh whose patches do not own consecutive runs of the elements is refused
+/// with an error naming the patch, not solved wrongly.
+#[test]
+fn a_mesh_with_patches_out_of_order_is_refused() {
+    let scene = two_plates(1.0, 1.0, 0.5, 1.0);
+    let mut mesh = Mesh::build(&scene, &scene.mesh_params()).unwrap();
+    assert!(mesh.patches.len() > 1);
+    mesh.patches.swap(0, 1);
+    let accel = Arc::new(Bvh::new(&occluder_triangles(&mesh)));
+    let err = Solver::new(Arc::new(mesh), accel, SolverParams::default()).err().unwrap();
+    assert!(matches!(err, radiosity_solver::SolverError::BadMesh { patch: 0 }), "{err}");
+}
