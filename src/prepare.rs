@@ -79,7 +79,7 @@ pub struct SolveOpts {
     /// Visibility rays per receiver and shooter.
     #[arg(long, default_value_t = 4)]
     pub visibility_rays: u32,
-    /// More rays for a receiver whose first visibility rays disagree (a penumbra); 0: none.
+    /// More rays for a receiver whose neighbours' first visibility rays saw a penumbra; 0: none.
     #[arg(long, default_value_t = 12)]
     pub penumbra_rays: u32,
     /// Memory for keeping each shooter's form factors for its next shots, in MiB (0: keep

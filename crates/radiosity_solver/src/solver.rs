@@ -72,8 +72,8 @@ pub struct SolverParams {
     pub form_factor: FormFactorMethod,
     /// Visibility rays per receiving element and shooter, ≥ 1. Default 4.
     pub visibility_rays: u32,
-    /// More rays for a receiver whose first `visibility_rays` disagree (some blocked, some
-    /// not: a penumbra), 0 for none. Default 12.
+    /// More rays for a receiver whose neighbours' first `visibility_rays` saw a penumbra
+    /// (one of them partly lit, or some lit and some dark), 0 for none. Default 12.
     pub penumbra_rays: u32,
     /// Largest receiver quadrature, Gauss cells per side, in 1..=256. Default 2: measured on
     /// the ρ = 0.9 furnaces (box, sphere), the worst element is within 3.7e-5 / 2.0e-5 of
