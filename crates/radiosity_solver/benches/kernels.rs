@@ -10,10 +10,11 @@ use std::sync::Arc;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{DVec3, Vec3};
-use radiosity_accel::{BruteForce, Bvh, RayQuery};
+use radiosity_accel::{BruteForce, Bvh, RayQuery, Segments4};
 use radiosity_core::{Mesh, MeshParams, furnace_box};
 use radiosity_solver::form_factor::{
     Rule, for_each_point, point_to_polygon, point_to_polygon_in_front, point_to_polygon_in_front_x4,
+    points_to_polygon_in_front_x4,
 };
 use radiosity_solver::{Solver, SolverParams, StepBudget, occluder_triangles};
 
@@ -37,6 +38,11 @@ fn form_factors(c: &mut Criterion) {
     });
     c.bench_function("point_to_polygon_in_front_x4 far (f32 lanes)", |b| {
         b.iter(|| point_to_polygon_in_front_x4(black_box(p), DVec3::Z, black_box(&shooter)))
+    });
+    // Four receivers at once, one per lane: divide by four for a per-receiver figure.
+    let four = [p, p + DVec3::X * 0.01, p + DVec3::Y * 0.01, p + DVec3::new(0.01, 0.01, 0.0)];
+    c.bench_function("points_to_polygon_in_front_x4 far, 4 receivers (f32 lanes)", |b| {
+        b.iter(|| points_to_polygon_in_front_x4(black_box(&four), &[DVec3::Z; 4], 4, black_box(&shooter)))
     });
     // A receiver perpendicular to the shooter and touching it: clipping does real work.
     let wall = [DVec3::new(0.0, 0.0, 0.0), DVec3::new(0.0, 0.2, 0.0), DVec3::new(0.0, 0.2, 1.0)];
@@ -89,6 +95,16 @@ fn rays(c: &mut Criterion) {
         b.iter(|| {
             i = (i + 2) % ends.len();
             brute.occluded_by(ends[i], ends[i + 1], black_box(&few))
+        })
+    });
+    let mut list = few.clone();
+    c.bench_function("candidate list occluded, 4 rays at once (12 triangles)", |b| {
+        let mut i = 0;
+        b.iter(|| {
+            i = (i + 8) % (ends.len() - 8);
+            let from = [ends[i], ends[i + 1], ends[i + 2], ends[i + 3]];
+            let to = [ends[i + 4], ends[i + 5], ends[i + 6], ends[i + 7]];
+            brute.occluded_x4(&Segments4::new(&from, &to, 4), black_box(&mut list))
         })
     });
 }
