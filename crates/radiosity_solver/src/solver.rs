@@ -247,6 +247,8 @@ pub struct Solver {
     unshot: Vec<Rgb>,
     patch_unshot_power: Vec<Rgb>,
     vertex_area: Vec<f64>,
+    /// Element areas, packed for the shot loop.
+    element_area: Vec<f64>,
     emitted: Rgb,
     absorbed: Rgb,
     escaped: Rgb,
@@ -489,6 +491,7 @@ impl Solver {
             })
             .collect();
         let (neighbour_start, neighbours) = element_neighbours(&mesh);
+        let element_area = mesh.elements.iter().map(|el| el.area).collect();
         let mut s = Self {
             patch_unshot_power: vec![Rgb::ZERO; mesh.patches.len()],
             plans: vec![PatchPlan::default(); mesh.patches.len()],
@@ -520,6 +523,7 @@ impl Solver {
             radiosity: emission.clone(),
             unshot: emission,
             vertex_area,
+            element_area,
             emitted,
             absorbed: Rgb::ZERO,
             escaped: Rgb::ZERO,
@@ -719,20 +723,27 @@ impl Solver {
         let mut offset = 0;
         for &(first, count) in &row.spans {
             let (first, count) = (first as usize, count as usize);
+            // Σ F·A over the span, then the irradiance once: what the span receives.
+            let mut seen = 0.0;
             let mut gained = Rgb::ZERO;
-            for (e, &f) in (first..first + count).zip(&row.factors[offset..offset + count]) {
+            let factors = &row.factors[offset..offset + count];
+            let elements = first..first + count;
+            let (rho, area) = (&self.reflectance[elements.clone()], &self.element_area[elements.clone()]);
+            let (radiosity, unshot) = (&mut self.radiosity[elements.clone()], &mut self.unshot[elements]);
+            for k in 0..count {
+                let f = f64::from(factors[k]);
                 if f == 0.0 {
                     continue;
                 }
-                let area = mesh.elements[e].area;
-                let incident = shot_b * f64::from(f); // irradiance from this shot, W/unit²
-                let reflected = self.reflectance[e] * incident;
-                self.radiosity[e] += reflected;
-                self.unshot[e] += reflected;
-                gained += reflected * area;
-                received += incident * area;
-                self.absorbed += (incident - reflected) * area;
+                let reflected = rho[k] * (shot_b * f); // ρ × irradiance from this shot, W/unit²
+                radiosity[k] += reflected;
+                unshot[k] += reflected;
+                gained += reflected * area[k];
+                seen += f * area[k];
             }
+            let span_received = shot_b * seen;
+            received += span_received;
+            self.absorbed += span_received - gained;
             self.patch_unshot_power[mesh.elements[first].patch as usize] += gained;
             offset += count;
         }
