@@ -1,20 +1,27 @@
 //! Ray queries for the radiosity renderer: segment occlusion (visibility between a receiver
 //! point and a point on a shooting patch) and closest hit (the image renderer).
 //!
-//! One small trait, [`RayQuery`], with two implementations: [`Bvh`], a compressed wide BVH8
-//! from the `obvhs` crate built with its slowest, best-quality preset (PLOC + spatial
-//! pre-splits + reinsertion, measured 5–10× faster per ray than its default on radiosity
-//! scenes of large polygons) up to [`BEST_BUILD_LIMIT`] triangles and its medium preset
-//! above, and [`BruteForce`], the obviously-correct reference the tests compare against.
+//! One small trait, [`RayQuery`], with two implementations: [`Bvh`], a four-wide BVH of our
+//! own traced one ray at a time with four-lane SIMD (`bvh4`: boxes and leaf triangles stored
+//! axis by axis, collapsed from obvhs's binary BVH built with PLOC and reinsertion), and
+//! [`BruteForce`], the obviously-correct reference the tests compare against, which also
+//! tests short candidate lists four rays at a time (`BruteForce::occluded_x4`).
+//!
+//! Measured on the bench's rays (108 k triangles, 1 M incoherent segments, one thread,
+//! `cargo run --release -p radiosity_accel --example ray_bench -- rays.bin`): 3.3 M rays/s,
+//! 1.7× obvhs's compressed wide BVH8 (which this replaced) in the same process, and
+//! 0.9–1.0× Embree on the same rays (`scripts/embree_bench.py`).
 #![warn(missing_docs)]
 #![forbid(unsafe_code)]
 
 use glam::{Vec3, Vec3A};
+mod bvh4;
 mod packet;
 
 pub use packet::Segments4;
 
-use obvhs::{BvhBuildParams, cwbvh::CwBvh, ray::Ray, rt_triangle::RtTriangle, triangle::Triangle};
+use bvh4::Bvh4;
+use obvhs::{BvhBuildParams, ray::Ray, rt_triangle::RtTriangle, triangle::Triangle};
 
 /// A ray hit: distance and the hit triangle with barycentric coordinates.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -43,11 +50,11 @@ pub trait RayQuery: Send + Sync {
     fn triangle_count(&self) -> usize;
 }
 
-/// Above this many triangles the BVH is built with obvhs's medium preset. Small triangles
-/// (tessellated models) gain nothing from spatial splits: on the bench's 108 k-triangle
-/// Cornell box the medium build took 0.08 s against 0.37 s and traced as fast (1.44 against
-/// 1.20 M rays/s on one thread), and a 1 M-triangle model spent 9 s building.
-pub const BEST_BUILD_LIMIT: usize = 50_000;
+/// Above this many triangles the BVH is built with obvhs's medium preset, below it with its
+/// slowest, best one. Measured on the bench's 108 k-triangle Cornell box (1 M segments, one
+/// thread): the slowest build took 0.25 s and traced 3.32–3.40 M rays/s, the medium one
+/// 0.05 s and 2.89 M; a 1 M-triangle model once spent 9 s in the slowest build.
+pub const BEST_BUILD_LIMIT: usize = 250_000;
 
 /// Margin at both ends of an occlusion segment, as a fraction of its length.
 const SEGMENT_MARGIN: f32 = 1e-4;
@@ -75,9 +82,10 @@ fn barycentric(tri: &Triangle, p: Vec3A) -> (f32, f32) {
 
 /// Replaces direction components that are (almost) zero by a tiny value of the same sign.
 ///
-/// obvhs's quantised slab test misses flat (zero-thickness) node boxes — every wall of an
-/// axis-aligned room — when a direction component is exactly zero; tilting the ray by 1e-7
-/// radian changes no result that matters and keeps the slab arithmetic finite.
+/// A slab test with an exactly zero direction component computes 0 × ∞ = NaN for a ray
+/// that starts on a box face, and flat (zero-thickness) boxes — every wall of an
+/// axis-aligned room — are all face; tilting the ray by 1e-7 radian changes no result that
+/// matters and keeps the slab arithmetic finite.
 fn nudge(d: Vec3A) -> Vec3A {
     let eps = 1e-7 * d.abs().max_element();
     Vec3A::select(d.abs().cmplt(Vec3A::splat(eps)), Vec3A::splat(eps).copysign(d + Vec3A::splat(0.0)), d)
@@ -87,62 +95,37 @@ fn segment_ray(from: Vec3, to: Vec3) -> Ray {
     Ray::new(Vec3A::from(from), nudge(Vec3A::from(to - from)), SEGMENT_MARGIN, 1.0 - SEGMENT_MARGIN)
 }
 
-/// A compressed wide BVH (8-wide nodes, SIMD traversal) over triangles.
+/// A four-wide BVH over triangles, traced with four-lane SIMD (see the `bvh4` module).
 pub struct Bvh {
-    bvh: CwBvh,
+    tree: Bvh4,
     triangles: Vec<Triangle>,
-    /// The triangles in leaf order with their edges and normal precomputed, so a leaf test
-    /// reads one contiguous record instead of following an index and rebuilding edges.
-    leaves: Vec<RtTriangle>,
 }
 
 impl Bvh {
     /// Builds the BVH. An empty slice gives a structure that never hits.
     pub fn new(triangles: &[[Vec3; 3]]) -> Self {
         let triangles = to_triangles(triangles);
-        let bvh = if triangles.is_empty() {
-            CwBvh::default()
+        let params = if triangles.len() <= BEST_BUILD_LIMIT {
+            BvhBuildParams::very_slow_build()
         } else {
-            obvhs::cwbvh::builder::build_cwbvh_from_tris(
-                &triangles,
-                if triangles.len() <= BEST_BUILD_LIMIT {
-                    BvhBuildParams::very_slow_build()
-                } else {
-                    BvhBuildParams::medium_build()
-                },
-                &mut std::time::Duration::default(),
-            )
+            BvhBuildParams::medium_build()
         };
-        let leaves =
-            bvh.primitive_indices.iter().map(|&i| RtTriangle::from(&triangles[i as usize])).collect();
-        Self { bvh, triangles, leaves }
+        Self { tree: Bvh4::new(&triangles, params), triangles }
     }
 }
 
 impl RayQuery for Bvh {
     fn occluded(&self, from: Vec3, to: Vec3) -> bool {
-        if self.triangles.is_empty() {
-            return false;
-        }
-        !self.bvh.ray_traverse_miss(segment_ray(from, to), |ray, id| self.leaves[id].intersect(ray))
+        let d = nudge(Vec3A::from(to - from));
+        self.tree.occluded(Vec3A::from(from), d, SEGMENT_MARGIN, 1.0 - SEGMENT_MARGIN)
     }
 
     fn closest_hit(&self, origin: Vec3, direction: Vec3, t_max: f32) -> Option<Hit> {
-        if self.triangles.is_empty() {
-            return None;
-        }
-        let ray = Ray::new(Vec3A::from(origin), nudge(Vec3A::from(direction)), 0.0, t_max);
-        let mut hit = obvhs::ray::RayHit::none();
-        if !self.bvh.ray_traverse(ray, &mut hit, |ray, id| {
-            let t = self.leaves[id].intersect(ray);
-            if t > 0.0 { t } else { f32::INFINITY }
-        }) {
-            return None;
-        }
-        let triangle = self.bvh.primitive_indices[hit.primitive_id as usize];
-        let p = ray.origin + ray.direction * hit.t;
-        let (u, v) = barycentric(&self.triangles[triangle as usize], p);
-        Some(Hit { t: hit.t, triangle, u, v })
+        let (origin, direction) = (Vec3A::from(origin), nudge(Vec3A::from(direction)));
+        // Hits at t > 0 only: the smallest positive float is the first distance allowed.
+        let (t, triangle) = self.tree.closest(origin, direction, f32::MIN_POSITIVE, t_max)?;
+        let (u, v) = barycentric(&self.triangles[triangle as usize], origin + direction * t);
+        Some(Hit { t, triangle, u, v })
     }
 
     fn triangle_count(&self) -> usize {
@@ -288,7 +271,7 @@ mod tests {
         let mut rng = XorShift(0x2545_f491_4f6c_dd1d);
         let tris: Vec<[Vec3; 3]> = random_scene(&mut rng, BEST_BUILD_LIMIT + 1000)
             .into_iter()
-            .map(|t| [t[0], t[0] + (t[1] - t[0]) * 0.1, t[0] + (t[2] - t[0]) * 0.1])
+            .map(|t| [t[0], t[0] + (t[1] - t[0]) * 0.04, t[0] + (t[2] - t[0]) * 0.04])
             .collect();
         let (bvh, brute) = (Bvh::new(&tris), BruteForce::new(&tris));
         let mut blocked = 0;
