@@ -65,21 +65,23 @@ impl BruteForce {
             let s = |v: Vec3A| (Vec4::splat(v.x), Vec4::splat(v.y), Vec4::splat(v.z));
             let ((v0x, v0y, v0z), (e1x, e1y, e1z)) = (s(tri.v0), s(tri.e1));
             let ((e2x, e2y, e2z), (nx, ny, nz)) = (s(tri.e2), s(tri.ng));
-            // c = v0 − o, r = d × c, as in the one-ray test.
+            // c = v0 − o, the distance to the triangle's plane first: most candidates lie
+            // where the segments do not reach their plane, and those skip the edge tests.
             let (cx, cy, cz) = (v0x - ox, v0y - oy, v0z - oz);
-            let (rx, ry, rz) = (dy * cz - dz * cy, dz * cx - dx * cz, dx * cy - dy * cx);
             let inv_det = Vec4::ONE / (nx * dx + ny * dy + nz * dz);
+            let t = (nx * cx + ny * cy + nz * cz) * inv_det;
+            let reach = t.cmpge(tmin).bitmask() & t.cmple(tmax).bitmask() & segments.live & !blocked;
+            if reach == 0 {
+                continue;
+            }
+            // r = d × c and the edge coordinates, as in the one-ray test.
+            let (rx, ry, rz) = (dy * cz - dz * cy, dz * cx - dx * cz, dx * cy - dy * cx);
             let u = (rx * e2x + ry * e2y + rz * e2z) * inv_det;
             let v = (rx * e1x + ry * e1y + rz * e1z) * inv_det;
             let w = Vec4::ONE - u - v;
-            let t = (nx * cx + ny * cy + nz * cz) * inv_det;
             // u, v, w all non-negative (sign bits clear, as the one-ray test reads them).
             let inside = !(u.is_negative_bitmask() | v.is_negative_bitmask() | w.is_negative_bitmask());
-            let hit = inside
-                & inv_det.cmpne(Vec4::ZERO).bitmask()
-                & t.cmpge(tmin).bitmask()
-                & t.cmple(tmax).bitmask()
-                & segments.live;
+            let hit = inside & inv_det.cmpne(Vec4::ZERO).bitmask() & reach;
             if hit & !blocked != 0 {
                 first.get_or_insert(k);
                 blocked |= hit;
