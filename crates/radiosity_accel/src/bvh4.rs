@@ -105,20 +105,23 @@ impl SlabRay {
         let [e1x, e1y, e1z] = t.e1;
         let [e2x, e2y, e2z] = t.e2;
         let [nx, ny, nz] = t.ng;
-        // c = v0 − o, r = d × c, as in the one-ray test, each lane one triangle.
+        // c = v0 − o and the distance to each plane first: lanes whose plane the ray does
+        // not reach within the range skip the edge tests. Otherwise the one-ray test's
+        // arithmetic, each lane one triangle.
         let (cx, cy, cz) = (v0x - ox, v0y - oy, v0z - oz);
-        let (rx, ry, rz) = (dy * cz - dz * cy, dz * cx - dx * cz, dx * cy - dy * cx);
         let inv_det = Vec4::ONE / (nx * dx + ny * dy + nz * dz);
+        let dist = (nx * cx + ny * cy + nz * cz) * inv_det;
+        let reach =
+            dist.cmpge(Vec4::splat(tmin)).bitmask() & dist.cmple(Vec4::splat(tmax)).bitmask() & t.live;
+        if reach == 0 {
+            return (dist, 0);
+        }
+        let (rx, ry, rz) = (dy * cz - dz * cy, dz * cx - dx * cz, dx * cy - dy * cx);
         let u = (rx * e2x + ry * e2y + rz * e2z) * inv_det;
         let v = (rx * e1x + ry * e1y + rz * e1z) * inv_det;
         let w = Vec4::ONE - u - v;
-        let dist = (nx * cx + ny * cy + nz * cz) * inv_det;
         let inside = !(u.is_negative_bitmask() | v.is_negative_bitmask() | w.is_negative_bitmask());
-        let hit = inside
-            & inv_det.cmpne(Vec4::ZERO).bitmask()
-            & dist.cmpge(Vec4::splat(tmin)).bitmask()
-            & dist.cmple(Vec4::splat(tmax)).bitmask()
-            & t.live;
+        let hit = inside & inv_det.cmpne(Vec4::ZERO).bitmask() & reach;
         (dist, hit)
     }
 }
