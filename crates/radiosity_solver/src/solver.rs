@@ -1128,15 +1128,21 @@ enum Light {
     None,
 }
 
+/// Element `e`'s corners in a fixed array (the first `vertex_count` are its own).
+fn corners_of(mesh: &Mesh, e: usize) -> [DVec3; 4] {
+    let mut pts = [DVec3::ZERO; 4];
+    for (k, p) in mesh.element_corners(e).enumerate() {
+        pts[k] = p;
+    }
+    pts
+}
+
 /// The first pass for element `e`: its unoccluded form factor and `params.visibility_rays`
 /// pilot rays.
 fn receive(shot: &Shot, plan: &PatchPlan, e: usize) -> Received {
     let Shot { mesh, shooter, shooter_elements, uneven, params, .. } = *shot;
     let el = &mesh.elements[e];
-    let mut pts = [DVec3::ZERO; 4];
-    for (k, p) in mesh.element_corners(e).enumerate() {
-        pts[k] = p;
-    }
+    let pts = corners_of(mesh, e);
     let receiver = &pts[..el.vertex_count as usize];
     let corners = shooter.corners();
     let facing = element_facing(shooter, plan, receiver);
@@ -1270,10 +1276,7 @@ fn wants_penumbra_rays(first: &[Received], e: usize, neighbours: &[u32]) -> bool
 fn trace(shot: &Shot, plan: &PatchPlan, e: usize, count: u32, rng: &mut Rng) -> (u32, u32) {
     let Shot { mesh, shooter, targets, lifted_targets, accel, boxes, blockers, offset, .. } = *shot;
     let el = &mesh.elements[e];
-    let mut pts = [DVec3::ZERO; 4];
-    for (k, p) in mesh.element_corners(e).enumerate() {
-        pts[k] = p;
-    }
+    let pts = corners_of(mesh, e);
     let receiver = &pts[..el.vertex_count as usize];
     let corners = shooter.corners();
     // Every segment between the element and the shooter lies in the box around both; when no
