@@ -1042,7 +1042,7 @@ const MIDPOINT_RATIO: f64 = 16.0;
 struct Shot<'a> {
     mesh: &'a Mesh,
     shooter: &'a radiosity_core::Patch,
-    /// Ray ends on the shooter, `TARGETS`² of them, row after row (see [`target`]).
+    /// Ray ends on the shooter, `TARGETS`² of them, row after row (see [`target_cell`]).
     targets: &'a [DVec3],
     /// The same points lifted off the shooter by `offset`, as the rays take them.
     lifted_targets: &'a [Vec3],
