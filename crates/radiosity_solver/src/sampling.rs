@@ -60,6 +60,7 @@ pub(crate) fn point_on(poly: &[DVec3], u: f64, v: f64) -> DVec3 {
 /// (counters, not a division per sample: rays are cheap enough for that to show).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Strata {
+    count: u32,
     columns: u32,
     rows: u32,
     scale: (f32, f32),
@@ -71,7 +72,12 @@ impl Strata {
     pub(crate) fn new(count: u32) -> Self {
         let columns = (count as f64).sqrt().ceil().max(1.0) as u32;
         let rows = count.div_ceil(columns).max(1);
-        Self { columns, rows, scale: (1.0 / columns as f32, 1.0 / rows as f32), at: (0, 0) }
+        Self { count, columns, rows, scale: (1.0 / columns as f32, 1.0 / rows as f32), at: (0, 0) }
+    }
+
+    /// How many samples it was made for.
+    pub(crate) fn count(&self) -> u32 {
+        self.count
     }
 
     /// The current stratum's cell `(column, row)`; then moves on to the next.

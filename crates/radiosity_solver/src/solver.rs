@@ -901,6 +901,8 @@ impl Solver {
             params: &self.params,
             offset: self.ray_offset,
             stream: shooter as u64,
+            pilot: Strata::new(self.params.visibility_rays),
+            penumbra: Strata::new(self.params.penumbra_rays),
         };
         let plans: &[PatchPlan] = self.plan_rows[shooter].as_deref().unwrap_or(&self.plans);
         // First pass, patch by patch: each receiving patch writes its own elements' slice.
@@ -933,7 +935,7 @@ impl Solver {
                 if flags[e] {
                     let plan = &plans[mesh.elements[e].patch as usize];
                     let mut rng = Rng::for_task(seed, shot.stream, e as u64 | PENUMBRA_STREAM);
-                    let (visible, traced) = trace(&shot, plan, e, count, &mut rng);
+                    let (visible, traced) = trace(&shot, plan, e, shot.penumbra, &mut rng);
                     out.visible += visible;
                     out.traced += traced;
                 }
@@ -1058,6 +1060,9 @@ struct Shot<'a> {
     offset: f64,
     /// Key of the random streams: the shooter, so that every shot of it draws the same rays.
     stream: u64,
+    /// Strata of the pilot and of the penumbra rays.
+    pilot: Strata,
+    penumbra: Strata,
 }
 
 /// The point at `(u, v)` ∈ [0,1)² on the shooter, drawn by unshot power: `u` picks the
@@ -1200,7 +1205,7 @@ fn pilot(shot: &Shot, plan: &PatchPlan, e: usize, unoccluded: f64) -> Received {
         return Received::default();
     }
     let mut rng = Rng::for_task(shot.params.seed, shot.stream, e as u64);
-    let (visible, traced) = trace(shot, plan, e, shot.params.visibility_rays, &mut rng);
+    let (visible, traced) = trace(shot, plan, e, shot.pilot, &mut rng);
     Received { unoccluded, visible, traced }
 }
 
@@ -1272,8 +1277,9 @@ fn wants_penumbra_rays(first: &[Received], e: usize, neighbours: &[u32]) -> bool
     full && none
 }
 
-/// `count` stratified rays between element `e` and the shooter: (unblocked, traced).
-fn trace(shot: &Shot, plan: &PatchPlan, e: usize, count: u32, rng: &mut Rng) -> (u32, u32) {
+/// Stratified rays between element `e` and the shooter, one per stratum of `strata` (fresh,
+/// at its first stratum): (unblocked, traced).
+fn trace(shot: &Shot, plan: &PatchPlan, e: usize, mut strata: Strata, rng: &mut Rng) -> (u32, u32) {
     let Shot { mesh, shooter, targets, lifted_targets, accel, boxes, blockers, offset, .. } = *shot;
     let el = &mesh.elements[e];
     let pts = corners_of(mesh, e);
@@ -1327,7 +1333,7 @@ fn trace(shot: &Shot, plan: &PatchPlan, e: usize, count: u32, rng: &mut Rng) -> 
     let lifted = &lifted[..receiver.len()];
     let (mut visible, mut traced) = (0u32, 0u32);
     let (mut from4, mut to4, mut n) = ([Vec3::ZERO; 4], [Vec3::ZERO; 4], 0);
-    let mut strata = Strata::new(count);
+    let count = strata.count();
     for _ in 0..count {
         // The same stratum on both ends, each jittered on its own.
         let stratum = strata.next();
