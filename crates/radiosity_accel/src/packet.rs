@@ -9,7 +9,7 @@
 
 use glam::{Vec3, Vec3A, Vec4};
 
-use crate::{BruteForce, SEGMENT_MARGIN, nudge};
+use crate::{BruteForce, SEGMENT_MARGIN};
 
 /// Up to four segments in structure-of-arrays form: lane `i` is segment `i`.
 #[derive(Clone, Copy, Debug)]
@@ -24,21 +24,20 @@ impl Segments4 {
     /// The segments `from[i] → to[i]` for `i < count` (at most four); other lanes are empty.
     pub fn new(from: &[Vec3; 4], to: &[Vec3; 4], count: usize) -> Self {
         let count = count.min(4);
-        let mut o = [[0.0f32; 4]; 3];
-        let mut d = [[0.0f32; 4]; 3];
+        let (mut o, mut e) = ([[0.0f32; 4]; 3], [[0.0f32; 4]; 3]);
         for i in 0..count {
-            // The one-ray test's direction, nudged the same way (see `nudge`).
-            let dir = nudge(Vec3A::from(to[i] - from[i]));
             for axis in 0..3 {
                 o[axis][i] = from[i][axis];
-                d[axis][i] = dir[axis];
+                e[axis][i] = to[i][axis];
             }
         }
-        Self {
-            origin: o.map(Vec4::from_array),
-            direction: d.map(Vec4::from_array),
-            live: (1u32 << count) - 1,
-        }
+        let origin = o.map(Vec4::from_array);
+        let d = [0, 1, 2].map(|a| Vec4::from_array(e[a]) - origin[a]);
+        // The one-ray test's direction, nudged the same way (see `nudge`), in the lanes:
+        // components below 1e-7 of the largest take that size with their own sign.
+        let eps = d[0].abs().max(d[1].abs()).max(d[2].abs()) * 1e-7;
+        let direction = d.map(|c| Vec4::select(c.abs().cmplt(eps), eps.copysign(c + Vec4::ZERO), c));
+        Self { origin, direction, live: (1u32 << count) - 1 }
     }
 
     /// Bit `i` set for each lane that holds a segment.
