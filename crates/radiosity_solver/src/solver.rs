@@ -1082,7 +1082,7 @@ const TARGETS: usize = 16;
 
 /// Index in the ray-end table of the cell that holds `(u, v)` ∈ [0,1)².
 fn target_cell(u: f32, v: f32) -> usize {
-    let cell = |x: f32| ((x * TARGETS as f32) as usize).min(TARGETS - 1);
+    let cell = |x: f32| ((x * TARGETS as f32) as u32).min(TARGETS as u32 - 1) as usize;
     cell(v) * TARGETS + cell(u)
 }
 
