@@ -8,7 +8,7 @@
 //! noise (4 rays per element and shooter, 16 in penumbrae), the coarse shooters' density
 //! weighting at one point per receiver, and the coarse solution's own seed spread (about
 //! 1 % RMS between seeds 0–3: a shooter's ray ends and its uneven-density switch are fixed
-//! from noisy first-shot values). Measured, seed 0: 1.28 % area-weighted RMS (seeds 1–3:
+//! from noisy first-shot values). Measured, seed 0: 1.29 % area-weighted RMS (seeds 1–3:
 //! 0.8–1.0 %), worst channel 7.3 % of its object's brightest channel (short block side,
 //! brighter on coarse patches for every seed); without the density weighting 3.2 % and
 //! 25 %. Bounds: 1.5 % and 8 %.

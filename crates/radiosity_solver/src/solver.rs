@@ -278,7 +278,7 @@ pub struct Solver {
     factors: Vec<Received>,
     /// Per element, whether it takes penumbra rays from the current shooter.
     penumbra: Vec<bool>,
-    /// Elements sharing a vertex (see [`element_neighbours`]).
+    /// Elements sharing an edge (see [`element_neighbours`]).
     neighbour_start: Vec<u32>,
     neighbours: Vec<u32>,
     /// Per element, the cumulative share of its patch's unshot power over the patch's
@@ -960,9 +960,12 @@ impl Solver {
 /// Key bit of an element's penumbra-ray stream, apart from its pilot-ray stream.
 const PENUMBRA_STREAM: u64 = 1 << 63;
 
-/// Each element's neighbours: the elements sharing a vertex with it (the mesh shares
+/// Each element's neighbours: the elements sharing an edge with it (the mesh shares
 /// vertices within a surface, across its patches too), as `(start, list)`: element `e`'s
-/// are `list[start[e]..start[e + 1]]`.
+/// are `list[start[e]..start[e + 1]]`. Edge neighbours, not vertex ones: on Cornell 15.6 k
+/// the diagonal neighbours added 7 % more rays (4 % of the solve) and changed neither the
+/// object means (0.17 % against 0.19 % RMS from 64 rays) nor the render (0.76 % against
+/// 0.73 % RMS pixel difference from a 64-ray render).
 fn element_neighbours(mesh: &Mesh) -> (Vec<u32>, Vec<u32>) {
     // Elements around each vertex, then the union over an element's vertices.
     let mut around = vec![Vec::new(); mesh.positions.len()];
@@ -977,7 +980,12 @@ fn element_neighbours(mesh: &Mesh) -> (Vec<u32>, Vec<u32>) {
         let first = list.len();
         for &v in el.vertex_indices() {
             for &n in &around[v as usize] {
-                if n as usize != e && !list[first..].contains(&n) {
+                let shared = mesh.elements[n as usize]
+                    .vertex_indices()
+                    .iter()
+                    .filter(|v| el.vertex_indices().contains(v))
+                    .count();
+                if n as usize != e && shared >= 2 && !list[first..].contains(&n) {
                     list.push(n);
                 }
             }
@@ -1252,7 +1260,7 @@ fn element_facing(shooter: &radiosity_core::Patch, plan: &PatchPlan, receiver: &
             && receiver.iter().all(|p| shooter.normal.dot(*p - corner) > 1e-9 * shooter.area.sqrt()))
 }
 
-/// Does `e` get penumbra rays? When its neighbours' pilot rays (never its own: the choice
+/// Does `e` get penumbra rays? When its (edge) neighbours' pilot rays (never its own: the choice
 /// must not depend on the rays it is averaged with, or it is biased) saw a penumbra: some
 /// neighbour saw the shooter in part, or some saw all of it and others none.
 ///
