@@ -3,14 +3,16 @@
 //!
 //! One small trait, [`RayQuery`], with two implementations: [`Bvh`], a four-wide BVH of our
 //! own traced one ray at a time with four-lane SIMD (`bvh4`: boxes and leaf triangles stored
-//! axis by axis, collapsed from obvhs's binary BVH built with PLOC and reinsertion), and
-//! [`BruteForce`], the obviously-correct reference the tests compare against, which also
-//! tests short candidate lists four rays at a time (`BruteForce::occluded_x4`).
+//! axis by axis, collapsed by least surface-area cost from obvhs's binary BVH built with
+//! PLOC and reinsertion), and [`BruteForce`], the obviously-correct reference the tests
+//! compare against, which also tests short candidate lists four rays at a time
+//! (`BruteForce::occluded_x4`).
 //!
 //! Measured on the bench's rays (108 k triangles, 1 M incoherent segments, one thread,
-//! `cargo run --release -p radiosity_accel --example ray_bench -- rays.bin`): 3.3 M rays/s,
-//! 1.7× obvhs's compressed wide BVH8 (which this replaced) in the same process, and
-//! 0.9–1.0× Embree on the same rays (`scripts/embree_bench.py`).
+//! `cargo run --release -p radiosity_accel --example ray_bench -- rays.bin`): 3.6–3.7 M
+//! rays/s, 1.8× obvhs's compressed wide BVH8 (which this replaced) in the same process;
+//! Embree (embreex, one thread, `scripts/embree_bench.py`) measured 3.63–3.69 M on the same
+//! rays, so about 1.0×. Building takes 0.25–0.35 s.
 #![warn(missing_docs)]
 #![forbid(unsafe_code)]
 
@@ -52,8 +54,8 @@ pub trait RayQuery: Send + Sync {
 
 /// Above this many triangles the BVH is built with obvhs's medium preset, below it with its
 /// slowest, best one. Measured on the bench's 108 k-triangle Cornell box (1 M segments, one
-/// thread): the slowest build took 0.25 s and traced 3.32–3.40 M rays/s, the medium one
-/// 0.05 s and 2.89 M; a 1 M-triangle model once spent 9 s in the slowest build.
+/// thread): the slowest build took 0.25–0.35 s and traced 3.6–3.7 M rays/s, the medium one
+/// 0.08 s and 3.25 M; a 1 M-triangle model once spent 9 s in the slowest build.
 pub const BEST_BUILD_LIMIT: usize = 250_000;
 
 /// Margin at both ends of an occlusion segment, as a fraction of its length.
