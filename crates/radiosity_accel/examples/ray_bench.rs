@@ -15,7 +15,10 @@ use std::time::Instant;
 
 use glam::{Vec3, Vec3A};
 use obvhs::{
-    BvhBuildParams, cwbvh::builder::build_cwbvh_from_tris, ray::Ray, rt_triangle::RtTriangle,
+    BvhBuildParams,
+    cwbvh::builder::build_cwbvh_from_tris,
+    ray::{Ray, RayHit},
+    rt_triangle::RtTriangle,
     triangle::Triangle,
 };
 use radiosity_accel::{BEST_BUILD_LIMIT, Bvh, RayQuery};
@@ -82,6 +85,41 @@ fn main() -> Result<(), String> {
         blocked_cw = segs.iter().filter(|(a, b)| cw_occluded(*a, *b)).count();
         best_cw = best_cw.min(thread_seconds(start) - t);
     }
+    // Closest hits (the image renderer's query) along the segments' lines, unbounded, on a
+    // fifth of them: the same triangle from both, or a tie in distance.
+    let rays = &segs[..ns / 5];
+    let cw_closest = |a: Vec3, b: Vec3| {
+        let mut hit = RayHit::none();
+        let ray = Ray::new(a.into(), Vec3A::from(b - a), 0.0, f32::INFINITY);
+        cw.ray_traverse(ray, &mut hit, |ray, id| leaves[id].intersect(ray));
+        (hit.t < f32::INFINITY).then(|| (cw.primitive_indices[hit.primitive_id as usize], hit.t))
+    };
+    let (mut best_ours_c, mut best_cw_c) = (f64::MAX, f64::MAX);
+    let (mut hits_ours, mut hits_cw) = (0, 0);
+    for _ in 0..rounds {
+        let t = thread_seconds(start);
+        hits_ours =
+            rays.iter().filter(|(a, b)| ours.closest_hit(*a, *b - *a, f32::INFINITY).is_some()).count();
+        best_ours_c = best_ours_c.min(thread_seconds(start) - t);
+        let t = thread_seconds(start);
+        hits_cw = rays.iter().filter(|(a, b)| cw_closest(*a, *b).is_some()).count();
+        best_cw_c = best_cw_c.min(thread_seconds(start) - t);
+    }
+    let differ = rays
+        .iter()
+        .filter(|(a, b)| {
+            let (x, y) = (ours.closest_hit(*a, *b - *a, f32::INFINITY), cw_closest(*a, *b));
+            match (x, y) {
+                (Some(x), Some((id, t))) => x.triangle != id && (x.t - t).abs() > 1e-5 * t,
+                (x, y) => x.is_some() != y.is_some(),
+            }
+        })
+        .count();
+    let (c1, c2) = (rays.len() as f64 / best_ours_c / 1e6, rays.len() as f64 / best_cw_c / 1e6);
+    println!(
+        "closest hits: ours {c1:.2} M rays/s ({hits_ours} hit), obvhs CwBvh {c2:.2} M rays/s ({hits_cw} hit): {:.2}×, {differ} differ",
+        c1 / c2
+    );
     // Where the two disagree, the brute-force answer says who is right.
     let brute = radiosity_accel::BruteForce::new(&tris);
     let all: Vec<u32> = (0..nt as u32).collect();
