@@ -1,29 +1,30 @@
 //! Ray queries for the radiosity renderer: segment occlusion (visibility between a receiver
 //! point and a point on a shooting patch) and closest hit (the image renderer).
 //!
-//! One small trait, [`RayQuery`], with two implementations: [`Bvh`], a four-wide BVH of our
-//! own traced one ray at a time with four-lane SIMD (`bvh4`: boxes and leaf triangles stored
-//! axis by axis, collapsed by least surface-area cost from obvhs's binary BVH built with
-//! PLOC and reinsertion), and [`BruteForce`], the obviously-correct reference the tests
+//! One small trait, [`RayQuery`], with two implementations: [`Bvh`], a sixteen-wide BVH of
+//! our own traced one ray at a time with four-lane SIMD (`wide`: boxes and leaf triangles
+//! stored axis by axis, collapsed by least surface-area cost from obvhs's binary BVH built
+//! with PLOC and reinsertion), and [`BruteForce`], the obviously-correct reference the tests
 //! compare against, which also tests short candidate lists four rays at a time
 //! (`BruteForce::occluded_x4`).
 //!
 //! Measured on the bench's rays (108 k triangles, 1 M incoherent segments, one thread,
-//! `cargo run --release -p radiosity_accel --example ray_bench -- rays.bin`): 3.6–3.7 M
-//! rays/s, 1.8× obvhs's compressed wide BVH8 (which this replaced) in the same process;
+//! `cargo run --release -p radiosity_accel --example ray_bench -- rays.bin`): 4.9–5.0 M
+//! rays/s, 2.4–2.5× obvhs's compressed wide BVH8 (which this replaced) in the same process;
 //! Embree (embreex, one thread, `scripts/embree_bench.py`) measured 3.63–3.69 M on the same
-//! rays, so about 1.0×. Building takes 0.25–0.35 s.
+//! rays, so about 1.35×. Closest hits 1.9 M rays/s, 1.3× the BVH8. Building takes
+//! 0.25–0.35 s.
 #![warn(missing_docs)]
 #![forbid(unsafe_code)]
 
 use glam::{Vec3, Vec3A};
-mod bvh4;
 mod packet;
+mod wide;
 
 pub use packet::Segments4;
 
-use bvh4::Bvh4;
 use obvhs::{BvhBuildParams, ray::Ray, rt_triangle::RtTriangle, triangle::Triangle};
+use wide::WideBvh;
 
 /// A ray hit: distance and the hit triangle with barycentric coordinates.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -54,8 +55,8 @@ pub trait RayQuery: Send + Sync {
 
 /// Above this many triangles the BVH is built with obvhs's medium preset, below it with its
 /// slowest, best one. Measured on the bench's 108 k-triangle Cornell box (1 M segments, one
-/// thread): the slowest build took 0.25–0.35 s and traced 3.6–3.7 M rays/s, the medium one
-/// 0.08 s and 3.25 M; a 1 M-triangle model once spent 9 s in the slowest build.
+/// thread): the slowest build took 0.25–0.35 s and traced 4.9–5.0 M rays/s, the medium one
+/// 0.07 s and 4.2–4.3 M; a 1 M-triangle model once spent 9 s in the slowest build.
 pub const BEST_BUILD_LIMIT: usize = 250_000;
 
 /// Margin at both ends of an occlusion segment, as a fraction of its length.
@@ -97,9 +98,9 @@ fn segment_ray(from: Vec3, to: Vec3) -> Ray {
     Ray::new(Vec3A::from(from), nudge(Vec3A::from(to - from)), SEGMENT_MARGIN, 1.0 - SEGMENT_MARGIN)
 }
 
-/// A four-wide BVH over triangles, traced with four-lane SIMD (see the `bvh4` module).
+/// A sixteen-wide BVH over triangles, traced with four-lane SIMD (see the `wide` module).
 pub struct Bvh {
-    tree: Bvh4,
+    tree: WideBvh,
     triangles: Vec<Triangle>,
 }
 
@@ -112,7 +113,7 @@ impl Bvh {
         } else {
             BvhBuildParams::medium_build()
         };
-        Self { tree: Bvh4::new(&triangles, params), triangles }
+        Self { tree: WideBvh::new(&triangles, params), triangles }
     }
 }
 
