@@ -75,12 +75,15 @@ fn barycentric(tri: &Triangle, p: Vec3A) -> (f32, f32) {
     let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
     let (d1, d2) = (d.dot(e1), d.dot(e2));
     let det = d11 * d22 - d12 * d12;
-    if det == 0.0 {
-        return (0.0, 0.0);
-    }
     let u = (d22 * d1 - d12 * d2) / det;
     let v = (d11 * d2 - d12 * d1) / det;
-    (u.clamp(0.0, 1.0), v.clamp(0.0, 1.0 - u.clamp(0.0, 1.0)))
+    // A degenerate triangle (det 0) or one so large that the products overflow gives NaN:
+    // take its first vertex rather than let a clamp on NaN panic.
+    if !(u.is_finite() && v.is_finite()) {
+        return (0.0, 0.0);
+    }
+    let u = u.clamp(0.0, 1.0);
+    (u, v.clamp(0.0, 1.0 - u))
 }
 
 /// Replaces direction components that are (almost) zero by a tiny value of the same sign.
@@ -320,6 +323,16 @@ mod tests {
         let h = bvh.closest_hit(Vec3::new(0.2, 0.3, 1.0), -Vec3::Z, 10.0).unwrap();
         assert!((h.t - 1.0).abs() < 1e-6);
         assert!((h.u - 0.2).abs() < 1e-6 && (h.v - 0.3).abs() < 1e-6);
+    }
+
+    /// A triangle too large for single-precision dot products still gives a hit with
+    /// barycentrics in range, not a panic.
+    #[test]
+    fn a_huge_triangle_hits_without_panicking() {
+        let tri = [[Vec3::new(-1e18, -1e18, 0.0), Vec3::new(1e18, -1e18, 0.0), Vec3::new(0.0, 1e18, 0.0)]];
+        let h = Bvh::new(&tri).closest_hit(Vec3::new(1.0, 2.0, 5.0), -Vec3::Z, 10.0).unwrap();
+        assert!((h.t - 5.0).abs() < 1e-5);
+        assert!((0.0..=1.0).contains(&h.u) && (0.0..=1.0 - h.u).contains(&h.v), "{h:?}");
     }
 
     #[test]
