@@ -82,6 +82,10 @@ pub struct SolveOpts {
     /// More rays for a receiver whose neighbours' first visibility rays saw a penumbra; 0: none.
     #[arg(long, default_value_t = 12)]
     pub penumbra_rays: u32,
+    /// Penumbra rays only from shooters whose shot carries at least this share of the
+    /// emitted power (0: from every shooter).
+    #[arg(long, default_value_t = 0.01, value_name = "SHARE")]
+    pub penumbra_power: f64,
     /// Memory for keeping each shooter's form factors for its next shots, in MiB (0: keep
     /// none; the answer is the same, only slower).
     #[arg(long, default_value_t = 256, value_name = "MIB")]
@@ -160,6 +164,7 @@ pub fn settings(scene_arg: &str, o: &SolveOpts) -> Result<Settings> {
         },
         visibility_rays: o.visibility_rays,
         penumbra_rays: o.penumbra_rays,
+        penumbra_power: o.penumbra_power,
         unshot_threshold: o.unshot_threshold.or(scene.solver.unshot_threshold).unwrap_or(1e-3),
         max_shots: o.max_shots.or(scene.solver.max_shots),
         time_limit,

@@ -84,6 +84,8 @@ fn bad_options_are_input_errors() {
         &["solve", "furnace", "--unshot-threshold", "2"][..],
         &["solve", "furnace", "--light-scale", "nan"][..],
         &["solve", "furnace", "--threads", "0"][..],
+        &["solve", "furnace", "--penumbra-power", "1.5"][..],
+        &["solve", "furnace", "--penumbra-power", "nan"][..],
     ] {
         let o = radiosity(args);
         assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));

@@ -108,3 +108,49 @@ fn penumbra_rays_leave_direct_light_unbiased() {
     eprintln!("direct light, default rays against 256: area-weighted RMS {rms:.4}");
     assert!(rms < 0.004, "area-weighted RMS {rms}");
 }
+
+/// Penumbra rays from dim shooters buy nothing that shows (see
+/// `SolverParams::penumbra_power`): the Cornell box at 15.6 k elements, solved with penumbra
+/// rays from the shooters whose first shot carries ≥ 1 % of the emitted power (the default)
+/// and from every shooter, each against 64 rays per element and shooter. Measured: 5.55 M
+/// against 8.39 M rays, area-weighted RMS of the per-object difference 0.179 % against
+/// 0.183 %. Bounds: at most 80 % of the rays, and within a tenth of the other's error (and
+/// 0.3 %).
+#[test]
+fn penumbra_rays_from_dim_shooters_are_not_missed() {
+    let scene = radiosity_io::builtin_scene("cornell").unwrap();
+    let params = MeshParams::try_new(scene.mesh_params().patch_size.max(14.3), 14.3).unwrap();
+    let mesh = Arc::new(Mesh::build(&scene, &params).unwrap());
+    let solve = |params: SolverParams| {
+        let accel = Arc::new(Bvh::new(&occluder_triangles(&mesh)));
+        let mut solver = Solver::new(Arc::clone(&mesh), accel, params).unwrap();
+        solver.solve();
+        (solver.solution().object_radiosity(&mesh), solver.rays())
+    };
+    let (bright, bright_rays) = solve(SolverParams::default());
+    let (every, every_rays) = solve(SolverParams { penumbra_power: 0.0, ..SolverParams::default() });
+    let (many, _) = solve(SolverParams { visibility_rays: 64, penumbra_rays: 0, ..SolverParams::default() });
+    let error = |objects: &[radiosity_solver::ObjectRadiosity]| {
+        let (mut sum, mut weight) = (0.0, 0.0);
+        for (o, m) in objects.iter().zip(&many) {
+            if o.name == "light" {
+                continue;
+            }
+            for (x, y) in [
+                (o.radiosity.r, m.radiosity.r),
+                (o.radiosity.g, m.radiosity.g),
+                (o.radiosity.b, m.radiosity.b),
+            ] {
+                sum += o.area * (x / y - 1.0).powi(2);
+                weight += o.area;
+            }
+        }
+        (sum / weight).sqrt()
+    };
+    let (e_bright, e_every) = (error(&bright), error(&every));
+    eprintln!(
+        "rays {bright_rays} against {every_rays}; RMS against 64 rays {e_bright:.5} against {e_every:.5}"
+    );
+    assert!(bright_rays * 10 <= every_rays * 8, "{bright_rays} rays against {every_rays}");
+    assert!(e_bright <= 1.1 * e_every && e_bright < 0.003, "RMS {e_bright} against {e_every}");
+}
