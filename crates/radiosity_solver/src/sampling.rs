@@ -51,10 +51,13 @@ pub(crate) fn point_on(poly: &[DVec3], u: f64, v: f64) -> DVec3 {
     }
 }
 
-/// Strata for `count` samples in the unit square: ⌈√count⌉ columns and as many rows as it
-/// takes, so that the rows cover the square (12 samples: 4 × 3). A square `k × k` grid for
-/// every count, as this was once, leaves rows empty whenever `count` is not a square: 12
-/// samples on a 4 × 4 grid never reached the last quarter of either patch.
+/// Strata for `count` samples in the unit square: `columns × rows = count` cells, one sample
+/// each, with the columns the smallest divisor of `count` not below √count (12 samples:
+/// 4 × 3, 8: 4 × 2, a prime: one row). Every cell must hold a sample or the estimate is
+/// biased: a square `k × k` grid for every count, as this was once, left the last quarter
+/// of both patches unsampled with 12 samples on 4 × 4, and ⌈√count⌉ columns with as many
+/// rows as it takes, as it was next, left the corner cell empty with 8 samples on 3 × 3
+/// (a block side 2 % too bright against 64 rays).
 ///
 /// Samples come row after row; each call to [`Strata::next`] moves to the next stratum
 /// (counters, not a division per sample: rays are cheap enough for that to show).
@@ -70,8 +73,9 @@ pub(crate) struct Strata {
 impl Strata {
     /// The grid for `count` samples (at least one cell), at its first stratum.
     pub(crate) fn new(count: u32) -> Self {
-        let columns = (count as f64).sqrt().ceil().max(1.0) as u32;
-        let rows = count.div_ceil(columns).max(1);
+        let count = count.max(1);
+        let columns = (1..=count).find(|&c| c * c >= count && count.is_multiple_of(c)).unwrap_or(count);
+        let rows = count / columns;
         Self { count, columns, rows, scale: (1.0 / columns as f32, 1.0 / rows as f32), at: (0, 0) }
     }
 
@@ -120,7 +124,7 @@ pub(crate) fn point_on_f32(poly: &[Vec3A], u: f32, v: f32) -> Vec3A {
 mod tests {
     use super::*;
 
-    /// Every row and column of the grid holds a sample, and whole grids hold one per cell.
+    /// Every cell of the grid holds exactly one sample, for every count.
     #[test]
     fn strata_cover_the_square_for_every_count() {
         let mut rng = Rng::for_task(1, 2, 3);
@@ -143,9 +147,9 @@ mod tests {
             for col in 0..c.min(count as usize) {
                 assert!((0..r).any(|row| cells[row * c + col] > 0), "count {count}: column {col} empty");
             }
-            if c * r == count as usize {
-                assert!(cells.iter().all(|&n| n == 1), "count {count}: {cells:?}");
-            }
+            assert_eq!(c * r, count as usize, "count {count}: {c} × {r}");
+            assert!(cells.iter().all(|&n| n == 1), "count {count}: {cells:?}");
+            assert!(c >= r, "count {count}: {c} × {r}");
         }
     }
 }
