@@ -76,16 +76,20 @@ pub struct SolveOpts {
     /// Form factor method.
     #[arg(long, value_enum, default_value_t = FormFactorArg::Exact)]
     pub form_factor: FormFactorArg,
-    /// Visibility rays per receiver and shooter.
-    #[arg(long, default_value_t = 4)]
+    /// Visibility rays per receiver from a bright shooter (see --bright-share).
+    #[arg(long, default_value_t = 8)]
     pub visibility_rays: u32,
-    /// More rays for a receiver whose neighbours' first visibility rays saw a penumbra; 0: none.
+    /// More rays from a bright shooter for a receiver whose neighbours' first visibility rays
+    /// saw a penumbra; 0: none.
     #[arg(long, default_value_t = 12)]
     pub penumbra_rays: u32,
-    /// Penumbra rays only from shooters whose shot carries at least this share of the
-    /// emitted power (0: from every shooter).
+    /// Visibility rays per receiver from a dim shooter.
+    #[arg(long, default_value_t = 1)]
+    pub dim_rays: u32,
+    /// A shooter is bright when its first shot carries at least this share of the first
+    /// (largest) shot's power; 0: every shooter is.
     #[arg(long, default_value_t = 0.01, value_name = "SHARE")]
-    pub penumbra_power: f64,
+    pub bright_share: f64,
     /// Memory for keeping each shooter's form factors for its next shots, in MiB (0: keep
     /// none; the answer is the same, only slower).
     #[arg(long, default_value_t = 256, value_name = "MIB")]
@@ -164,7 +168,8 @@ pub fn settings(scene_arg: &str, o: &SolveOpts) -> Result<Settings> {
         },
         visibility_rays: o.visibility_rays,
         penumbra_rays: o.penumbra_rays,
-        penumbra_power: o.penumbra_power,
+        dim_rays: o.dim_rays,
+        bright_share: o.bright_share,
         unshot_threshold: o.unshot_threshold.or(scene.solver.unshot_threshold).unwrap_or(1e-3),
         max_shots: o.max_shots.or(scene.solver.max_shots),
         time_limit,

@@ -84,8 +84,9 @@ fn bad_options_are_input_errors() {
         &["solve", "furnace", "--unshot-threshold", "2"][..],
         &["solve", "furnace", "--light-scale", "nan"][..],
         &["solve", "furnace", "--threads", "0"][..],
-        &["solve", "furnace", "--penumbra-power", "1.5"][..],
-        &["solve", "furnace", "--penumbra-power", "nan"][..],
+        &["solve", "furnace", "--bright-share", "1.5"][..],
+        &["solve", "furnace", "--bright-share", "nan"][..],
+        &["solve", "furnace", "--dim-rays", "0"][..],
     ] {
         let o = radiosity(args);
         assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));

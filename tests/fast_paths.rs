@@ -9,7 +9,8 @@
 //! f32 kernel is within 3e-7 absolute and ~4e-7 relative in total of the f64 one (its own
 //! test), so elements agree to 1e-5 relative. A ray that grazes a triangle edge may come out
 //! differently in the tree and in a candidate list, moving that element's share of one shot
-//! by a quarter of the visibility (4 rays). So: every element within 1e-5 relative, except at
+//! by its ray's share of the visibility (an eighth from a bright shooter, all of it from a
+//! dim one, whose shot is small). So: every element within 1e-5 relative, except at
 //! most 0.1 % of elements, none of them off by more than 5 %; per-object means within 1e-4.
 
 use std::sync::Arc;
