@@ -1199,16 +1199,16 @@ fn corners_of(mesh: &Mesh, e: usize) -> [DVec3; 4] {
     pts
 }
 
-/// The first pass for element `e`: its unoccluded form factor and `params.visibility_rays`
-/// pilot rays.
-fn receive(shot: &Shot, plan: &PatchPlan, e: usize) -> Received {
+/// Element `e`'s form factor to the shooter without visibility (weighted for an uneven
+/// shooter).
+fn unoccluded(shot: &Shot, plan: &PatchPlan, e: usize) -> f64 {
     let Shot { mesh, shooter, shooter_elements, uneven, params, .. } = *shot;
     let el = &mesh.elements[e];
     let pts = corners_of(mesh, e);
     let receiver = &pts[..el.vertex_count as usize];
     let corners = shooter.corners();
     let facing = element_facing(shooter, plan, receiver);
-    let unoccluded = match params.form_factor {
+    match params.form_factor {
         FormFactorMethod::Exact => {
             let (n, rule) = if plan.far {
                 (1, Rule::Midpoint)
@@ -1252,50 +1252,93 @@ fn receive(shot: &Shot, plan: &PatchPlan, e: usize) -> Received {
         FormFactorMethod::PointToPoint => {
             point_to_point(el.centre, el.normal, shooter.centre, shooter.normal, shooter.area)
         }
-    };
-    pilot(shot, plan, e, unoccluded)
-}
-
-/// Element `e`'s pilot rays, once its unoccluded form factor is known.
-fn pilot(shot: &Shot, plan: &PatchPlan, e: usize, unoccluded: f64) -> Received {
-    if unoccluded <= 0.0 {
-        return Received::default();
     }
-    let mut rng = Rng::for_task(shot.params.seed, shot.stream, e as u64);
-    let (visible, traced) = trace(shot, plan, e, shot.pilot, &mut rng);
-    Received { unoccluded, visible, traced }
 }
 
 /// The first pass for the elements of one receiving patch (`first` is its first element,
-/// `out` its slice). A patch that faces the shooter from far away takes its elements' form
-/// factors four at a time (one midpoint each, nothing to clip: the same formula and points
-/// as [`receive`]).
+/// `out` its slice): their unoccluded form factors, then their pilot rays. A patch that faces
+/// the shooter from far away takes its elements' form factors four at a time (one midpoint
+/// each, nothing to clip: the same formula and points as [`unoccluded`]).
 fn receive_patch(shot: &Shot, plan: &PatchPlan, first: usize, out: &mut [Received]) {
+    out.fill(Received::default());
     if !plan.live {
-        out.fill(Received::default());
         return;
     }
     let params = shot.params;
-    if !(plan.facing && plan.far && !params.reference_path && params.form_factor == FormFactorMethod::Exact) {
+    if plan.facing && plan.far && !params.reference_path && params.form_factor == FormFactorMethod::Exact {
+        let corners = shot.shooter.corners();
+        for (c, chunk) in out.chunks_mut(4).enumerate() {
+            let base = first + 4 * c;
+            let (mut points, mut normals) = ([DVec3::ZERO; 4], [DVec3::ZERO; 4]);
+            for (k, (p, n)) in points.iter_mut().zip(&mut normals).take(chunk.len()).enumerate() {
+                let el = &shot.mesh.elements[base + k];
+                *p = shot.mesh.element_corners(base + k).sum::<DVec3>() / f64::from(el.vertex_count);
+                *n = el.normal;
+            }
+            let f = points_to_polygon_in_front_x4(&points, &normals, chunk.len(), corners);
+            for (r, f) in chunk.iter_mut().zip(f) {
+                r.unoccluded = f.max(0.0);
+            }
+        }
+    } else {
         for (k, r) in out.iter_mut().enumerate() {
-            *r = receive(shot, plan, first + k);
+            r.unoccluded = unoccluded(shot, plan, first + k).max(0.0);
+        }
+    }
+    if plan.visibility == Visibility::Clear {
+        return;
+    }
+    if shot.pilot.count() == 1 && plan.visibility == Visibility::Few {
+        // One ray per element: four elements' rays share a packet (the same rays as one
+        // packet each, a quarter of the tests).
+        let mut order = [0u32; FEW];
+        let candidates = &mut order[..plan.candidates.len()];
+        candidates.copy_from_slice(&plan.candidates);
+        let mut packet = Packet::default();
+        let mut test = |packet: &mut Packet, out: &mut [Received]| {
+            let blocked =
+                shot.blockers.occluded_x4(&Segments4::new(&packet.from, &packet.to, packet.n), candidates);
+            for (lane, &k) in packet.owner[..packet.n].iter().enumerate() {
+                out[k as usize].visible += u32::from(blocked >> lane & 1 == 0);
+                out[k as usize].traced += 1;
+            }
+            packet.n = 0;
+        };
+        for k in 0..out.len() {
+            if out[k].unoccluded <= 0.0 {
+                continue;
+            }
+            let mut rng = Rng::for_task(params.seed, shot.stream, (first + k) as u64);
+            draw_rays(shot, plan, first + k, shot.pilot, &mut rng, |from, to| {
+                packet.from[packet.n] = from;
+                packet.to[packet.n] = to;
+                packet.owner[packet.n] = k as u32;
+                packet.n += 1;
+            });
+            if packet.n == 4 {
+                test(&mut packet, out);
+            }
+        }
+        if packet.n > 0 {
+            test(&mut packet, out);
         }
         return;
     }
-    let corners = shot.shooter.corners();
-    for (c, chunk) in out.chunks_mut(4).enumerate() {
-        let base = first + 4 * c;
-        let (mut points, mut normals) = ([DVec3::ZERO; 4], [DVec3::ZERO; 4]);
-        for (k, (p, n)) in points.iter_mut().zip(&mut normals).take(chunk.len()).enumerate() {
-            let el = &shot.mesh.elements[base + k];
-            *p = shot.mesh.element_corners(base + k).sum::<DVec3>() / f64::from(el.vertex_count);
-            *n = el.normal;
-        }
-        let f = points_to_polygon_in_front_x4(&points, &normals, chunk.len(), corners);
-        for (k, r) in chunk.iter_mut().enumerate() {
-            *r = pilot(shot, plan, base + k, f[k]);
+    for (k, r) in out.iter_mut().enumerate() {
+        if r.unoccluded > 0.0 {
+            let mut rng = Rng::for_task(params.seed, shot.stream, (first + k) as u64);
+            (r.visible, r.traced) = trace(shot, plan, first + k, shot.pilot, &mut rng);
         }
     }
+}
+
+/// Up to four segments to test together; lane `i` belongs to `owner[i]`.
+#[derive(Default)]
+struct Packet {
+    from: [Vec3; 4],
+    to: [Vec3; 4],
+    owner: [u32; 4],
+    n: usize,
 }
 
 /// The element (corners `receiver`) and the shooter see each other whole: no clipping, no
@@ -1336,12 +1379,8 @@ fn wants_penumbra_rays(first: &[Received], e: usize, neighbours: &[u32]) -> bool
 
 /// Stratified rays between element `e` and the shooter, one per stratum of `strata` (fresh,
 /// at its first stratum): (unblocked, traced).
-fn trace(shot: &Shot, plan: &PatchPlan, e: usize, mut strata: Strata, rng: &mut Rng) -> (u32, u32) {
-    let Shot { mesh, shooter, targets, lifted_targets, accel, boxes, blockers, offset, .. } = *shot;
-    let el = &mesh.elements[e];
-    let pts = corners_of(mesh, e);
-    let receiver = &pts[..el.vertex_count as usize];
-    let corners = shooter.corners();
+fn trace(shot: &Shot, plan: &PatchPlan, e: usize, strata: Strata, rng: &mut Rng) -> (u32, u32) {
+    let Shot { mesh, shooter, accel, boxes, blockers, offset, .. } = *shot;
     // Every segment between the element and the shooter lies in the box around both; when no
     // blocking triangle comes near that box the pair is fully visible and needs no ray.
     if plan.visibility == Visibility::Clear {
@@ -1357,11 +1396,58 @@ fn trace(shot: &Shot, plan: &PatchPlan, e: usize, mut strata: Strata, rng: &mut 
     if few {
         candidates.copy_from_slice(&plan.candidates);
     } else {
-        let (lo, hi) = bounds(receiver.iter().chain(corners));
+        let pts = corners_of(mesh, e);
+        let (lo, hi) = bounds(pts[..mesh.elements[e].vertex_count as usize].iter().chain(shooter.corners()));
         if !boxes.may_block(lo, hi, 2.0 * offset) {
             return (0, 0);
         }
     }
+    // Unblocked segments of a packet: four at once against the candidate list, one by one
+    // through the ray structure.
+    let mut unblocked = |packet: &Packet| -> u32 {
+        if few {
+            let blocked =
+                blockers.occluded_x4(&Segments4::new(&packet.from, &packet.to, packet.n), candidates);
+            packet.n as u32 - blocked.count_ones()
+        } else {
+            (0..packet.n).filter(|&i| !accel.occluded(packet.from[i], packet.to[i])).count() as u32
+        }
+    };
+    let (mut visible, mut traced) = (0u32, 0u32);
+    let mut packet = Packet::default();
+    draw_rays(shot, plan, e, strata, rng, |from, to| {
+        packet.from[packet.n] = from;
+        packet.to[packet.n] = to;
+        packet.n += 1;
+        traced += 1;
+        if packet.n == 4 {
+            visible += unblocked(&packet);
+            packet.n = 0;
+        }
+    });
+    if packet.n > 0 {
+        visible += unblocked(&packet);
+    }
+    // None traced: the parts of each that face the other are too small to hit; the caller
+    // then takes the pair as unblocked.
+    (visible, traced)
+}
+
+/// Draws element `e`'s rays to the shooter, one per stratum of `strata` (fresh, at its first
+/// stratum), and hands each segment (ends lifted off both surfaces, single precision) to
+/// `ray`.
+fn draw_rays(
+    shot: &Shot,
+    plan: &PatchPlan,
+    e: usize,
+    mut strata: Strata,
+    rng: &mut Rng,
+    mut ray: impl FnMut(Vec3, Vec3),
+) {
+    let Shot { mesh, shooter, targets, lifted_targets, offset, .. } = *shot;
+    let el = &mesh.elements[e];
+    let pts = corners_of(mesh, e);
+    let receiver = &pts[..el.vertex_count as usize];
     // The form factor counts only the part of the shooter in front of the receiver point
     // (and receiver points in front of the shooter), so the visibility must be the fraction
     // of *that* part that is unblocked. A ray to a shooter point behind the receiver's plane
@@ -1371,16 +1457,6 @@ fn trace(shot: &Shot, plan: &PatchPlan, e: usize, mut strata: Strata, rng: &mut 
     let clipped = !element_facing(shooter, plan, receiver);
     let ahead =
         |from: DVec3, to: DVec3| el.normal.dot(to - from) > 0.0 && shooter.normal.dot(from - to) > 0.0;
-    // Unblocked segments among the first `n` of a batch of up to four: four at once
-    // against the candidate list, one by one through the ray structure.
-    let mut unblocked = |from: &[Vec3; 4], to: &[Vec3; 4], n: usize| -> u32 {
-        if few {
-            let blocked = blockers.occluded_x4(&Segments4::new(from, to, n), candidates);
-            n as u32 - blocked.count_ones()
-        } else {
-            (0..n).filter(|&i| !accel.occluded(from[i], to[i])).count() as u32
-        }
-    };
     // Ray origins on the element lifted off its surface, in single precision.
     let lift = el.normal * offset;
     let mut lifted = [Vec3A::ZERO; 4];
@@ -1388,16 +1464,13 @@ fn trace(shot: &Shot, plan: &PatchPlan, e: usize, mut strata: Strata, rng: &mut 
         *l = (*p + lift).as_vec3().into();
     }
     let lifted = &lifted[..receiver.len()];
-    let (mut visible, mut traced) = (0u32, 0u32);
-    let (mut from4, mut to4, mut n) = ([Vec3::ZERO; 4], [Vec3::ZERO; 4], 0);
-    let count = strata.count();
-    for _ in 0..count {
+    for _ in 0..strata.count() {
         // The same stratum on both ends, each jittered on its own.
         let stratum = strata.next();
         let (u, v) = strata.jitter(stratum, rng);
         let (a, b) = strata.jitter(stratum, rng);
         let mut cell = target_cell(a, b);
-        if clipped {
+        let from = if clipped {
             let mut from = point_on(receiver, f64::from(u), f64::from(v));
             let mut tries = 0;
             while !ahead(from, targets[cell]) && tries < REDRAWS {
@@ -1409,24 +1482,12 @@ fn trace(shot: &Shot, plan: &PatchPlan, e: usize, mut strata: Strata, rng: &mut 
             if !ahead(from, targets[cell]) {
                 continue;
             }
-            from4[n] = (from + lift).as_vec3();
+            (from + lift).as_vec3()
         } else {
-            from4[n] = point_on_f32(lifted, u, v).into();
-        }
-        to4[n] = lifted_targets[cell];
-        n += 1;
-        traced += 1;
-        if n == 4 {
-            visible += unblocked(&from4, &to4, n);
-            n = 0;
-        }
+            point_on_f32(lifted, u, v).into()
+        };
+        ray(from, lifted_targets[cell]);
     }
-    if n > 0 {
-        visible += unblocked(&from4, &to4, n);
-    }
-    // None traced: the parts of each that face the other are too small to hit; the caller
-    // then takes the pair as unblocked.
-    (visible, traced)
 }
 
 /// Σ_k d_k F_{p→k} / Σ_k F_{p→k} over the shooter's elements k: how much brighter than its
