@@ -273,6 +273,9 @@ pub struct Solver {
     vertex_area: Vec<f64>,
     /// Element areas, packed for the shot loop.
     element_area: Vec<f64>,
+    /// Per patch, the reflectance all its elements share, if they do (they do unless a
+    /// caller's mesh mixes materials within a patch).
+    patch_reflectance: Vec<Option<Rgb>>,
     emitted: Rgb,
     absorbed: Rgb,
     escaped: Rgb,
@@ -527,6 +530,15 @@ impl Solver {
             .collect();
         let (neighbour_start, neighbours) = element_neighbours(&mesh);
         let element_area = mesh.elements.iter().map(|el| el.area).collect();
+        let patch_reflectance = mesh
+            .patches
+            .iter()
+            .map(|p| {
+                let mut rho = reflectance[p.elements.start as usize..p.elements.end as usize].iter();
+                let first = *rho.next()?;
+                rho.all(|r| *r == first).then_some(first)
+            })
+            .collect();
         let mut s = Self {
             patch_unshot_power: vec![Rgb::ZERO; mesh.patches.len()],
             plans: vec![PatchPlan::default(); mesh.patches.len()],
@@ -561,6 +573,7 @@ impl Solver {
             unshot: emission,
             vertex_area,
             element_area,
+            patch_reflectance,
             emitted,
             absorbed: Rgb::ZERO,
             escaped: Rgb::ZERO,
@@ -767,16 +780,30 @@ impl Solver {
             let elements = first..first + count;
             let (rho, area) = (&self.reflectance[elements.clone()], &self.element_area[elements.clone()]);
             let (radiosity, unshot) = (&mut self.radiosity[elements.clone()], &mut self.unshot[elements]);
-            for k in 0..count {
-                let f = f64::from(factors[k]);
-                if f == 0.0 {
-                    continue;
+            if let Some(rho) = self.patch_reflectance[mesh.elements[first].patch as usize] {
+                // One reflectance for the whole span (the usual case): ρ × the shot's
+                // radiosity once, and what the span gains is that times Σ F·A.
+                let per_factor = rho * shot_b;
+                for k in 0..count {
+                    let f = f64::from(factors[k]);
+                    let reflected = per_factor * f; // ρ × irradiance from this shot, W/unit²
+                    radiosity[k] += reflected;
+                    unshot[k] += reflected;
+                    seen += f * area[k];
                 }
-                let reflected = rho[k] * (shot_b * f); // ρ × irradiance from this shot, W/unit²
-                radiosity[k] += reflected;
-                unshot[k] += reflected;
-                gained += reflected * area[k];
-                seen += f * area[k];
+                gained = per_factor * seen;
+            } else {
+                for k in 0..count {
+                    let f = f64::from(factors[k]);
+                    if f == 0.0 {
+                        continue;
+                    }
+                    let reflected = rho[k] * (shot_b * f);
+                    radiosity[k] += reflected;
+                    unshot[k] += reflected;
+                    gained += reflected * area[k];
+                    seen += f * area[k];
+                }
             }
             let span_received = shot_b * seen;
             received += span_received;
