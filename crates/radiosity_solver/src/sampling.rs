@@ -16,10 +16,29 @@ fn mix(mut z: u64) -> u64 {
 /// A small SplitMix64 stream.
 pub(crate) struct Rng(u64);
 
+/// Four uniform numbers in [0, 1) with 16 bits each from one hash of `key` and `index`:
+/// the one ray of a receiver from a dim shooter (its two ends' points), for one hash instead
+/// of a stream's five. Sixteen bits place a point within 1/65 536 of an element's side.
+pub(crate) fn four_units(key: u64, index: u64) -> [f32; 4] {
+    let bits = mix(key ^ index);
+    [0, 16, 32, 48].map(|shift| (bits >> shift & 0xffff) as u32 as f32 / 65_536.0)
+}
+
 impl Rng {
+    /// A stream that starts from `state` (itself a hash: see [`four_units`]'s callers).
+    pub(crate) fn from_state(state: u64) -> Self {
+        Rng(mix(state))
+    }
+
     /// The stream for one `(seed, task, element)` task.
     pub(crate) fn for_task(seed: u64, task: u64, element: u64) -> Self {
         Rng(mix(seed ^ mix(task ^ mix(element))))
+    }
+
+    /// 64 uniform bits.
+    pub(crate) fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        mix(self.0)
     }
 
     /// A uniform number in [0, 1).

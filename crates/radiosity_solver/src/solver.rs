@@ -30,7 +30,7 @@ use crate::form_factor::{
     point_to_polygon_in_front_x4, points_to_polygon_in_front_x4,
 };
 use crate::occluders::{OccluderBoxes, blocking_triangles};
-use crate::sampling::{Rng, Strata, point_on, point_on_f32};
+use crate::sampling::{Rng, Strata, four_units, point_on, point_on_f32};
 use crate::shaft::{Blockers, FEW, Pair, Visibility, bounds};
 use crate::solution::{Solution, vertex_average};
 
@@ -972,6 +972,7 @@ impl Solver {
             params: &self.params,
             offset: self.ray_offset,
             stream: shooter as u64,
+            single_key: Rng::for_task(self.params.seed, shooter as u64, SINGLE_STREAM).next_u64(),
             pilot: Strata::new(if self.bright[shooter] {
                 self.params.visibility_rays
             } else {
@@ -1006,12 +1007,11 @@ impl Solver {
             for_each_maybe_parallel(&mut self.penumbra, |e, out| {
                 *out = wants_penumbra_rays(first, e, &adjacent[start[e] as usize..start[e + 1] as usize]);
             });
-            let (flags, seed) = (&self.penumbra, self.params.seed);
+            let flags = &self.penumbra;
             for_each_maybe_parallel(&mut self.factors, |e, out| {
                 if flags[e] {
                     let plan = &plans[mesh.elements[e].patch as usize];
-                    let mut rng = Rng::for_task(seed, shot.stream, e as u64 | PENUMBRA_STREAM);
-                    let (visible, traced) = trace(&shot, plan, e, shot.penumbra, &mut rng);
+                    let (visible, traced) = trace(&shot, plan, e, Rays::Penumbra);
                     out.visible += visible;
                     out.traced += traced;
                 }
@@ -1035,6 +1035,9 @@ impl Solver {
 
 /// Key bit of an element's penumbra-ray stream, apart from its pilot-ray stream.
 const PENUMBRA_STREAM: u64 = 1 << 63;
+
+/// Key of a row's one-ray hashes, apart from every element's streams.
+const SINGLE_STREAM: u64 = (1 << 63) - 1;
 
 /// Each element's neighbours: the elements sharing an edge with it (the mesh shares
 /// vertices within a surface, across its patches too), as `(start, list)`: element `e`'s
@@ -1144,6 +1147,8 @@ struct Shot<'a> {
     offset: f64,
     /// Key of the random streams: the shooter, so that every shot of it draws the same rays.
     stream: u64,
+    /// Key of the one-ray receivers' hashes (see [`four_units`]).
+    single_key: u64,
     /// Strata of the pilot and of the penumbra rays.
     pilot: Strata,
     penumbra: Strata,
@@ -1335,8 +1340,7 @@ fn receive_patch(shot: &Shot, plan: &PatchPlan, first: usize, out: &mut [Receive
             if out[k].unoccluded <= 0.0 {
                 continue;
             }
-            let mut rng = Rng::for_task(params.seed, shot.stream, (first + k) as u64);
-            draw_rays(shot, plan, first + k, shot.pilot, &mut rng, |from, to| {
+            draw(shot, plan, first + k, Rays::Pilot, |from, to| {
                 packet.from[packet.n] = from;
                 packet.to[packet.n] = to;
                 packet.owner[packet.n] = k as u32;
@@ -1353,8 +1357,7 @@ fn receive_patch(shot: &Shot, plan: &PatchPlan, first: usize, out: &mut [Receive
     }
     for (k, r) in out.iter_mut().enumerate() {
         if r.unoccluded > 0.0 {
-            let mut rng = Rng::for_task(params.seed, shot.stream, (first + k) as u64);
-            (r.visible, r.traced) = trace(shot, plan, first + k, shot.pilot, &mut rng);
+            (r.visible, r.traced) = trace(shot, plan, first + k, Rays::Pilot);
         }
     }
 }
@@ -1404,9 +1407,37 @@ fn wants_penumbra_rays(first: &[Received], e: usize, neighbours: &[u32]) -> bool
     full && none
 }
 
-/// Stratified rays between element `e` and the shooter, one per stratum of `strata` (fresh,
-/// at its first stratum): (unblocked, traced).
-fn trace(shot: &Shot, plan: &PatchPlan, e: usize, strata: Strata, rng: &mut Rng) -> (u32, u32) {
+/// Which of an element's rays to a shooter.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Rays {
+    /// Its first rays: `shot.pilot`'s strata.
+    Pilot,
+    /// Its penumbra rays: `shot.penumbra`'s strata.
+    Penumbra,
+}
+
+/// Draws element `e`'s `rays` to the shooter and hands each segment to `ray` (see
+/// [`draw_rays`]). Every path draws an element's rays here, so the fast and the reference
+/// paths trace the same rays. Each set has its own stream keyed by the shooter and the
+/// element; a lone first ray (from a dim shooter) takes its four coordinates from one hash.
+fn draw(shot: &Shot, plan: &PatchPlan, e: usize, rays: Rays, ray: impl FnMut(Vec3, Vec3)) {
+    let (seed, key) = (shot.params.seed, e as u64);
+    match rays {
+        Rays::Pilot if shot.pilot.count() == 1 => {
+            let [u, v, a, b] = four_units(shot.single_key, key);
+            let mut redraws = Rng::from_state(shot.single_key ^ key);
+            draw_rays_from(shot, plan, e, 1, &mut redraws, ray, |_| ((u, v), (a, b)));
+        }
+        Rays::Pilot => draw_rays(shot, plan, e, shot.pilot, &mut Rng::for_task(seed, shot.stream, key), ray),
+        Rays::Penumbra => {
+            let mut rng = Rng::for_task(seed, shot.stream, key | PENUMBRA_STREAM);
+            draw_rays(shot, plan, e, shot.penumbra, &mut rng, ray);
+        }
+    }
+}
+
+/// Element `e`'s `rays` to the shooter, traced: (unblocked, traced).
+fn trace(shot: &Shot, plan: &PatchPlan, e: usize, rays: Rays) -> (u32, u32) {
     let Shot { mesh, shooter, accel, boxes, blockers, offset, .. } = *shot;
     // Every segment between the element and the shooter lies in the box around both; when no
     // blocking triangle comes near that box the pair is fully visible and needs no ray.
@@ -1442,7 +1473,7 @@ fn trace(shot: &Shot, plan: &PatchPlan, e: usize, strata: Strata, rng: &mut Rng)
     };
     let (mut visible, mut traced) = (0u32, 0u32);
     let mut packet = Packet::default();
-    draw_rays(shot, plan, e, strata, rng, |from, to| {
+    draw(shot, plan, e, rays, |from, to| {
         packet.from[packet.n] = from;
         packet.to[packet.n] = to;
         packet.n += 1;
@@ -1469,7 +1500,26 @@ fn draw_rays(
     e: usize,
     mut strata: Strata,
     rng: &mut Rng,
+    ray: impl FnMut(Vec3, Vec3),
+) {
+    let count = strata.count();
+    draw_rays_from(shot, plan, e, count, rng, ray, |rng| {
+        // The same stratum on both ends, each jittered on its own.
+        let stratum = strata.next();
+        (strata.jitter(stratum, rng), strata.jitter(stratum, rng))
+    });
+}
+
+/// [`draw_rays`] for `count` rays whose `(u, v)` on the element and `(a, b)` on the shooter
+/// come from `sample`; `rng` draws the redraws.
+fn draw_rays_from(
+    shot: &Shot,
+    plan: &PatchPlan,
+    e: usize,
+    count: u32,
+    rng: &mut Rng,
     mut ray: impl FnMut(Vec3, Vec3),
+    mut sample: impl FnMut(&mut Rng) -> ((f32, f32), (f32, f32)),
 ) {
     let Shot { mesh, shooter, targets, lifted_targets, offset, .. } = *shot;
     let el = &mesh.elements[e];
@@ -1491,11 +1541,8 @@ fn draw_rays(
         *l = (*p + lift).as_vec3().into();
     }
     let lifted = &lifted[..receiver.len()];
-    for _ in 0..strata.count() {
-        // The same stratum on both ends, each jittered on its own.
-        let stratum = strata.next();
-        let (u, v) = strata.jitter(stratum, rng);
-        let (a, b) = strata.jitter(stratum, rng);
+    for _ in 0..count {
+        let ((u, v), (a, b)) = sample(rng);
         let mut cell = target_cell(a, b);
         let from = if clipped {
             let mut from = point_on(receiver, f64::from(u), f64::from(v));
