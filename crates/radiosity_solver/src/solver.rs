@@ -273,6 +273,9 @@ pub struct Solver {
     vertex_area: Vec<f64>,
     /// Element areas, packed for the shot loop.
     element_area: Vec<f64>,
+    /// Per element, the mean of its vertices: the one quadrature point of a far element (the
+    /// centre of the bilinear map, see `for_each_point`), which every row needs.
+    vertex_means: Vec<DVec3>,
     /// Per patch, the reflectance all its elements share, if they do (they do unless a
     /// caller's mesh mixes materials within a patch).
     patch_reflectance: Vec<Option<Rgb>>,
@@ -530,6 +533,9 @@ impl Solver {
             .collect();
         let (neighbour_start, neighbours) = element_neighbours(&mesh);
         let element_area = mesh.elements.iter().map(|el| el.area).collect();
+        let vertex_means = (0..n)
+            .map(|e| mesh.element_corners(e).sum::<DVec3>() / f64::from(mesh.elements[e].vertex_count))
+            .collect();
         let patch_reflectance = mesh
             .patches
             .iter()
@@ -573,6 +579,7 @@ impl Solver {
             unshot: emission,
             vertex_area,
             element_area,
+            vertex_means,
             patch_reflectance,
             emitted,
             absorbed: Rgb::ZERO,
@@ -961,6 +968,7 @@ impl Solver {
             targets: &self.targets,
             lifted_targets: &self.lifted_targets,
             shooter_elements: &self.shooter_elements,
+            vertex_means: &self.vertex_means,
             uneven: self.nonuniform[shooter].then_some(Uneven {
                 density,
                 clusters: &self.clusters,
@@ -1137,6 +1145,8 @@ struct Shot<'a> {
     lifted_targets: &'a [Vec3],
     /// The shooter's elements.
     shooter_elements: &'a [ShooterElement],
+    /// Every element's vertex mean (see [`Solver::vertex_means`]).
+    vertex_means: &'a [DVec3],
     /// How the shooter's unshot radiosity is spread, when it is uneven.
     uneven: Option<Uneven<'a>>,
     accel: &'a dyn RayQuery,
@@ -1255,7 +1265,7 @@ fn unoccluded(shot: &Shot, plan: &PatchPlan, e: usize) -> f64 {
             let mut f = 0.0;
             if facing && plan.far && fast {
                 // One midpoint and nothing to clip.
-                let centre = receiver.iter().copied().sum::<DVec3>() / receiver.len() as f64;
+                let centre = shot.vertex_means[e];
                 f = point_to_polygon_in_front_x4(centre, el.normal, corners);
             } else if facing {
                 let eval = if fast { point_to_polygon_in_front_x4 } else { point_to_polygon_in_front };
@@ -1303,9 +1313,8 @@ fn receive_patch(shot: &Shot, plan: &PatchPlan, first: usize, out: &mut [Receive
             let base = first + 4 * c;
             let (mut points, mut normals) = ([DVec3::ZERO; 4], [DVec3::ZERO; 4]);
             for (k, (p, n)) in points.iter_mut().zip(&mut normals).take(chunk.len()).enumerate() {
-                let el = &shot.mesh.elements[base + k];
-                *p = shot.mesh.element_corners(base + k).sum::<DVec3>() / f64::from(el.vertex_count);
-                *n = el.normal;
+                *p = shot.vertex_means[base + k];
+                *n = shot.mesh.elements[base + k].normal;
             }
             let f = points_to_polygon_in_front_x4(&points, &normals, chunk.len(), corners);
             for (r, f) in chunk.iter_mut().zip(f) {
