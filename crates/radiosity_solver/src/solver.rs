@@ -276,6 +276,8 @@ pub struct Solver {
     /// Per element, the mean of its vertices: the one quadrature point of a far element (the
     /// centre of the bilinear map, see `for_each_point`), which every row needs.
     vertex_means: Vec<DVec3>,
+    /// Per element, its circumradius about its centre (see [`element_radius`]).
+    element_radii: Vec<f64>,
     /// Per patch, the reflectance all its elements share, if they do (they do unless a
     /// caller's mesh mixes materials within a patch).
     patch_reflectance: Vec<Option<Rgb>>,
@@ -522,12 +524,14 @@ impl Solver {
         let (lo, hi) = mesh.bounds();
         // One scan for both ray-skipping structures (it can cost T × V half-space tests).
         let blocking = blocking_triangles(&mesh);
+        let element_radii: Vec<f64> = (0..n).map(|e| element_radius(&mesh, e)).collect();
         let patch_element_radius = mesh
             .patches
             .iter()
             .map(|p| {
-                (p.elements.start..p.elements.end)
-                    .map(|e| element_radius(&mesh, e as usize))
+                element_radii[p.elements.start as usize..p.elements.end as usize]
+                    .iter()
+                    .copied()
                     .fold(0.0, f64::max)
             })
             .collect();
@@ -580,6 +584,7 @@ impl Solver {
             vertex_area,
             element_area,
             vertex_means,
+            element_radii,
             patch_reflectance,
             emitted,
             absorbed: Rgb::ZERO,
@@ -934,7 +939,7 @@ impl Solver {
             }
             let count = mesh.elements[e as usize].vertex_count;
             let centre = mesh.elements[e as usize].centre;
-            let radius = element_radius(&mesh, e as usize);
+            let radius = self.element_radii[e as usize];
             let area = mesh.elements[e as usize].area;
             self.shooter_elements.push(ShooterElement { corners, count, centre, radius, area });
         }
@@ -969,6 +974,7 @@ impl Solver {
             lifted_targets: &self.lifted_targets,
             shooter_elements: &self.shooter_elements,
             vertex_means: &self.vertex_means,
+            element_radii: &self.element_radii,
             uneven: self.nonuniform[shooter].then_some(Uneven {
                 density,
                 clusters: &self.clusters,
@@ -980,6 +986,7 @@ impl Solver {
             params: &self.params,
             offset: self.ray_offset,
             stream: shooter as u64,
+            shooter_radius: corners.iter().map(|c| c.distance(patch.centre)).fold(0.0, f64::max),
             single_key: Rng::for_task(self.params.seed, shooter as u64, SINGLE_STREAM).next_u64(),
             pilot: Strata::new(if self.bright[shooter] {
                 self.params.visibility_rays
@@ -1132,6 +1139,31 @@ fn quadrature(el_radius: f64, gap: f64, max: u32) -> (u32, Rule) {
     (((4.0 * el_radius / gap).ceil() as u32).clamp(1, max), Rule::Gauss)
 }
 
+/// [`quadrature`] for an element at `centre` with circumradius `radius`, and the shooter
+/// (circumradius `shooter_radius` about its centre). The exact distance to the shooter lies
+/// between the larger of the distance to its plane and the distance to its centre less its
+/// radius, and the distance to its centre; the rule only grows as the gap shrinks, so when
+/// both bounds (widened by a millionth, more than the exact distance's rounding) give the
+/// same rule, so does the exact distance, which is then not computed (it costs ~10 times
+/// as much for elements beside the shooter).
+fn element_quadrature(
+    centre: DVec3,
+    radius: f64,
+    shooter: &radiosity_core::Patch,
+    shooter_radius: f64,
+    max: u32,
+) -> (u32, Rule) {
+    let corners = shooter.corners();
+    let to_centre = centre.distance(shooter.centre);
+    let height = shooter.normal.dot(centre - corners[0]).abs();
+    let (low, high) = (height.max(to_centre - shooter_radius), to_centre);
+    let near = quadrature(radius, low * (1.0 - 1e-6) - radius, max);
+    if near == quadrature(radius, high * (1.0 + 1e-6) - radius, max) {
+        return near;
+    }
+    quadrature(radius, distance_to_polygon(centre, shooter.normal, corners) - radius, max)
+}
+
 /// An element takes one midpoint when its gap to the shooter exceeds this many of its radii.
 const MIDPOINT_RATIO: f64 = 16.0;
 
@@ -1147,6 +1179,8 @@ struct Shot<'a> {
     shooter_elements: &'a [ShooterElement],
     /// Every element's vertex mean (see [`Solver::vertex_means`]).
     vertex_means: &'a [DVec3],
+    /// Every element's circumradius.
+    element_radii: &'a [f64],
     /// How the shooter's unshot radiosity is spread, when it is uneven.
     uneven: Option<Uneven<'a>>,
     accel: &'a dyn RayQuery,
@@ -1159,6 +1193,8 @@ struct Shot<'a> {
     stream: u64,
     /// Key of the one-ray receivers' hashes (see [`four_units`]).
     single_key: u64,
+    /// The shooter's circumradius about its centre.
+    shooter_radius: f64,
     /// Strata of the pilot and of the penumbra rays.
     pilot: Strata,
     penumbra: Strata,
@@ -1255,9 +1291,8 @@ fn unoccluded(shot: &Shot, plan: &PatchPlan, e: usize) -> f64 {
             let (n, rule) = if plan.far {
                 (1, Rule::Midpoint)
             } else {
-                let el_radius = receiver.iter().map(|p| p.distance(el.centre)).fold(0.0, f64::max);
-                let gap = distance_to_polygon(el.centre, shooter.normal, corners) - el_radius;
-                quadrature(el_radius, gap, params.max_quadrature)
+                let el_radius = shot.element_radii[e];
+                element_quadrature(el.centre, el_radius, shooter, shot.shooter_radius, params.max_quadrature)
             };
             // The fast path evaluates the formula in four f32 lanes (within 3e-7 absolute of
             // the f64 loop, see `point_to_polygon_in_front_x4`); the reference path in f64.
