@@ -278,6 +278,8 @@ pub struct Solver {
     vertex_means: Vec<DVec3>,
     /// Per element, its circumradius about its centre (see [`element_radius`]).
     element_radii: Vec<f64>,
+    /// Per element, its corners lifted off it by the ray offset (see [`lift_corners`]).
+    lifted_corners: Vec<[Vec3A; 4]>,
     /// Per patch, the reflectance all its elements share, if they do (they do unless a
     /// caller's mesh mixes materials within a patch).
     patch_reflectance: Vec<Option<Rgb>>,
@@ -537,6 +539,8 @@ impl Solver {
             .collect();
         let (neighbour_start, neighbours) = element_neighbours(&mesh);
         let element_area = mesh.elements.iter().map(|el| el.area).collect();
+        let ray_offset = 1e-6 * (hi - lo).length();
+        let lifted_corners = lift_corners(&mesh, ray_offset);
         let vertex_means = (0..n)
             .map(|e| mesh.element_corners(e).sum::<DVec3>() / f64::from(mesh.elements[e].vertex_count))
             .collect();
@@ -571,7 +575,7 @@ impl Solver {
             penumbra: vec![false; n],
             neighbour_start,
             neighbours,
-            ray_offset: 1e-6 * (hi - lo).length(),
+            ray_offset,
             occluder_boxes: OccluderBoxes::new(&blocking),
             blockers: Blockers::new(&mesh, &blocking),
             patch_element_radius,
@@ -585,6 +589,7 @@ impl Solver {
             element_area,
             vertex_means,
             element_radii,
+            lifted_corners,
             patch_reflectance,
             emitted,
             absorbed: Rgb::ZERO,
@@ -975,6 +980,7 @@ impl Solver {
             shooter_elements: &self.shooter_elements,
             vertex_means: &self.vertex_means,
             element_radii: &self.element_radii,
+            lifted_corners: &self.lifted_corners,
             uneven: self.nonuniform[shooter].then_some(Uneven {
                 density,
                 clusters: &self.clusters,
@@ -1181,6 +1187,9 @@ struct Shot<'a> {
     vertex_means: &'a [DVec3],
     /// Every element's circumradius.
     element_radii: &'a [f64],
+    /// Every element's corners lifted off it by `offset`, in single precision: where its
+    /// rays start (see [`lift_corners`]).
+    lifted_corners: &'a [[Vec3A; 4]],
     /// How the shooter's unshot radiosity is spread, when it is uneven.
     uneven: Option<Uneven<'a>>,
     accel: &'a dyn RayQuery,
@@ -1219,6 +1228,22 @@ const TARGETS: usize = 16;
 fn target_cell(u: f32, v: f32) -> usize {
     let cell = |x: f32| ((x * TARGETS as f32) as u32).min(TARGETS as u32 - 1) as usize;
     cell(v) * TARGETS + cell(u)
+}
+
+/// Every element's corners lifted off its surface by `offset` along its normal, in single
+/// precision (a triangle's fourth slot stays zero): the origins of its rays, the same
+/// points every row.
+fn lift_corners(mesh: &Mesh, offset: f64) -> Vec<[Vec3A; 4]> {
+    (0..mesh.elements.len())
+        .map(|e| {
+            let lift = mesh.elements[e].normal * offset;
+            let mut out = [Vec3A::ZERO; 4];
+            for (l, p) in out.iter_mut().zip(mesh.element_corners(e)) {
+                *l = (p + lift).as_vec3().into();
+            }
+            out
+        })
+        .collect()
 }
 
 /// Circumradius of element `e` about its centre.
@@ -1567,6 +1592,16 @@ fn draw_rays_from(
 ) {
     let Shot { mesh, shooter, targets, lifted_targets, offset, .. } = *shot;
     let el = &mesh.elements[e];
+    let corners = shot.lifted_corners[e];
+    let lifted = &corners[..el.vertex_count as usize];
+    if plan.facing {
+        // Nothing to clip (the usual case): origins straight from the lifted corners.
+        for _ in 0..count {
+            let ((u, v), (a, b)) = sample(rng);
+            ray(point_on_f32(lifted, u, v).into(), lifted_targets[target_cell(a, b)]);
+        }
+        return;
+    }
     let pts = corners_of(mesh, e);
     let receiver = &pts[..el.vertex_count as usize];
     // The form factor counts only the part of the shooter in front of the receiver point
@@ -1578,13 +1613,7 @@ fn draw_rays_from(
     let clipped = !element_facing(shooter, plan, receiver);
     let ahead =
         |from: DVec3, to: DVec3| el.normal.dot(to - from) > 0.0 && shooter.normal.dot(from - to) > 0.0;
-    // Ray origins on the element lifted off its surface, in single precision.
     let lift = el.normal * offset;
-    let mut lifted = [Vec3A::ZERO; 4];
-    for (l, p) in lifted.iter_mut().zip(receiver) {
-        *l = (*p + lift).as_vec3().into();
-    }
-    let lifted = &lifted[..receiver.len()];
     for _ in 0..count {
         let ((u, v), (a, b)) = sample(rng);
         let mut cell = target_cell(a, b);
