@@ -280,9 +280,8 @@ pub struct Solver {
     element_radii: Vec<f64>,
     /// Per element, its corners lifted off it by the ray offset (see [`lift_corners`]).
     lifted_corners: Vec<[Vec3A; 4]>,
-    /// Per patch, the reflectance all its elements share, if they do (they do unless a
-    /// caller's mesh mixes materials within a patch).
-    patch_reflectance: Vec<Option<Rgb>>,
+    /// Per patch, its reflectance (a patch's elements share its surface's material).
+    patch_reflectance: Vec<Rgb>,
     emitted: Rgb,
     absorbed: Rgb,
     escaped: Rgb,
@@ -547,11 +546,7 @@ impl Solver {
         let patch_reflectance = mesh
             .patches
             .iter()
-            .map(|p| {
-                let mut rho = reflectance[p.elements.start as usize..p.elements.end as usize].iter();
-                let first = *rho.next()?;
-                rho.all(|r| *r == first).then_some(first)
-            })
+            .map(|p| mesh.materials[mesh.surfaces[p.surface as usize].material as usize].reflectance)
             .collect();
         let mut s = Self {
             patch_unshot_power: vec![Rgb::ZERO; mesh.patches.len()],
@@ -792,36 +787,21 @@ impl Solver {
             let (first, count) = (first as usize, count as usize);
             // Σ F·A over the span, then the irradiance once: what the span receives.
             let mut seen = 0.0;
-            let mut gained = Rgb::ZERO;
             let factors = &row.factors[offset..offset + count];
             let elements = first..first + count;
-            let (rho, area) = (&self.reflectance[elements.clone()], &self.element_area[elements.clone()]);
+            let area = &self.element_area[elements.clone()];
             let (radiosity, unshot) = (&mut self.radiosity[elements.clone()], &mut self.unshot[elements]);
-            if let Some(rho) = self.patch_reflectance[mesh.elements[first].patch as usize] {
-                // One reflectance for the whole span (the usual case): ρ × the shot's
-                // radiosity once, and what the span gains is that times Σ F·A.
-                let per_factor = rho * shot_b;
-                for k in 0..count {
-                    let f = f64::from(factors[k]);
-                    let reflected = per_factor * f; // ρ × irradiance from this shot, W/unit²
-                    radiosity[k] += reflected;
-                    unshot[k] += reflected;
-                    seen += f * area[k];
-                }
-                gained = per_factor * seen;
-            } else {
-                for k in 0..count {
-                    let f = f64::from(factors[k]);
-                    if f == 0.0 {
-                        continue;
-                    }
-                    let reflected = rho[k] * (shot_b * f);
-                    radiosity[k] += reflected;
-                    unshot[k] += reflected;
-                    gained += reflected * area[k];
-                    seen += f * area[k];
-                }
+            // A span is one patch, of one reflectance: ρ × the shot's radiosity once, and what
+            // the span gains is that times Σ F·A.
+            let per_factor = self.patch_reflectance[mesh.elements[first].patch as usize] * shot_b;
+            for k in 0..count {
+                let f = f64::from(factors[k]);
+                let reflected = per_factor * f; // ρ × irradiance from this shot, W/unit²
+                radiosity[k] += reflected;
+                unshot[k] += reflected;
+                seen += f * area[k];
             }
+            let gained = per_factor * seen;
             let span_received = shot_b * seen;
             received += span_received;
             self.absorbed += span_received - gained;
