@@ -93,3 +93,22 @@ fn kept_rows_change_nothing_whatever_the_budget() {
     assert_eq!(some.element_radiosity, none.element_radiosity);
     assert_eq!(all.element_unshot, none.element_unshot);
 }
+
+/// One thread or two give bit-identical solutions on a mesh large enough for every parallel
+/// part of a shot (the receiving patches' first pass, penumbra rays, and applying the shot
+/// span by span, which only runs in parallel above 32 k elements).
+#[test]
+fn one_and_two_threads_agree_on_a_large_cornell_box() {
+    let scene = radiosity_io::builtin_scene("cornell").unwrap();
+    let params = radiosity_core::MeshParams::try_new(scene.mesh_params().patch_size, 9.0).unwrap();
+    let mesh = Arc::new(Mesh::build(&scene, &params).unwrap());
+    assert!(mesh.elements.len() > 32_768, "{} elements", mesh.elements.len());
+    let run = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| solve_with(&mesh, SolverParams { max_shots: Some(60), ..SolverParams::default() }))
+    };
+    let (one, two) = (run(1), run(2));
+    assert_eq!(one.shots, 60);
+    assert_eq!(one.element_radiosity, two.element_radiosity);
+    assert_eq!(one.element_unshot, two.element_unshot);
+}

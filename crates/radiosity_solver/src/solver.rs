@@ -780,33 +780,53 @@ impl Solver {
         let mesh = Arc::clone(&self.mesh);
         let patch = &mesh.patches[shooter];
         let shot_b = self.patch_unshot_power[shooter] * (omega / patch.area);
-        // Sequential in element order: the sums are the same for any thread count.
-        let mut received = Rgb::ZERO;
-        let mut offset = 0;
+        // Each receiving span (one patch, of one reflectance) takes ρ × the shot's radiosity
+        // times F per element, and its Σ F·A; spans own disjoint elements, so they may run
+        // in parallel. The sums over spans then run in span order: the same numbers for any
+        // thread count.
+        let mut spans = Vec::with_capacity(row.spans.len());
+        let (mut radiosity, mut unshot) = (&mut self.radiosity[..], &mut self.unshot[..]);
+        let (mut at, mut offset) = (0, 0);
         for &(first, count) in &row.spans {
             let (first, count) = (first as usize, count as usize);
-            // Σ F·A over the span, then the irradiance once: what the span receives.
+            let (r, rest_r) = std::mem::take(&mut radiosity)[first - at..].split_at_mut(count);
+            let (u, rest_u) = std::mem::take(&mut unshot)[first - at..].split_at_mut(count);
+            (radiosity, unshot, at) = (rest_r, rest_u, first + count);
+            let rho = self.patch_reflectance[mesh.elements[first].patch as usize];
+            let area = &self.element_area[first..first + count];
+            spans.push((rho * shot_b, &row.factors[offset..offset + count], area, r, u));
+            offset += count;
+        }
+        let receive = |(per_factor, factors, area, radiosity, unshot): &mut (
+            Rgb,
+            &[f32],
+            &[f64],
+            &mut [Rgb],
+            &mut [Rgb],
+        )| {
             let mut seen = 0.0;
-            let factors = &row.factors[offset..offset + count];
-            let elements = first..first + count;
-            let area = &self.element_area[elements.clone()];
-            let (radiosity, unshot) = (&mut self.radiosity[elements.clone()], &mut self.unshot[elements]);
-            // A span is one patch, of one reflectance: ρ × the shot's radiosity once, and what
-            // the span gains is that times Σ F·A.
-            let per_factor = self.patch_reflectance[mesh.elements[first].patch as usize] * shot_b;
-            for k in 0..count {
+            for k in 0..factors.len() {
                 let f = f64::from(factors[k]);
-                let reflected = per_factor * f; // ρ × irradiance from this shot, W/unit²
+                let reflected = *per_factor * f; // ρ × irradiance from this shot, W/unit²
                 radiosity[k] += reflected;
                 unshot[k] += reflected;
                 seen += f * area[k];
             }
-            let gained = per_factor * seen;
+            seen
+        };
+        let seen: Vec<f64> = if mesh.elements.len() < APPLY_PARALLEL_MIN || rayon::current_num_threads() == 1
+        {
+            spans.iter_mut().map(receive).collect()
+        } else {
+            spans.par_iter_mut().with_min_len(APPLY_SPANS_PER_TASK).map(receive).collect()
+        };
+        let mut received = Rgb::ZERO;
+        for (&(first, _), (span, seen)) in row.spans.iter().zip(spans.iter().zip(seen)) {
+            let gained = span.0 * seen;
             let span_received = shot_b * seen;
             received += span_received;
             self.absorbed += span_received - gained;
-            self.patch_unshot_power[mesh.elements[first].patch as usize] += gained;
-            offset += count;
+            self.patch_unshot_power[mesh.elements[first as usize].patch as usize] += gained;
         }
         self.escaped += shot_b * patch.area - received;
         for e in patch.elements.start..patch.elements.end {
@@ -1074,6 +1094,12 @@ fn element_neighbours(mesh: &Mesh) -> (Vec<u32>, Vec<u32>) {
     }
     (start, list)
 }
+
+/// Below this many elements a shot is applied on one thread (a parallel pass costs more).
+const APPLY_PARALLEL_MIN: usize = 32_768;
+
+/// Receiving spans per parallel task when a shot is applied.
+const APPLY_SPANS_PER_TASK: usize = 16;
 
 /// Entries of one shooter's plans (receiving patches plus candidate triangles).
 fn plan_entries(plans: &[PatchPlan]) -> usize {
