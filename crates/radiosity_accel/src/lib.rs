@@ -219,6 +219,18 @@ impl RayQuery for BruteForce {
     }
 }
 
+/// Uniform numbers in [0, 1) from a seeded xorshift64 stream (24 bits each): the tests'
+/// random triangles and segments.
+#[cfg(test)]
+pub(crate) fn test_uniforms(mut seed: u64) -> impl FnMut() -> f32 {
+    move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -103,13 +103,7 @@ mod tests {
     #[test]
     fn four_lanes_answer_as_four_single_rays() {
         // A fan of small triangles and segments through and past them, some grazing edges.
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut next = crate::test_uniforms(0x2545_f491_4f6c_dd1du64);
         let mut tris = Vec::new();
         for _ in 0..40 {
             let c = Vec3::new(next(), next(), next()) * 4.0;

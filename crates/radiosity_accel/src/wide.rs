@@ -533,13 +533,7 @@ mod tests {
     /// nodes come out well filled (each node visited is a cache miss saved or spent).
     #[test]
     fn the_collapse_keeps_every_triangle_and_fills_the_nodes() {
-        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut next = crate::test_uniforms(0x9e37_79b9_7f4a_7c15u64);
         let triangles: Vec<Triangle> = (0..5000)
             .map(|_| {
                 let c = Vec3A::new(next(), next(), next()) * 10.0;
@@ -624,13 +618,8 @@ mod more_tests {
             [Vec3::new(-1.0, 0.2, 0.3), Vec3::new(2.0, 0.2, 0.3), Vec3::new(2.0, 0.2 + 1e-6, 0.3)], // sliver
             [Vec3::new(0.2, -1.0, -1.0), Vec3::new(0.2, 2.0, -1.0), Vec3::new(0.2, 0.5, 2.0)],
         ];
-        let mut seed = 0x853c_49e6_748f_ea9bu64;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 40) as f32 / (1u64 << 24) as f32 * 3.0 - 1.0
-        };
+        let mut uniform = crate::test_uniforms(0x853c_49e6_748f_ea9bu64);
+        let mut next = move || uniform() * 3.0 - 1.0;
         for n in 1..=base.len() {
             let tris = &base[..n];
             let (bvh, brute) = (Bvh::new(tris), BruteForce::new(tris));
@@ -648,13 +637,7 @@ mod more_tests {
     /// level of the collapse) agree with the scan, triangle and distance.
     #[test]
     fn closest_hits_agree_on_a_deep_tree() {
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut next = crate::test_uniforms(0x2545_f491_4f6c_dd1du64);
         let tris: Vec<[Vec3; 3]> = (0..3000)
             .map(|_| {
                 let c = Vec3::new(next(), next(), next()) * 10.0;
