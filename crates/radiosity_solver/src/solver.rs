@@ -266,7 +266,6 @@ pub struct Solver {
     mesh: Arc<Mesh>,
     accel: Arc<dyn RayQuery>,
     params: SolverParams,
-    reflectance: Vec<Rgb>,
     radiosity: Vec<Rgb>,
     unshot: Vec<Rgb>,
     patch_unshot_power: Vec<Rgb>,
@@ -507,7 +506,6 @@ impl Solver {
             return Err(SolverError::BadMesh { patch: mesh.patches.len() });
         }
         let n = mesh.elements.len();
-        let reflectance: Vec<Rgb> = (0..n).map(|e| mesh.element_material(e).reflectance).collect();
         let emission: Vec<Rgb> = (0..n).map(|e| mesh.element_material(e).emission).collect();
         let emitted: Rgb = mesh.elements.iter().zip(&emission).map(|(el, e)| *e * el.area).sum();
         if emitted.sum() <= 0.0 {
@@ -520,8 +518,10 @@ impl Solver {
             }
         }
         let total_area = mesh.total_area();
-        let mean_reflectance =
-            mesh.elements.iter().zip(&reflectance).map(|(el, r)| *r * el.area).sum::<Rgb>() / total_area;
+        let mean_reflectance = (mesh.elements.iter().enumerate())
+            .map(|(e, el)| mesh.element_material(e).reflectance * el.area)
+            .sum::<Rgb>()
+            / total_area;
         let (lo, hi) = mesh.bounds();
         // One scan for both ray-skipping structures (it can cost T × V half-space tests).
         let blocking = blocking_triangles(&mesh);
@@ -577,7 +577,6 @@ impl Solver {
             mesh,
             accel,
             params,
-            reflectance,
             radiosity: emission.clone(),
             unshot: emission,
             vertex_area,
@@ -715,7 +714,10 @@ impl Solver {
                 let unshot_power: Rgb = self.patch_unshot_power.iter().copied().sum();
                 let r = self.mean_reflectance.map(|m| 1.0 / (1.0 - m));
                 let ambient = r * unshot_power / self.total_area;
-                self.radiosity.iter().zip(&self.reflectance).map(|(b, rho)| *b + *rho * ambient).collect()
+                let mesh = &self.mesh;
+                (self.radiosity.iter().enumerate())
+                    .map(|(e, b)| *b + self.patch_reflectance[mesh.elements[e].patch as usize] * ambient)
+                    .collect()
             }
         };
         Solution {
@@ -1415,12 +1417,7 @@ fn receive_patch(shot: &Shot, plan: &PatchPlan, first: usize, out: &mut [Receive
             if out[k].unoccluded <= 0.0 {
                 continue;
             }
-            draw(shot, plan, first + k, Rays::Pilot, |from, to| {
-                packet.from[packet.n] = from;
-                packet.to[packet.n] = to;
-                packet.owner[packet.n] = k as u32;
-                packet.n += 1;
-            });
+            draw(shot, plan, first + k, Rays::Pilot, |from, to| packet.push(from, to, k as u32));
             if packet.n == 4 {
                 test(&mut packet, out);
             }
@@ -1444,6 +1441,14 @@ struct Packet {
     to: [Vec3; 4],
     owner: [u32; 4],
     n: usize,
+}
+
+impl Packet {
+    /// Adds the segment `from → to` of `owner` (the caller tests a full packet first).
+    fn push(&mut self, from: Vec3, to: Vec3, owner: u32) {
+        (self.from[self.n], self.to[self.n], self.owner[self.n]) = (from, to, owner);
+        self.n += 1;
+    }
 }
 
 /// The element (corners `receiver`) and the shooter see each other whole: no clipping, no
@@ -1549,9 +1554,7 @@ fn trace(shot: &Shot, plan: &PatchPlan, e: usize, rays: Rays) -> (u32, u32) {
     let (mut visible, mut traced) = (0u32, 0u32);
     let mut packet = Packet::default();
     draw(shot, plan, e, rays, |from, to| {
-        packet.from[packet.n] = from;
-        packet.to[packet.n] = to;
-        packet.n += 1;
+        packet.push(from, to, 0);
         traced += 1;
         if packet.n == 4 {
             visible += unblocked(&packet);
