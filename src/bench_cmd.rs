@@ -19,6 +19,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 use glam::{DVec3, Vec3};
 use radiosity_accel::{Bvh, RayQuery};
+use radiosity_core::random::XorShift64;
 use radiosity_core::{Mesh, MeshParams, Scene, Shape};
 use radiosity_solver::{Solver, SolverParams, occluder_triangles};
 use rayon::prelude::*;
@@ -43,18 +44,6 @@ pub struct BenchArgs {
     /// `scripts/embree_bench.py`, which traces the same rays with Embree).
     #[arg(long)]
     pub dump_rays: Option<String>,
-}
-
-/// A small deterministic generator (xorshift64): the cases must not change between runs.
-struct XorShift(u64);
-
-impl XorShift {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
 }
 
 /// Triangles of a UV sphere with `stacks × slices` cells.
@@ -121,11 +110,11 @@ fn random_segments(tris: &[[DVec3; 3]], count: usize, lift: f64) -> Vec<(Vec3, V
         total += 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
         cdf.push(total);
     }
-    let mut rng = XorShift(0x2545_F491_4F6C_DD1D);
-    let point = |rng: &mut XorShift| {
-        let k = cdf.partition_point(|&c| c < rng.next() * total).min(tris.len() - 1);
+    let mut rng = XorShift64::new(0x2545_F491_4F6C_DD1D);
+    let point = |rng: &mut XorShift64| {
+        let k = cdf.partition_point(|&c| c < rng.next_f64() * total).min(tris.len() - 1);
         let t = &tris[k];
-        let (s, v) = (rng.next().sqrt(), rng.next());
+        let (s, v) = (rng.next_f64().sqrt(), rng.next_f64());
         let p = t[0] * (1.0 - s) + t[1] * (s * (1.0 - v)) + t[2] * (s * v);
         let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
         (p, n)

@@ -222,51 +222,39 @@ impl RayQuery for BruteForce {
 /// Uniform numbers in [0, 1) from a seeded xorshift64 stream (24 bits each): the tests'
 /// random triangles and segments.
 #[cfg(test)]
-pub(crate) fn test_uniforms(mut seed: u64) -> impl FnMut() -> f32 {
-    move || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed >> 40) as f32 / (1u64 << 24) as f32
-    }
+pub(crate) fn test_uniforms(seed: u64) -> impl FnMut() -> f32 {
+    let mut rng = radiosity_core::random::XorShift64::new(seed);
+    move || rng.next_f32()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// A small deterministic generator so the test needs no crate.
-    struct XorShift(u64);
-    impl XorShift {
-        fn next_f32(&mut self) -> f32 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            (self.0 >> 40) as f32 / (1u64 << 24) as f32
-        }
-        fn point(&mut self) -> Vec3 {
-            Vec3::new(self.next_f32(), self.next_f32(), self.next_f32()) * 10.0
-        }
+    use radiosity_core::random::XorShift64;
+
+    fn random_point(rng: &mut XorShift64) -> Vec3 {
+        Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 10.0
     }
 
-    fn random_scene(rng: &mut XorShift, n: usize) -> Vec<[Vec3; 3]> {
+    fn random_scene(rng: &mut XorShift64, n: usize) -> Vec<[Vec3; 3]> {
         (0..n)
             .map(|_| {
-                let c = rng.point();
-                [c, c + (rng.point() - 5.0) * 0.3, c + (rng.point() - 5.0) * 0.3]
+                let c = random_point(rng);
+                [c, c + (random_point(rng) - 5.0) * 0.3, c + (random_point(rng) - 5.0) * 0.3]
             })
             .collect()
     }
 
     #[test]
     fn bvh_agrees_with_brute_force() {
-        let mut rng = XorShift(0x9e3779b97f4a7c15);
+        let mut rng = XorShift64::new(0x9e3779b97f4a7c15);
         let tris = random_scene(&mut rng, 500);
         let (bvh, brute) = (Bvh::new(&tris), BruteForce::new(&tris));
         let all: Vec<u32> = (0..tris.len() as u32).collect();
         let mut blocked = 0;
         for _ in 0..4000 {
-            let (a, b) = (rng.point(), rng.point());
+            let (a, b) = (random_point(&mut rng), random_point(&mut rng));
             let expected = brute.occluded(a, b);
             assert_eq!(bvh.occluded(a, b), expected, "segment {a} -> {b}");
             // The candidate-list test (its own copy of the triangle arithmetic) on every
@@ -286,7 +274,7 @@ mod tests {
     /// Above `BEST_BUILD_LIMIT` the other build preset answers the same.
     #[test]
     fn a_large_bvh_agrees_with_brute_force() {
-        let mut rng = XorShift(0x2545_f491_4f6c_dd1d);
+        let mut rng = XorShift64::new(0x2545_f491_4f6c_dd1d);
         let tris: Vec<[Vec3; 3]> = random_scene(&mut rng, BEST_BUILD_LIMIT + 1000)
             .into_iter()
             .map(|t| [t[0], t[0] + (t[1] - t[0]) * 0.04, t[0] + (t[2] - t[0]) * 0.04])
@@ -294,7 +282,7 @@ mod tests {
         let (bvh, brute) = (Bvh::new(&tris), BruteForce::new(&tris));
         let mut blocked = 0;
         for _ in 0..400 {
-            let (a, b) = (rng.point(), rng.point());
+            let (a, b) = (random_point(&mut rng), random_point(&mut rng));
             let expected = brute.occluded(a, b);
             assert_eq!(bvh.occluded(a, b), expected, "segment {a} -> {b}");
             blocked += usize::from(expected);

@@ -10,6 +10,7 @@
 mod canonical;
 mod color;
 mod mesh;
+pub mod random;
 mod scene;
 
 pub use canonical::{furnace_box, furnace_sphere, two_plates, unit_cube_floor_light};

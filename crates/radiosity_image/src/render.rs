@@ -21,12 +21,16 @@ use std::sync::Arc;
 
 use glam::{DVec2, DVec3, Vec3};
 use radiosity_accel::{Bvh, RayQuery};
+use radiosity_core::random::Rng;
 use radiosity_core::{Camera, Mesh, Rgb};
 use radiosity_solver::Solution;
 use rayon::prelude::*;
 use thiserror::Error;
 
 use crate::HdrImage;
+
+/// Task key of the pixels' streams (`Rng::for_task(seed, PIXEL_TASK, pixel)`).
+const PIXEL_TASK: u64 = 0x7069_7865_6c73; // "pixels"
 
 /// How radiosity is taken at a hit point.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -320,7 +324,7 @@ impl Renderer {
         pixels.par_chunks_mut(w).zip(object_ids.par_chunks_mut(w)).enumerate().for_each(|(y, (row, ids))| {
             for x in 0..w {
                 let index = (y * w + x) as u64;
-                let mut rng = Rng::new(params.seed, index);
+                let mut rng = Rng::for_task(params.seed, PIXEL_TASK, index);
                 let mut sum = Rgb::ZERO;
                 for i in 0..n {
                     let (jx, jy) = (rng.next_f64(), rng.next_f64());
@@ -430,31 +434,6 @@ fn inverse_bilinear(p: DVec2, a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> (f64, f
     let s = s_of(t);
     let s = if s.is_finite() { s } else { 0.0 };
     (s.clamp(0.0, 1.0), t.clamp(0.0, 1.0))
-}
-
-/// SplitMix64 (Steele, Lea & Flood 2014): a tiny, statistically sound generator whose stream
-/// is keyed by `(seed, pixel)`, so the picture does not depend on thread scheduling.
-struct Rng(u64);
-
-impl Rng {
-    fn new(seed: u64, index: u64) -> Self {
-        let mut r = Rng(seed ^ 0x9e37_79b9_7f4a_7c15);
-        let k = r.next_u64();
-        Rng(k ^ index.wrapping_mul(0xd1b5_4a32_d192_ed03))
-    }
-
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [0, 1), 53 bits.
-    fn next_f64(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-    }
 }
 
 #[cfg(test)]

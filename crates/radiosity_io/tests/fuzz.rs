@@ -8,8 +8,7 @@ use radiosity_io::parse_scene;
 
 const CORNELL: &str = include_str!("../../../scenes/cornell.toml");
 
-mod common;
-use common::XorShift;
+use radiosity_core::random::XorShift64;
 
 /// Fragments inserted or written over the text: TOML punctuation, the special floats, a
 /// multi-byte character, escapes, headers and keys that shift the structure.
@@ -59,7 +58,7 @@ const FRAGMENTS: &[&str] = &[
 ];
 
 /// Applies one random edit to `chars` (a char vector keeps the text valid UTF-8).
-fn mutate(chars: &mut Vec<char>, rng: &mut XorShift) {
+fn mutate(chars: &mut Vec<char>, rng: &mut XorShift64) {
     let len = chars.len().max(1);
     match rng.below(6) {
         0 => chars.truncate(rng.below(len)),
@@ -122,7 +121,7 @@ fn parse_without_panic(text: &str, what: &str) {
 #[test]
 fn random_mutations_never_panic() {
     let base: Vec<char> = CORNELL.chars().collect();
-    let mut rng = XorShift(0x9e37_79b9_7f4a_7c15);
+    let mut rng = XorShift64::new(0x9e37_79b9_7f4a_7c15);
     let mut accepted = 0;
     for i in 0..2000 {
         let mut chars = base.clone();

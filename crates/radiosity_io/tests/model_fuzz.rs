@@ -9,8 +9,7 @@ use radiosity_core::{Mesh, Rgb};
 use radiosity_io::{ModelFormat, Transform, glb_bytes, parse_model, resolve_scene};
 use radiosity_solver::Solution;
 
-mod common;
-use common::XorShift;
+use radiosity_core::random::XorShift64;
 
 /// Text fragments that break OBJ and glTF structure and numbers.
 const FRAGMENTS: &[&str] = &[
@@ -61,7 +60,7 @@ const FRAGMENTS: &[&str] = &[
     "\u{0}",
 ];
 
-fn mutate(rng: &mut XorShift, original: &[u8]) -> Vec<u8> {
+fn mutate(rng: &mut XorShift64, original: &[u8]) -> Vec<u8> {
     let mut b = original.to_vec();
     for _ in 0..1 + rng.below(4) {
         let at = rng.below(b.len() + 1);
@@ -95,7 +94,7 @@ fn mutate(rng: &mut XorShift, original: &[u8]) -> Vec<u8> {
 
 /// Runs `count` mutations of `original` through the importer for `format`.
 fn fuzz(name: &str, original: &[u8], format: ModelFormat, base: Option<&Path>, seed: u64, count: usize) {
-    let mut rng = XorShift(seed);
+    let mut rng = XorShift64::new(seed);
     let (mut ok, mut err) = (0, 0);
     for case in 0..count {
         let bytes = if case == 0 { original.to_vec() } else { mutate(&mut rng, original) };

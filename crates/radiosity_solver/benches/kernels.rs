@@ -63,13 +63,8 @@ fn form_factors(c: &mut Criterion) {
 
 /// Deterministic points for ray benchmarks.
 fn points(n: usize, seed: u64) -> Vec<Vec3> {
-    let mut s = seed;
-    let mut next = move || {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        (s >> 40) as f32 / (1u64 << 24) as f32
-    };
+    let mut rng = radiosity_core::random::XorShift64::new(seed);
+    let mut next = move || rng.next_f32();
     (0..n).map(|_| Vec3::new(next(), next(), next()) * 10.0).collect()
 }
 

@@ -428,13 +428,8 @@ mod tests {
 
     #[test]
     fn simd_kernel_matches_double_precision() {
-        let mut state = 0x1234_5678_9abc_def0u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = radiosity_core::random::XorShift64::new(0x1234_5678_9abc_def0u64);
+        let mut next = move || rng.next_f64();
         let (mut worst, mut total_error, mut total) = (0.0f64, 0.0, 0.0);
         for case in 0..20_000 {
             let size = 0.05 + next();
@@ -466,13 +461,8 @@ mod tests {
     /// closely as the edges-in-lanes kernel does (same bound as its test).
     #[test]
     fn receivers_in_lanes_match_double_precision() {
-        let mut state = 0x0bad_cafe_f00d_d00du64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = radiosity_core::random::XorShift64::new(0x0bad_cafe_f00d_d00du64);
+        let mut next = move || rng.next_f64();
         let (mut worst, mut checked) = (0.0f64, 0);
         for case in 0..5_000 {
             let size = 0.05 + next();

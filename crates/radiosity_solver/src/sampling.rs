@@ -1,60 +1,10 @@
-//! Seeded random streams and stratified points on patches.
+//! Stratified points on patches (the seeded streams are `radiosity_core::random`).
 //!
 //! Every stochastic choice draws from a stream keyed by `(seed, shooter, element)`, never by
 //! a thread, so one thread and many give bit-identical results.
 
 use glam::{DVec3, Vec3A};
-
-/// SplitMix64 finaliser (Steele, Lea & Flood 2014): a strong 64-bit mix.
-fn mix(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
-/// A small SplitMix64 stream.
-pub(crate) struct Rng(u64);
-
-/// Four uniform numbers in [0, 1) with 16 bits each from one hash of `key` and `index`:
-/// the one ray of a receiver from a dim shooter (its two ends' points), for one hash instead
-/// of a stream's five. Sixteen bits place a point within 1/65 536 of an element's side.
-pub(crate) fn four_units(key: u64, index: u64) -> [f32; 4] {
-    let bits = mix(key ^ index);
-    [0, 16, 32, 48].map(|shift| (bits >> shift & 0xffff) as u32 as f32 / 65_536.0)
-}
-
-impl Rng {
-    /// A stream that starts from `state` (itself a hash: see [`four_units`]'s callers).
-    pub(crate) fn from_state(state: u64) -> Self {
-        Rng(mix(state))
-    }
-
-    /// The stream for one `(seed, task, element)` task.
-    pub(crate) fn for_task(seed: u64, task: u64, element: u64) -> Self {
-        Rng(mix(seed ^ mix(task ^ mix(element))))
-    }
-
-    /// 64 uniform bits.
-    pub(crate) fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        mix(self.0)
-    }
-
-    /// A uniform number in [0, 1).
-    pub(crate) fn next_f64(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        (mix(self.0) >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    /// Two uniform numbers in [0, 1) with 24 bits each, from one draw.
-    pub(crate) fn next_f32_pair(&mut self) -> (f32, f32) {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let bits = mix(self.0);
-        let unit = |b: u64| (b & 0xff_ffff) as f32 / (1u32 << 24) as f32;
-        (unit(bits >> 40), unit(bits >> 8))
-    }
-}
+pub(crate) use radiosity_core::random::{Rng, four_units};
 
 /// The point at `(u, v)` ∈ [0,1)² on a triangle (area-uniform, Shirley's square-to-triangle
 /// map) or a convex quad (bilinear).
