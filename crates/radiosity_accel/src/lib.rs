@@ -5,23 +5,27 @@
 //! our own traced one ray at a time with four-lane SIMD (`wide`: boxes and leaf triangles
 //! stored axis by axis, collapsed by least surface-area cost from obvhs's binary BVH built
 //! with PLOC and reinsertion), and [`BruteForce`], the obviously-correct reference the tests
-//! compare against, which also tests short candidate lists four rays at a time
-//! (`BruteForce::occluded_x4`).
+//! compare against (every triangle, obvhs's own triangle test).
 //!
-//! Measured on the bench's rays (108 k triangles, 1 M incoherent segments, one thread,
-//! `cargo run --release -p radiosity_accel --example ray_bench -- rays.bin`): 4.9–5.0 M
-//! rays/s, 2.4–2.5× obvhs's compressed wide BVH8 (which this replaced) in the same process;
-//! Embree (embreex, one thread, `scripts/embree_bench.py`) measured 3.63–3.69 M on the same
-//! rays, so about 1.35×. Closest hits 1.9 M rays/s, 1.3× the BVH8. Building takes
-//! 0.25–0.35 s.
+//! Beside them, [`CandidateTriangles`] answers segments against short lists of triangle
+//! indices, four segments at a time: the solver's production path for receiver–shooter pairs
+//! that its shaft culling narrowed to a few triangles.
+//!
+//! All the fast paths share one four-lane segment–triangle test (`lanes`), which computes
+//! what obvhs's `RtTriangle::intersect` computes, bit for bit; the BVH traces the solver's
+//! incoherent segments faster than obvhs's compressed wide BVH8, which it replaced, and is
+//! within reach of Embree on the same rays (`cargo run --release -p radiosity_accel
+//! --example ray_bench -- rays.bin`, `scripts/embree_bench.py`; the figures are in
+//! `docs/PERFORMANCE.md`).
 #![warn(missing_docs)]
 #![forbid(unsafe_code)]
 
 use glam::{Vec3, Vec3A};
-mod packet;
+mod candidates;
+mod lanes;
 mod wide;
 
-pub use packet::Segments4;
+pub use candidates::{CandidateTriangles, Segments4};
 
 use obvhs::{BvhBuildParams, ray::Ray, rt_triangle::RtTriangle, triangle::Triangle};
 use wide::WideBvh;
@@ -54,9 +58,9 @@ pub trait RayQuery: Send + Sync {
 }
 
 /// Above this many triangles the BVH is built with obvhs's medium preset, below it with its
-/// slowest, best one. Measured on the bench's 108 k-triangle Cornell box (1 M segments, one
-/// thread): the slowest build took 0.25–0.35 s and traced 4.9–5.0 M rays/s, the medium one
-/// 0.07 s and 4.2–4.3 M; a 1 M-triangle model once spent 9 s in the slowest build.
+/// slowest, best one. On the bench's Cornell box the slowest build traces noticeably faster
+/// for a fraction of a second more building, but its build time grows too fast for models of
+/// a million triangles.
 pub const BEST_BUILD_LIMIT: usize = 250_000;
 
 /// Margin at both ends of an occlusion segment, as a fraction of its length.
@@ -139,11 +143,11 @@ impl RayQuery for Bvh {
     }
 }
 
-/// Tests every triangle for every ray: slow, obviously correct; the reference for tests.
+/// Tests every triangle for every ray with obvhs's own triangle test: slow, obviously
+/// correct; the reference for tests.
 pub struct BruteForce {
     triangles: Vec<Triangle>,
-    /// The same triangles with edges and normal precomputed: the BVH's leaf test, so both
-    /// structures answer a segment with the same arithmetic.
+    /// The same triangles with edges and normal precomputed (obvhs's `RtTriangle`).
     rt: Vec<RtTriangle>,
 }
 
@@ -153,45 +157,6 @@ impl BruteForce {
         let triangles = to_triangles(triangles);
         let rt = triangles.iter().map(RtTriangle::from).collect();
         Self { triangles, rt }
-    }
-}
-
-impl BruteForce {
-    /// [`RayQuery::occluded`] against only the triangles at `indices` (indices into the slice
-    /// this was built from): the same ray and the same triangle test, so on a list that holds
-    /// every triangle the segment could meet the answer is the full query's answer.
-    ///
-    /// The solver gathers such lists once per shooter and receiving patch (shaft culling,
-    /// Haines & Wallace 1991) and tests a handful of triangles per ray instead of walking a
-    /// tree.
-    pub fn occluded_by(&self, from: Vec3, to: Vec3, indices: &[u32]) -> bool {
-        self.first_blocker(from, to, indices).is_some()
-    }
-
-    /// Like [`BruteForce::occluded_by`], and says which entry of `indices` blocked: callers
-    /// test that triangle first for the next, nearby segment (the last-occluder cache).
-    pub fn first_blocker(&self, from: Vec3, to: Vec3, indices: &[u32]) -> Option<usize> {
-        // The ray of `segment_ray` without its inverse direction (three divisions only the
-        // tree's box tests need), and obvhs's `RtTriangle::intersect` written out with the
-        // same operations in the same order, so the answers are the same bit for bit.
-        let (origin, direction) = (Vec3A::from(from), nudge(Vec3A::from(to - from)));
-        let (tmin, tmax) = (SEGMENT_MARGIN, 1.0 - SEGMENT_MARGIN);
-        indices.iter().position(|&i| {
-            let tri = &self.rt[i as usize];
-            let c = tri.v0 - origin;
-            let r = direction.cross(c);
-            let inv_det = 1.0 / tri.ng.dot(direction);
-            let u = r.dot(tri.e2) * inv_det;
-            let v = r.dot(tri.e1) * inv_det;
-            let w = 1.0 - u - v;
-            let hit = u.to_bits() | v.to_bits() | w.to_bits();
-            if inv_det != 0.0 && hit & 0x8000_0000 == 0 {
-                let t = tri.ng.dot(c) * inv_det;
-                t >= tmin && t <= tmax
-            } else {
-                false
-            }
-        })
     }
 }
 
@@ -250,16 +215,16 @@ mod tests {
     fn bvh_agrees_with_brute_force() {
         let mut rng = XorShift64::new(0x9e3779b97f4a7c15);
         let tris = random_scene(&mut rng, 500);
-        let (bvh, brute) = (Bvh::new(&tris), BruteForce::new(&tris));
+        let (bvh, brute, candidates) =
+            (Bvh::new(&tris), BruteForce::new(&tris), CandidateTriangles::new(&tris));
         let all: Vec<u32> = (0..tris.len() as u32).collect();
         let mut blocked = 0;
         for _ in 0..4000 {
             let (a, b) = (random_point(&mut rng), random_point(&mut rng));
             let expected = brute.occluded(a, b);
             assert_eq!(bvh.occluded(a, b), expected, "segment {a} -> {b}");
-            // The candidate-list test (its own copy of the triangle arithmetic) on every
-            // triangle gives the same answer.
-            assert_eq!(brute.occluded_by(a, b, &all), expected, "segment {a} -> {b}");
+            // The candidate-list path on every triangle gives the same answer.
+            assert_eq!(candidates.occluded_by(a, b, &all), expected, "segment {a} -> {b}");
             blocked += usize::from(expected);
             let (h1, h2) = (bvh.closest_hit(a, b - a, 1.0), brute.closest_hit(a, b - a, 1.0));
             assert_eq!(h1.map(|h| h.triangle), h2.map(|h| h.triangle));

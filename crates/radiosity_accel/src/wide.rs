@@ -1,8 +1,8 @@
 //! A sixteen-wide BVH traced one ray at a time with four-lane SIMD (SSE through glam's
 //! `Vec4`): each node holds its sixteen children's boxes axis by axis in four groups of four
 //! lanes, so one ray meets all of them in a few dozen vector operations, and each leaf holds
-//! up to four triangles the same way, tested at once with
-//! [`crate::BruteForce::first_blocker`]'s arithmetic lane by lane.
+//! up to four triangles the same way, tested at once with the crate's one four-lane
+//! triangle test ([`crate::lanes`]), each lane one triangle.
 //!
 //! The tree comes from obvhs's binary BVH (PLOC, spatial pre-splits, reinsertion), collapsed
 //! to sixteen-wide nodes and leaves of at most four triangles by dynamic programming on the
@@ -10,23 +10,19 @@
 //!
 //! Why sixteen: an incoherent segment's traversal is a chain of dependent loads (node, then
 //! the child it names), each missing the first-level cache, so the time goes with the number
-//! of nodes visited more than with the box tests in each. Measured on the bench's rays
-//! (108 k triangles, 1 M segments, one thread, in the same process as obvhs's CwBvh at
-//! 2.0 M rays/s), with the same collapse at each width: 4 wide 3.6–3.7 M rays/s (10 134
-//! nodes, 13.9 node visits per segment), 8 wide 4.2–4.3 M, 12 wide 4.5–4.6 M, 16 wide
-//! 4.9–5.1 M (2 576 nodes), 20 wide 4.8 M, 24 wide 4.6–4.7 M. Closest hits went from 1.45
-//! to 1.9 M rays/s (CwBvh 1.45 M). Before the collapse by cost, a greedy one (open the child
-//! with the largest area until there are four) left the nodes near the leaves two or three
-//! children wide and traced 3.4 M at four wide.
+//! of nodes visited more than with the box tests in each. Measured on the bench's rays with
+//! the same collapse at each width, the speed rose from four wide to sixteen and fell again
+//! beyond (twenty, twenty-four); closest hits gained as well. The collapse by cost matters
+//! too: a greedy one (open the child with the largest area until the node is full) left the
+//! nodes near the leaves two or three children wide and traced slower.
 //!
 //! Occlusion visits hit children in slot order. Measured slower at four wide: nearest-first
-//! ordering (3.0 against 3.35 M rays/s), ordering by the ray's sign on the node's split axis
-//! (3.4–3.5 against 3.6 M), pushing all hit children without branches (3.45 against 3.6 M);
-//! testing leaf children before descending gained nothing measurable. Most segments either
-//! pass clear, visiting every box they meet anyway, or are blocked near either end. At
-//! sixteen wide, boxes stored group by group (with a count of groups in use, to skip empty
-//! ones) traced 4.4–4.5 M against 4.9–5.0 M axis by axis, and cache-line-aligned nodes
-//! 4.8–4.9 M.
+//! ordering, ordering by the ray's sign on the node's split axis, pushing all hit children
+//! without branches; testing leaf children before descending gained nothing measurable.
+//! Most segments either pass clear, visiting every box they meet anyway, or are blocked near
+//! either end. At sixteen wide, boxes stored group by group (with a count of groups in use,
+//! to skip empty ones) traced slower than axis by axis, and so did cache-line-aligned nodes.
+//! (The figures are in `docs/PERFORMANCE.md`.)
 //!
 //! Boxes are widened by a millionth of the scene's extent against rounding; a segment
 //! grazing a triangle almost edge-on can still come out differently from the brute-force
@@ -36,13 +32,15 @@
 use glam::{Vec3A, Vec4};
 use obvhs::{BvhBuildParams, bvh2::Bvh2, triangle::Triangle};
 
+use crate::lanes::{RayLanes, TriangleLanes, hit_x4};
+
 /// Child slot that holds nothing (its box never meets a ray).
 const EMPTY: u32 = u32::MAX;
 /// Child slot that holds a leaf: the low bits give its first [`Tri4`] and their count.
 const LEAF: u32 = 1 << 31;
 /// Traversal stack on the program stack, in entries, for trees that never need more
 /// (`stack_need`; 94 for the bench's 108 k triangles). Every ray zeroes its stack, so it is
-/// kept small: 1024 entries traced the bench's rays at 4.1–4.2 M rays/s against 5.0 M.
+/// kept small: 1024 entries traced the bench's rays markedly slower.
 const STACK: usize = 128;
 /// The larger stack for trees that need more than [`STACK`]; beyond it, one on the heap.
 const BIG_STACK: usize = 512;
@@ -80,12 +78,7 @@ impl Node {
 /// `ng` come first.
 #[derive(Clone, Copy, Debug)]
 #[repr(align(64))]
-struct Tri4 {
-    v0: [Vec4; 3],
-    ng: [Vec4; 3],
-    e1: [Vec4; 3],
-    e2: [Vec4; 3],
-}
+struct Tri4(TriangleLanes);
 
 /// The sixteen-wide BVH. Empty when built from no triangles.
 #[derive(Clone, Debug, Default)]
@@ -101,26 +94,22 @@ pub(crate) struct WideBvh {
     stack_need: usize,
 }
 
-/// A ray prepared for box tests: origin and inverse direction in lanes, and which side of
-/// each box it enters first.
+/// A ray prepared for box tests (origin and inverse direction in lanes, and which side of
+/// each box it enters first) and for leaf tests (origin and direction in every lane).
 struct SlabRay {
-    origin: [Vec4; 3],
+    lanes: RayLanes,
     inv: [Vec4; 3],
     negative: [bool; 3],
-    /// Origin and direction for the triangle tests.
-    o: Vec3A,
-    d: Vec3A,
 }
 
 impl SlabRay {
     fn new(o: Vec3A, d: Vec3A) -> Self {
         let inv = Vec3A::ONE / d;
+        let splat = |v: Vec3A| [Vec4::splat(v.x), Vec4::splat(v.y), Vec4::splat(v.z)];
         Self {
-            origin: [Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z)],
-            inv: [Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z)],
+            lanes: RayLanes { origin: splat(o), direction: splat(d) },
+            inv: splat(inv),
             negative: [inv.x < 0.0, inv.y < 0.0, inv.z < 0.0],
-            o,
-            d,
         }
     }
 
@@ -128,6 +117,7 @@ impl SlabRay {
     /// within `[tmin, tmax]` (bit per child).
     #[inline(always)]
     fn boxes(&self, node: &Node, tmin: f32, tmax: f32) -> ([Vec4; GROUPS], u32) {
+        let origin = &self.lanes.origin;
         let mut nears = [Vec4::ZERO; GROUPS];
         let mut hits = 0;
         for (g, nears) in nears.iter_mut().enumerate() {
@@ -139,8 +129,8 @@ impl SlabRay {
                 } else {
                     (node.min[a][g], node.max[a][g])
                 };
-                near = near.max((lo - self.origin[a]) * self.inv[a]);
-                far = far.min((hi - self.origin[a]) * self.inv[a]);
+                near = near.max((lo - origin[a]) * self.inv[a]);
+                far = far.min((hi - origin[a]) * self.inv[a]);
             }
             *nears = near;
             hits |= near.cmple(far).bitmask() << (4 * g);
@@ -148,33 +138,11 @@ impl SlabRay {
         (nears, hits)
     }
 
-    /// Distance to each triangle of `t` hit within `[tmin, tmax]`, and which lanes hit.
+    /// Distance to each triangle of `t` hit within `[tmin, tmax]`, and which lanes hit: the
+    /// crate's one triangle test, each lane one triangle.
     #[inline(always)]
     fn triangles(&self, t: &Tri4, tmin: f32, tmax: f32) -> (Vec4, u32) {
-        let s = |v: f32| Vec4::splat(v);
-        let (ox, oy, oz) = (s(self.o.x), s(self.o.y), s(self.o.z));
-        let (dx, dy, dz) = (s(self.d.x), s(self.d.y), s(self.d.z));
-        let [v0x, v0y, v0z] = t.v0;
-        let [e1x, e1y, e1z] = t.e1;
-        let [e2x, e2y, e2z] = t.e2;
-        let [nx, ny, nz] = t.ng;
-        // c = v0 − o and the distance to each plane first: lanes whose plane the ray does
-        // not reach within the range skip the edge tests. Otherwise the one-ray test's
-        // arithmetic, each lane one triangle.
-        let (cx, cy, cz) = (v0x - ox, v0y - oy, v0z - oz);
-        let inv_det = Vec4::ONE / (nx * dx + ny * dy + nz * dz);
-        let dist = (nx * cx + ny * cy + nz * cz) * inv_det;
-        let reach = dist.cmpge(Vec4::splat(tmin)).bitmask() & dist.cmple(Vec4::splat(tmax)).bitmask();
-        if reach == 0 {
-            return (dist, 0);
-        }
-        let (rx, ry, rz) = (dy * cz - dz * cy, dz * cx - dx * cz, dx * cy - dy * cx);
-        let u = (rx * e2x + ry * e2y + rz * e2z) * inv_det;
-        let v = (rx * e1x + ry * e1y + rz * e1z) * inv_det;
-        let w = Vec4::ONE - u - v;
-        let inside = !(u.is_negative_bitmask() | v.is_negative_bitmask() | w.is_negative_bitmask());
-        let hit = inside & inv_det.cmpne(Vec4::ZERO).bitmask() & reach;
-        (dist, hit)
+        hit_x4(&self.lanes, &t.0, Vec4::splat(tmin), Vec4::splat(tmax), 0b1111)
     }
 }
 
@@ -353,7 +321,7 @@ impl WideBvh {
         let start = self.tris.len();
         for group in ids.chunks(4) {
             let zero = [Vec4::ZERO; 3];
-            let mut t = Tri4 { v0: zero, ng: zero, e1: zero, e2: zero };
+            let mut t = TriangleLanes { v0: zero, ng: zero, e1: zero, e2: zero };
             let mut ids = [0; 4];
             for (lane, &id) in group.iter().enumerate() {
                 let tri = &triangles[id as usize];
@@ -368,7 +336,7 @@ impl WideBvh {
                 }
                 ids[lane] = id;
             }
-            self.tris.push(t);
+            self.tris.push(Tri4(t));
             self.ids.push(ids);
         }
         let n = self.tris.len() - start;
@@ -554,6 +522,7 @@ mod tests {
                 for (t, ids) in tree.tris[leaf_range(c)].iter().zip(&tree.ids[leaf_range(c)]) {
                     for lane in 0..4 {
                         // A live lane holds its triangle's normal; a padded one is all zeros.
+                        let t = &t.0;
                         if t.ng.iter().any(|n| n[lane] != 0.0) {
                             seen[ids[lane] as usize] += 1;
                         } else {

@@ -10,7 +10,7 @@ use std::sync::Arc;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{DVec3, Vec3};
-use radiosity_accel::{BruteForce, Bvh, RayQuery, Segments4};
+use radiosity_accel::{Bvh, CandidateTriangles, RayQuery, Segments4};
 use radiosity_core::{Mesh, MeshParams, furnace_box};
 use radiosity_solver::form_factor::{
     Rule, for_each_point, point_to_polygon, point_to_polygon_in_front, point_to_polygon_in_front_x4,
@@ -84,12 +84,12 @@ fn rays(c: &mut Criterion) {
         })
     });
     let few: Vec<u32> = (0..12).collect();
-    let brute = BruteForce::new(&tris);
+    let candidates = CandidateTriangles::new(&tris);
     c.bench_function("candidate list occluded (12 triangles)", |b| {
         let mut i = 0;
         b.iter(|| {
             i = (i + 2) % ends.len();
-            brute.occluded_by(ends[i], ends[i + 1], black_box(&few))
+            candidates.occluded_by(ends[i], ends[i + 1], black_box(&few))
         })
     });
     let mut list = few.clone();
@@ -99,7 +99,7 @@ fn rays(c: &mut Criterion) {
             i = (i + 8) % (ends.len() - 8);
             let from = [ends[i], ends[i + 1], ends[i + 2], ends[i + 3]];
             let to = [ends[i + 4], ends[i + 5], ends[i + 6], ends[i + 7]];
-            brute.occluded_x4(&Segments4::new(&from, &to, 4), black_box(&mut list))
+            candidates.occluded_x4(&Segments4::new(&from, &to, 4), black_box(&mut list))
         })
     });
 }

@@ -11,7 +11,7 @@
 //! ray — so the answer of a ray is the same as the full query's.
 
 use glam::{DVec3, Vec3};
-use radiosity_accel::{BruteForce, Segments4};
+use radiosity_accel::{CandidateTriangles, Segments4};
 use radiosity_core::Mesh;
 
 /// Above this many blocking triangles the per-patch scan costs more than it saves; every
@@ -55,7 +55,8 @@ pub(crate) struct Blockers {
     /// Runs of `CLUSTER` consecutive triangles (neighbours, as meshes come) with the box
     /// around each run: a shaft that misses the run's box skips all its triangles.
     clusters: Vec<(DVec3, DVec3)>,
-    brute: BruteForce,
+    /// The triangles for the candidate-list tests.
+    triangles: CandidateTriangles,
     /// Absolute slack for the single-precision rounding of ray ends and triangles.
     slack: f64,
 }
@@ -83,7 +84,7 @@ impl Blockers {
             .chunks(CLUSTER)
             .map(|c| c.iter().fold(c[0], |(lo, hi), (a, b)| (lo.min(*a), hi.max(*b))))
             .collect();
-        Self { boxes, clusters, brute: BruteForce::new(tris), slack }
+        Self { boxes, clusters, triangles: CandidateTriangles::new(tris), slack }
     }
 
     /// True when the per-patch scan is affordable.
@@ -146,7 +147,7 @@ impl Blockers {
     /// The full query's answer for a segment that only the triangles at `indices` can meet.
     #[cfg(test)]
     pub(crate) fn occluded_by(&self, from: Vec3, to: Vec3, indices: &[u32]) -> bool {
-        self.brute.occluded_by(from, to, indices)
+        self.triangles.occluded_by(from, to, indices)
     }
 
     /// Which of up to four segments the triangles at `indices` block (bit `i` for segment
@@ -154,7 +155,7 @@ impl Blockers {
     /// `indices`, so the next rays of the same element, which likely meet it too, test it
     /// first. The answer does not depend on the order.
     pub(crate) fn occluded_x4(&self, segments: &Segments4, indices: &mut [u32]) -> u32 {
-        self.brute.occluded_x4(segments, indices)
+        self.triangles.occluded_x4(segments, indices)
     }
 }
 
@@ -225,7 +226,7 @@ fn hull_planes(a: &[DVec3], b: &[DVec3], margin: f64, out: &mut [(DVec3, f64); M
 mod tests {
     use super::*;
     use crate::sampling::{Rng, point_on};
-    use radiosity_accel::RayQuery;
+    use radiosity_accel::{BruteForce, RayQuery};
 
     fn quad(c: DVec3, u: DVec3, v: DVec3) -> Vec<DVec3> {
         vec![c - u - v, c + u - v, c + u + v, c - u + v]
