@@ -40,7 +40,7 @@ fn clip_to_hemisphere(p: DVec3, n: DVec3, poly: &[DVec3], out: &mut [DVec3; 8]) 
 /// their cross product and their dot product.
 ///
 /// The form factor's hot loop calls this four times per evaluation, and libm's `atan2` was a
-/// quarter of the solve time; this is the classic reduction (Cephes `atan`): fold into
+/// large share of the solve time; this is the classic reduction (Cephes `atan`): fold into
 /// t ∈ [0, 1], then by atan(t) = π/6 + atan((√3 t − 1)/(√3 + t)) into |t| ≤ tan(π/12), where
 /// the odd Taylor series to t¹⁵ leaves about 1e-11 rad of error.
 #[inline]

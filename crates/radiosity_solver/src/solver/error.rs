@@ -1,0 +1,30 @@
+//! Why solving cannot start.
+
+use thiserror::Error;
+
+/// Why solving cannot start.
+#[derive(Clone, Debug, Error, PartialEq)]
+pub enum SolverError {
+    /// Nothing emits: there is no light to shoot.
+    #[error("the scene emits no light (total emitted power is 0); give a material an emission > 0")]
+    NoEmission,
+    /// The mesh has no elements.
+    #[error("the mesh has no elements")]
+    EmptyMesh,
+    /// The patches do not own consecutive runs of all the elements, in order.
+    #[error("mesh patch {patch}: patches must own consecutive runs of the elements, in order")]
+    BadMesh {
+        /// The first patch out of order (the patch count when elements are left over).
+        patch: usize,
+    },
+    /// A parameter is out of range.
+    #[error("solver parameter {name} = {value} is out of range: {expected}")]
+    BadParameter {
+        /// Parameter name.
+        name: &'static str,
+        /// Value given.
+        value: String,
+        /// What is expected.
+        expected: &'static str,
+    },
+}

@@ -1,0 +1,219 @@
+//! What the solver precomputes once per mesh: per-element geometry that every row reads,
+//! element neighbours, and the ray-skipping structures over the blocking triangles.
+
+use glam::{DVec3, Vec3A};
+use radiosity_core::{Mesh, Rgb};
+
+use super::SolverError;
+use crate::occluders::{OccluderBoxes, blocking_triangles};
+use crate::shaft::Blockers;
+
+/// Per-mesh tables, fixed when the solver is made.
+pub(super) struct MeshTables {
+    /// Per vertex, the area of the elements around it (the weights of vertex radiosity).
+    pub(super) vertex_area: Vec<f64>,
+    /// Element areas, packed for the shot loop.
+    pub(super) element_area: Vec<f64>,
+    /// Per element, the mean of its vertices: the one quadrature point of a far element (the
+    /// centre of the bilinear map, see `for_each_point`), which every row needs.
+    pub(super) vertex_means: Vec<DVec3>,
+    /// Per element, its circumradius about its centre (see [`element_radius`]).
+    pub(super) element_radii: Vec<f64>,
+    /// Per element, its corners lifted off it by the ray offset (see [`lift_corners`]).
+    pub(super) lifted_corners: Vec<[Vec3A; 4]>,
+    /// Per patch, its reflectance (a patch's elements share its surface's material).
+    pub(super) patch_reflectance: Vec<Rgb>,
+    /// Per patch, the largest circumradius of its elements (about their centres).
+    pub(super) patch_element_radius: Vec<f64>,
+    /// Elements sharing an edge (see [`element_neighbours`]): element `e`'s are
+    /// `neighbours[neighbour_start[e]..neighbour_start[e + 1]]`.
+    pub(super) neighbour_start: Vec<u32>,
+    pub(super) neighbours: Vec<u32>,
+    /// Σ of the element areas.
+    pub(super) total_area: f64,
+    /// Area-weighted mean reflectance (the ambient term's interreflection factor).
+    pub(super) mean_reflectance: Rgb,
+    /// Ray origins and targets are lifted this far off their surfaces: a millionth of the
+    /// scene's diagonal.
+    pub(super) ray_offset: f64,
+    /// Boxes around the blocking triangles: a segment whose box meets none needs no ray.
+    pub(super) occluder_boxes: OccluderBoxes,
+    /// The blocking triangles for shaft culling and candidate lists.
+    pub(super) blockers: Blockers,
+}
+
+impl MeshTables {
+    /// The tables of `mesh`.
+    pub(super) fn new(mesh: &Mesh) -> Self {
+        let n = mesh.elements.len();
+        let mut vertex_area = vec![0.0; mesh.positions.len()];
+        for el in &mesh.elements {
+            for &v in el.vertex_indices() {
+                vertex_area[v as usize] += el.area;
+            }
+        }
+        let total_area = mesh.total_area();
+        let mean_reflectance = (mesh.elements.iter().enumerate())
+            .map(|(e, el)| mesh.element_material(e).reflectance * el.area)
+            .sum::<Rgb>()
+            / total_area;
+        let (lo, hi) = mesh.bounds();
+        // One scan for both ray-skipping structures (it can cost T × V half-space tests).
+        let blocking = blocking_triangles(mesh);
+        let element_radii: Vec<f64> = (0..n).map(|e| element_radius(mesh, e)).collect();
+        let patch_element_radius = mesh
+            .patches
+            .iter()
+            .map(|p| {
+                element_radii[p.elements.start as usize..p.elements.end as usize]
+                    .iter()
+                    .copied()
+                    .fold(0.0, f64::max)
+            })
+            .collect();
+        let (neighbour_start, neighbours) = element_neighbours(mesh);
+        let ray_offset = 1e-6 * (hi - lo).length();
+        Self {
+            vertex_area,
+            element_area: mesh.elements.iter().map(|el| el.area).collect(),
+            vertex_means: (0..n)
+                .map(|e| mesh.element_corners(e).sum::<DVec3>() / f64::from(mesh.elements[e].vertex_count))
+                .collect(),
+            element_radii,
+            lifted_corners: lift_corners(mesh, ray_offset),
+            patch_reflectance: mesh
+                .patches
+                .iter()
+                .map(|p| mesh.materials[mesh.surfaces[p.surface as usize].material as usize].reflectance)
+                .collect(),
+            patch_element_radius,
+            neighbour_start,
+            neighbours,
+            total_area,
+            mean_reflectance,
+            ray_offset,
+            occluder_boxes: OccluderBoxes::new(&blocking),
+            blockers: Blockers::new(mesh, &blocking),
+        }
+    }
+
+    /// Element `e`'s edge neighbours.
+    pub(super) fn neighbours_of(&self, e: usize) -> &[u32] {
+        &self.neighbours[self.neighbour_start[e] as usize..self.neighbour_start[e + 1] as usize]
+    }
+}
+
+/// Checks that the mesh has elements and that its patches own consecutive runs of them, in
+/// order (as `Mesh::build` makes them): a row is split into one slice per patch.
+///
+/// # Errors
+/// [`SolverError::EmptyMesh`] or [`SolverError::BadMesh`].
+pub(super) fn check_patch_runs(mesh: &Mesh) -> Result<(), SolverError> {
+    if mesh.elements.is_empty() {
+        return Err(SolverError::EmptyMesh);
+    }
+    let mut next = 0;
+    for (q, p) in mesh.patches.iter().enumerate() {
+        if p.elements.start != next || p.elements.end < p.elements.start {
+            return Err(SolverError::BadMesh { patch: q });
+        }
+        next = p.elements.end;
+    }
+    if next as usize != mesh.elements.len() {
+        return Err(SolverError::BadMesh { patch: mesh.patches.len() });
+    }
+    Ok(())
+}
+
+/// Each element's neighbours: the elements sharing an edge with it (the mesh shares
+/// vertices within a surface, across its patches too), as `(start, list)`: element `e`'s
+/// are `list[start[e]..start[e + 1]]`. Edge neighbours, not vertex ones: on the Cornell box
+/// the diagonal neighbours added rays and changed neither the object means nor the render
+/// beyond their noise.
+fn element_neighbours(mesh: &Mesh) -> (Vec<u32>, Vec<u32>) {
+    // Elements around each vertex, then the union over an element's vertices.
+    let mut around = vec![Vec::new(); mesh.positions.len()];
+    for (e, el) in mesh.elements.iter().enumerate() {
+        for &v in el.vertex_indices() {
+            around[v as usize].push(e as u32);
+        }
+    }
+    let (mut start, mut list) = (Vec::with_capacity(mesh.elements.len() + 1), Vec::new());
+    start.push(0);
+    for (e, el) in mesh.elements.iter().enumerate() {
+        let first = list.len();
+        for &v in el.vertex_indices() {
+            for &n in &around[v as usize] {
+                let shared = mesh.elements[n as usize]
+                    .vertex_indices()
+                    .iter()
+                    .filter(|v| el.vertex_indices().contains(v))
+                    .count();
+                if n as usize != e && shared >= 2 && !list[first..].contains(&n) {
+                    list.push(n);
+                }
+            }
+        }
+        start.push(list.len() as u32);
+    }
+    (start, list)
+}
+
+/// Every element's corners lifted off its surface by `offset` along its normal, in single
+/// precision (a triangle's fourth slot stays zero): the origins of its rays, the same
+/// points every row.
+fn lift_corners(mesh: &Mesh, offset: f64) -> Vec<[Vec3A; 4]> {
+    (0..mesh.elements.len())
+        .map(|e| {
+            let lift = mesh.elements[e].normal * offset;
+            let mut out = [Vec3A::ZERO; 4];
+            for (l, p) in out.iter_mut().zip(mesh.element_corners(e)) {
+                *l = (p + lift).as_vec3().into();
+            }
+            out
+        })
+        .collect()
+}
+
+/// Circumradius of element `e` about its centre.
+fn element_radius(mesh: &Mesh, e: usize) -> f64 {
+    let c = mesh.elements[e].centre;
+    mesh.element_corners(e).map(|p| p.distance(c)).fold(0.0, f64::max)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use radiosity_core::furnace_box;
+
+    /// In a box meshed into quads, an element inside a face has four edge neighbours, one at
+    /// a face's corner two (vertices are not shared across surfaces), and the relation is
+    /// symmetric.
+    #[test]
+    fn neighbours_share_an_edge_within_a_surface() {
+        let scene = furnace_box(0.5, 1.0);
+        let mesh = Mesh::build(&scene, &scene.mesh_params()).unwrap();
+        let tables = MeshTables::new(&mesh);
+        let mut counts = std::collections::BTreeSet::new();
+        for e in 0..mesh.elements.len() {
+            let own = tables.neighbours_of(e);
+            counts.insert(own.len());
+            for &n in own {
+                assert!(tables.neighbours_of(n as usize).contains(&(e as u32)), "{e} and {n}");
+                let surface = |e: usize| mesh.patches[mesh.elements[e].patch as usize].surface;
+                assert_eq!(surface(n as usize), surface(e), "{e} and {n}");
+            }
+        }
+        assert_eq!(counts.first(), Some(&2));
+        assert_eq!(counts.last(), Some(&4));
+    }
+
+    #[test]
+    fn patches_must_own_consecutive_runs() {
+        let scene = furnace_box(0.5, 1.0);
+        let mut mesh = Mesh::build(&scene, &scene.mesh_params()).unwrap();
+        assert_eq!(check_patch_runs(&mesh), Ok(()));
+        mesh.patches[1].elements.start += 1;
+        assert_eq!(check_patch_runs(&mesh), Err(SolverError::BadMesh { patch: 1 }));
+    }
+}

@@ -1,0 +1,176 @@
+//! Progressive refinement by shooting (Cohen, Chen, Wallace & Greenberg 1988, "A progressive
+//! refinement approach to fast radiosity image generation").
+//!
+//! Each shot takes the patch i with the largest unshot power ΔB_i·A_i and, for every element
+//! j that can see it, adds `ρ_j · ΔB_i · F_{j→i}` to B_j and to ΔB_j (the source document's
+//! `dB = ρj dBi Fij Ai/Aj`, by reciprocity F_{j→i} = F_{i→j} A_i/A_j), then zeroes ΔB_i.
+//! F_{j→i} is the area-to-polygon form factor (see [`crate::form_factor`]) times the
+//! fraction of unblocked stratified rays between the element and the patch.
+//!
+//! A patch shoots several times as light comes back to it. Its rays are drawn from a stream
+//! keyed by the shooter (not the shot) and end where its unshot power was at its first shot,
+//! so each of its shots has the same row of form factors F_{j→i}; the row is kept (within
+//! `SolverParams::row_cache_bytes`) and a later shot is one multiply-add per receiver.
+//!
+//! Options: the ambient term of Cohen et al. 1988 §4 for early display, and overshooting by
+//! over-relaxation (Gortler, Cohen & Slusallek 1993, "Radiosity and relaxation methods"):
+//! shoot ω·ΔB_i and leave (1 − ω)·ΔB_i, which may be negative, unshot.
+//!
+//! The files, by what they do:
+//!
+//! * `shooting`: the loop, step by step (start here);
+//! * `params`, `error`, `stop`: settings, errors, stop criteria and the NotConverging rule;
+//! * state by lifetime: `mesh_tables` (per mesh), `first_shots` and `row_cache` (per
+//!   shooter), `shot` (per shot: what receivers read, and scratch), `tally` (the physics:
+//!   B, ΔB and the power bookkeeping, and applying a shot);
+//! * computing a row: `row` (the passes), `plans` (per receiving patch), `ray_ends` (where
+//!   rays end on the shooter), `receive` (form factors and pilot rays), `quadrature`,
+//!   `rays` (drawing and tracing), `penumbra` (which receivers take more rays), `uneven`
+//!   (shooters whose unshot radiosity is uneven), `parallel`.
+
+use std::sync::Arc;
+use std::time::Duration;
+
+use radiosity_accel::RayQuery;
+use radiosity_core::{Mesh, Rgb};
+
+mod error;
+mod first_shots;
+mod mesh_tables;
+mod parallel;
+mod params;
+mod penumbra;
+mod plans;
+mod quadrature;
+mod ray_ends;
+mod rays;
+mod receive;
+mod row;
+mod row_cache;
+mod shooting;
+mod shot;
+mod stop;
+mod tally;
+mod uneven;
+
+pub use error::SolverError;
+pub use params::{Ambient, FormFactorMethod, Overshoot, SolverParams};
+pub use stop::{StepBudget, StepReport, StopReason};
+pub use tally::EnergyBalance;
+
+use crate::solution::{Solution, vertex_average};
+use first_shots::FirstShots;
+use mesh_tables::MeshTables;
+use row_cache::RowCache;
+use shot::ShotScratch;
+use stop::Progress;
+use tally::Tally;
+
+/// The progressive shooting solver. Owns its working state; callers own the loop.
+pub struct Solver {
+    mesh: Arc<Mesh>,
+    accel: Arc<dyn RayQuery>,
+    params: SolverParams,
+    /// Per mesh: fixed when the solver is made.
+    tables: MeshTables,
+    /// Per shooter: what its first shot fixed.
+    first_shots: FirstShots,
+    /// Per shooter: its kept row of form factors, or its kept plans.
+    rows: RowCache,
+    /// Per shot: scratch memory, kept to avoid allocating in the loop.
+    scratch: ShotScratch,
+    /// The physics: B, ΔB, power.
+    tally: Tally,
+    /// Shots, rays, time, stop.
+    progress: Progress,
+}
+
+impl Solver {
+    /// A solver at shot 0: B = E and ΔB = E on every element.
+    ///
+    /// # Errors
+    /// [`SolverError::EmptyMesh`], [`SolverError::NoEmission`], or
+    /// [`SolverError::BadParameter`] for out-of-range parameters.
+    pub fn new(mesh: Arc<Mesh>, accel: Arc<dyn RayQuery>, params: SolverParams) -> Result<Self, SolverError> {
+        params.validate()?;
+        mesh_tables::check_patch_runs(&mesh)?;
+        let tally = Tally::new(&mesh)?;
+        Ok(Self {
+            tables: MeshTables::new(&mesh),
+            first_shots: FirstShots::new(&mesh),
+            rows: RowCache::new(mesh.patches.len()),
+            scratch: ShotScratch::new(&mesh),
+            tally,
+            progress: Progress::new(mesh.patches.len()),
+            mesh,
+            accel,
+            params,
+        })
+    }
+
+    /// The mesh being solved.
+    pub fn mesh(&self) -> &Arc<Mesh> {
+        &self.mesh
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &SolverParams {
+        &self.params
+    }
+
+    /// Why the solve stopped, or `None` while it goes on.
+    pub fn stop_reason(&self) -> Option<StopReason> {
+        self.progress.stop
+    }
+
+    /// Shots done.
+    pub fn shots(&self) -> u64 {
+        self.progress.shots
+    }
+
+    /// Unshot power / emitted power.
+    pub fn unshot_fraction(&self) -> f64 {
+        self.tally.unshot_fraction
+    }
+
+    /// Visibility rays traced.
+    pub fn rays(&self) -> u64 {
+        self.progress.rays
+    }
+
+    /// Time spent inside [`Solver::step`].
+    pub fn elapsed(&self) -> Duration {
+        self.progress.elapsed
+    }
+
+    /// Power bookkeeping, summed fresh from the element state.
+    pub fn energy(&self) -> EnergyBalance {
+        self.tally.energy(&self.mesh)
+    }
+
+    /// A snapshot of the current solution.
+    pub fn solution(&self) -> Solution {
+        let tally = &self.tally;
+        let element_radiosity = match self.params.ambient {
+            Ambient::Off => tally.radiosity.clone(),
+            Ambient::On => {
+                let unshot_power: Rgb = tally.patch_unshot_power.iter().copied().sum();
+                let r = self.tables.mean_reflectance.map(|m| 1.0 / (1.0 - m));
+                let ambient = r * unshot_power / self.tables.total_area;
+                let mesh = &self.mesh;
+                (tally.radiosity.iter().enumerate())
+                    .map(|(e, b)| {
+                        *b + self.tables.patch_reflectance[mesh.elements[e].patch as usize] * ambient
+                    })
+                    .collect()
+            }
+        };
+        Solution {
+            vertex_radiosity: vertex_average(&self.mesh, &element_radiosity, &self.tables.vertex_area),
+            element_radiosity,
+            element_unshot: tally.unshot.clone(),
+            shots: self.progress.shots,
+            unshot_fraction: tally.unshot_fraction,
+        }
+    }
+}

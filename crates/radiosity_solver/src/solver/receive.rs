@@ -1,0 +1,195 @@
+//! The receivers' side of a row's first pass: each element's form factor to the shooter
+//! without visibility (Lambert's exact point-to-polygon formula integrated over the element,
+//! see [`crate::form_factor`]), then its pilot rays.
+
+use glam::DVec3;
+use radiosity_accel::Segments4;
+use radiosity_core::{Mesh, Patch};
+
+use super::FormFactorMethod;
+use super::plans::PatchPlan;
+use super::quadrature::element_quadrature;
+use super::rays::{Packet, Rays, draw, trace};
+use super::shot::Shot;
+use super::uneven::density_weight;
+use crate::form_factor::{
+    Rule, for_each_point, point_to_point, point_to_polygon, point_to_polygon_in_front,
+    point_to_polygon_in_front_x4, points_to_polygon_in_front_x4,
+};
+use crate::shaft::{FEW, Visibility};
+
+/// What one element learns from one shooter's first pass: its form factor without
+/// visibility, and its pilot rays.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Received {
+    /// F_{e→shooter} without visibility (weighted for uneven shooters); 0 when it cannot
+    /// receive.
+    pub(super) unoccluded: f64,
+    /// Unblocked rays among `traced`.
+    pub(super) visible: u32,
+    /// Rays traced; 0 when the pair needs none (nothing can block it).
+    pub(super) traced: u32,
+}
+
+impl Received {
+    /// The element's form factor with visibility.
+    pub(super) fn factor(&self) -> f64 {
+        if self.traced == 0 {
+            return self.unoccluded;
+        }
+        self.unoccluded * f64::from(self.visible) / f64::from(self.traced)
+    }
+}
+
+/// Element `e`'s corners in a fixed array (the first `vertex_count` are its own).
+pub(super) fn corners_of(mesh: &Mesh, e: usize) -> [DVec3; 4] {
+    let mut pts = [DVec3::ZERO; 4];
+    for (k, p) in mesh.element_corners(e).enumerate() {
+        pts[k] = p;
+    }
+    pts
+}
+
+/// The element (corners `receiver`) and the shooter see each other whole: no clipping, no
+/// redrawn rays. A patch that meets the shooter's plane (a wall standing on the floor) has
+/// most of its elements off that plane: those, when no part of the shooter is behind them
+/// either, are such elements too. Same test as the patch's, same tolerance.
+pub(super) fn element_facing(shooter: &Patch, plan: &PatchPlan, receiver: &[DVec3]) -> bool {
+    let corner = shooter.corners()[0];
+    plan.facing
+        || (plan.shooter_ahead
+            && receiver.iter().all(|p| shooter.normal.dot(*p - corner) > 1e-9 * shooter.area.sqrt()))
+}
+
+/// Element `e`'s form factor to the shooter without visibility (weighted for an uneven
+/// shooter).
+fn unoccluded(shot: &Shot, plan: &PatchPlan, e: usize) -> f64 {
+    let Shot { mesh, shooter, shooter_elements, uneven, params, .. } = *shot;
+    let el = &mesh.elements[e];
+    let pts = corners_of(mesh, e);
+    let receiver = &pts[..el.vertex_count as usize];
+    let corners = shooter.corners();
+    let facing = element_facing(shooter, plan, receiver);
+    match params.form_factor {
+        FormFactorMethod::Exact => {
+            let (n, rule) = if plan.far {
+                (1, Rule::Midpoint)
+            } else {
+                let el_radius = shot.element_radii[e];
+                element_quadrature(el.centre, el_radius, shooter, shot.shooter_radius, params.max_quadrature)
+            };
+            // The fast path evaluates the formula in four f32 lanes (within 3e-7 absolute of
+            // the f64 loop, see `point_to_polygon_in_front_x4`); the reference path in f64.
+            let fast = !params.reference_path;
+            let mut f = 0.0;
+            if facing && plan.far && fast {
+                // One midpoint and nothing to clip.
+                let centre = shot.vertex_means[e];
+                f = point_to_polygon_in_front_x4(centre, el.normal, corners);
+            } else if facing {
+                let eval = if fast { point_to_polygon_in_front_x4 } else { point_to_polygon_in_front };
+                for_each_point(receiver, n, rule, |p, w| f += w * eval(p, el.normal, corners));
+            } else {
+                // Clipped polygons keep the f64 loop: their receivers sit next to the shooter,
+                // where nearly parallel edge vectors make f32 lose digits.
+                for_each_point(receiver, n, rule, |p, w| {
+                    if shooter.normal.dot(p - corners[0]) > 0.0 {
+                        f += w * point_to_polygon(p, el.normal, corners);
+                    }
+                });
+            }
+            if let Some(uneven) = uneven.filter(|_| plan.touching) {
+                // A receiver on or across the shooter's plane sees only part of it (a block
+                // side sees the floor in front of it, not under it), so the shooter's mean
+                // unshot radiosity is wrong for it when that radiosity is uneven: the
+                // transfer is Σ_k ΔB_k F_{j→k} = ΔB̄ Σ_k d_k F_{j→k}, d_k = ΔB_k/ΔB̄. The
+                // form factor keeps its quadrature; the weighting is taken at the centre.
+                // The whole patch is weighted, its elements off the plane too: they are the
+                // ones next to the contact line.
+                f *= density_weight(el.centre, el.normal, shooter.normal, &uneven, shooter_elements);
+            }
+            f
+        }
+        FormFactorMethod::PointToPoint => {
+            point_to_point(el.centre, el.normal, shooter.centre, shooter.normal, shooter.area)
+        }
+    }
+}
+
+/// The first pass for the elements of one receiving patch (`first` is its first element,
+/// `out` its slice): their unoccluded form factors, then their pilot rays.
+pub(super) fn receive_patch(shot: &Shot, plan: &PatchPlan, first: usize, out: &mut [Received]) {
+    out.fill(Received::default());
+    if !plan.live {
+        return;
+    }
+    unoccluded_factors(shot, plan, first, out);
+    if plan.visibility == Visibility::Clear {
+        return;
+    }
+    if shot.pilot.count() == 1 && plan.visibility == Visibility::Few {
+        single_rays_in_packets(shot, plan, first, out);
+        return;
+    }
+    for (k, r) in out.iter_mut().enumerate() {
+        if r.unoccluded > 0.0 {
+            (r.visible, r.traced) = trace(shot, plan, first + k, Rays::Pilot);
+        }
+    }
+}
+
+/// The unoccluded form factors of one receiving patch's elements. A patch that faces the
+/// shooter from far away takes them four at a time (one midpoint each, nothing to clip: the
+/// same formula and points as [`unoccluded`]).
+fn unoccluded_factors(shot: &Shot, plan: &PatchPlan, first: usize, out: &mut [Received]) {
+    let params = shot.params;
+    if plan.facing && plan.far && !params.reference_path && params.form_factor == FormFactorMethod::Exact {
+        let corners = shot.shooter.corners();
+        for (c, chunk) in out.chunks_mut(4).enumerate() {
+            let base = first + 4 * c;
+            let (mut points, mut normals) = ([DVec3::ZERO; 4], [DVec3::ZERO; 4]);
+            for (k, (p, n)) in points.iter_mut().zip(&mut normals).take(chunk.len()).enumerate() {
+                *p = shot.vertex_means[base + k];
+                *n = shot.mesh.elements[base + k].normal;
+            }
+            let f = points_to_polygon_in_front_x4(&points, &normals, chunk.len(), corners);
+            for (r, f) in chunk.iter_mut().zip(f) {
+                r.unoccluded = f.max(0.0);
+            }
+        }
+    } else {
+        for (k, r) in out.iter_mut().enumerate() {
+            r.unoccluded = unoccluded(shot, plan, first + k).max(0.0);
+        }
+    }
+}
+
+/// One pilot ray per element against the patch's candidate list: four elements' rays share
+/// a packet (the same rays as one packet each, a quarter of the tests).
+fn single_rays_in_packets(shot: &Shot, plan: &PatchPlan, first: usize, out: &mut [Received]) {
+    let mut order = [0u32; FEW];
+    let candidates = &mut order[..plan.candidates.len()];
+    candidates.copy_from_slice(&plan.candidates);
+    let mut packet = Packet::default();
+    let mut test = |packet: &mut Packet, out: &mut [Received]| {
+        let blocked =
+            shot.blockers.occluded_x4(&Segments4::new(&packet.from, &packet.to, packet.n), candidates);
+        for (lane, &k) in packet.owner[..packet.n].iter().enumerate() {
+            out[k as usize].visible += u32::from(blocked >> lane & 1 == 0);
+            out[k as usize].traced += 1;
+        }
+        packet.n = 0;
+    };
+    for k in 0..out.len() {
+        if out[k].unoccluded <= 0.0 {
+            continue;
+        }
+        draw(shot, plan, first + k, Rays::Pilot, |from, to| packet.push(from, to, k as u32));
+        if packet.n == 4 {
+            test(&mut packet, out);
+        }
+    }
+    if packet.n > 0 {
+        test(&mut packet, out);
+    }
+}

@@ -1,0 +1,172 @@
+//! One shooter's row of form factors F_{j→i} (visibility included) to every receiving
+//! element j, and how it is computed: plan the receiving patches, fix the shooter's first-shot
+//! spread, lay out its ray ends, then two passes over the receivers (form factors and pilot
+//! rays; penumbra rays where the neighbours saw a penumbra) and gather the factors.
+
+use std::sync::Arc;
+
+use radiosity_core::Mesh;
+use rayon::prelude::*;
+
+use super::Solver;
+use super::parallel::{PARALLEL_MIN, for_each_maybe_parallel};
+use super::penumbra::wants_penumbra_rays;
+use super::plans::{PatchPlan, plan_patches};
+use super::ray_ends::draw_ray_ends;
+use super::rays::{Rays, SINGLE_STREAM, trace};
+use super::receive::{Received, receive_patch};
+use super::shot::Shot;
+use super::uneven::{Uneven, cluster_elements};
+use crate::sampling::{Rng, Strata};
+
+/// One shooter's form factors F_{j→shooter} (visibility included) to the elements of every
+/// patch that can receive from it, as runs of consecutive elements.
+pub(super) struct Row {
+    /// `(first element, element count)` of each receiving patch, in patch order.
+    pub(super) spans: Vec<(u32, u32)>,
+    /// The factors, span after span, in f32 (7 digits, far below the visibility noise); a
+    /// row applied fresh is rounded the same way, so keeping it changes nothing.
+    pub(super) factors: Vec<f32>,
+}
+
+impl Row {
+    /// Heap and inline bytes the row holds.
+    pub(super) fn bytes(&self) -> usize {
+        std::mem::size_of::<Self>() + 8 * self.spans.len() + 4 * self.factors.len()
+    }
+}
+
+impl Solver {
+    /// Computes `shooter`'s row: the form factor from every element to it, visibility
+    /// included.
+    pub(super) fn compute_row(&mut self, shooter: usize) -> Row {
+        let mesh = Arc::clone(&self.mesh);
+        let patch = &mesh.patches[shooter];
+        if self.rows.plans(shooter).is_none() {
+            plan_patches(&mesh, shooter, &self.tables, self.params.reference_path, &mut self.scratch.plans);
+        }
+        let first_of_solve = self.progress.shots == 0;
+        self.first_shots.freeze(&mesh, shooter, &self.tally, first_of_solve, self.params.bright_share);
+        let scratch = &mut self.scratch;
+        scratch.load_shooter(&mesh, patch, &self.tables.element_radii);
+        let cdf = self.first_shots.cdf(&mesh, shooter);
+        let lift = patch.normal * self.tables.ray_offset;
+        let (targets, lifted) = (&mut scratch.targets, &mut scratch.lifted_targets);
+        draw_ray_ends(
+            self.params.seed,
+            shooter as u64,
+            cdf,
+            &scratch.shooter_elements,
+            lift,
+            targets,
+            lifted,
+        );
+        let density = self.first_shots.uneven_density(&mesh, shooter);
+        scratch.clusters.clear();
+        scratch.cluster_order.clear();
+        if let Some(density) = density {
+            let (order, clusters) = (&mut scratch.cluster_order, &mut scratch.clusters);
+            cluster_elements(&scratch.shooter_elements, density, order, clusters);
+        }
+
+        let bright = self.first_shots.bright(shooter);
+        let (params, tables) = (&self.params, &self.tables);
+        let shot = Shot {
+            mesh: &mesh,
+            shooter: patch,
+            targets: &scratch.targets,
+            lifted_targets: &scratch.lifted_targets,
+            shooter_elements: &scratch.shooter_elements,
+            vertex_means: &tables.vertex_means,
+            element_radii: &tables.element_radii,
+            lifted_corners: &tables.lifted_corners,
+            uneven: density.map(|density| Uneven {
+                density,
+                clusters: &scratch.clusters,
+                order: &scratch.cluster_order,
+            }),
+            accel: &*self.accel,
+            boxes: &tables.occluder_boxes,
+            blockers: &tables.blockers,
+            params,
+            offset: tables.ray_offset,
+            stream: shooter as u64,
+            shooter_radius: patch.corners().iter().map(|c| c.distance(patch.centre)).fold(0.0, f64::max),
+            single_key: Rng::for_task(params.seed, shooter as u64, SINGLE_STREAM).next_u64(),
+            pilot: Strata::new(if bright { params.visibility_rays } else { params.dim_rays }),
+            penumbra: Strata::new(params.penumbra_rays),
+        };
+        let plans: &[PatchPlan] = self.rows.plans(shooter).unwrap_or(&scratch.plans);
+        first_pass(&shot, plans, &mut scratch.factors);
+        if params.penumbra_rays > 0 && bright {
+            penumbra_pass(&shot, plans, tables, &mut scratch.penumbra, &mut scratch.factors);
+        }
+        let (row, rays) = gather(&mesh, plans, &scratch.factors);
+        self.progress.rays += rays;
+        row
+    }
+}
+
+/// First pass, patch by patch: each receiving patch writes its own elements' slice of
+/// `factors` (their form factors without visibility and their pilot rays).
+fn first_pass(shot: &Shot, plans: &[PatchPlan], factors: &mut [Received]) {
+    let mesh = shot.mesh;
+    let mut slices: Vec<&mut [Received]> = Vec::with_capacity(mesh.patches.len());
+    let mut rest = factors;
+    for p in &mesh.patches {
+        let (own, after) = rest.split_at_mut(p.elements.len());
+        slices.push(own);
+        rest = after;
+    }
+    let receive_one = |q: usize, out: &mut &mut [Received]| {
+        receive_patch(shot, &plans[q], mesh.patches[q].elements.start as usize, out)
+    };
+    if mesh.elements.len() < PARALLEL_MIN || rayon::current_num_threads() == 1 {
+        slices.iter_mut().enumerate().for_each(|(q, out)| receive_one(q, out));
+    } else {
+        // About 64 elements per task, as `for_each_maybe_parallel` takes them.
+        let per_task = (PARALLEL_MIN * mesh.patches.len() / mesh.elements.len()).max(1);
+        slices.par_iter_mut().enumerate().with_min_len(per_task).for_each(|(q, out)| receive_one(q, out));
+    }
+}
+
+/// Penumbrae: more rays where the neighbours' pilot rays disagree (see
+/// [`wants_penumbra_rays`]), added to `factors`; `flags` is scratch, one per element.
+fn penumbra_pass(
+    shot: &Shot,
+    plans: &[PatchPlan],
+    tables: &super::mesh_tables::MeshTables,
+    flags: &mut [bool],
+    factors: &mut [Received],
+) {
+    let first: &[Received] = factors;
+    for_each_maybe_parallel(flags, |e, out| {
+        *out = wants_penumbra_rays(first, e, tables.neighbours_of(e));
+    });
+    let flags: &[bool] = flags;
+    for_each_maybe_parallel(factors, |e, out| {
+        if flags[e] {
+            let plan = &plans[shot.mesh.elements[e].patch as usize];
+            let (visible, traced) = trace(shot, plan, e, Rays::Penumbra);
+            out.visible += visible;
+            out.traced += traced;
+        }
+    });
+}
+
+/// The row of the live patches' factors, and the rays traced for them.
+fn gather(mesh: &Mesh, plans: &[PatchPlan], factors: &[Received]) -> (Row, u64) {
+    let mut row = Row { spans: Vec::new(), factors: Vec::new() };
+    let mut rays = 0;
+    for (q, plan) in plans.iter().enumerate() {
+        if !plan.live {
+            continue;
+        }
+        let range = mesh.patches[q].elements.clone();
+        row.spans.push((range.start, range.end - range.start));
+        let factors = &factors[range.start as usize..range.end as usize];
+        row.factors.extend(factors.iter().map(|r| r.factor() as f32));
+        rays += factors.iter().map(|r| u64::from(r.traced)).sum::<u64>();
+    }
+    (row, rays)
+}

@@ -1,0 +1,136 @@
+//! What every receiver of one shot reads ([`Shot`]), and the per-shot scratch memory it is
+//! built in ([`ShotScratch`]).
+
+use glam::{DVec3, Vec3, Vec3A};
+use radiosity_accel::RayQuery;
+use radiosity_core::{Mesh, Patch};
+
+use super::SolverParams;
+use super::plans::PatchPlan;
+use super::receive::Received;
+use super::uneven::{Cluster, Uneven};
+use crate::form_factor::{point_to_point, point_to_polygon};
+use crate::occluders::OccluderBoxes;
+use crate::sampling::Strata;
+use crate::shaft::Blockers;
+
+/// Corners of one element of the shooter, copied once per shot so ray ends need no lookups.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct ShooterElement {
+    pub(super) corners: [DVec3; 4],
+    pub(super) count: u8,
+    pub(super) centre: DVec3,
+    /// Circumradius about `centre`.
+    pub(super) radius: f64,
+    pub(super) area: f64,
+}
+
+impl ShooterElement {
+    /// Element `e` of `mesh`, whose circumradius is `radius`.
+    pub(super) fn new(mesh: &Mesh, e: usize, radius: f64) -> Self {
+        let mut corners = [DVec3::ZERO; 4];
+        for (slot, p) in corners.iter_mut().zip(mesh.element_corners(e)) {
+            *slot = p;
+        }
+        let el = &mesh.elements[e];
+        Self { corners, count: el.vertex_count, centre: el.centre, radius, area: el.area }
+    }
+
+    pub(super) fn corners(&self) -> &[DVec3] {
+        &self.corners[..self.count as usize]
+    }
+
+    /// Form factor from a differential area at `p` (normal `n`) to this element of a shooter
+    /// with normal `ns`: the exact polygon formula up close, else the point-to-point one,
+    /// cos θ cos θ' A / (π r²), which is within ~2 % beyond four radii (Cohen & Wallace
+    /// §4.9's "five times rule" is the same trade).
+    pub(super) fn factor_from(&self, p: DVec3, n: DVec3, ns: DVec3) -> f64 {
+        if self.centre.distance_squared(p) < 16.0 * self.radius * self.radius {
+            point_to_polygon(p, n, self.corners())
+        } else {
+            point_to_point(p, n, self.centre, ns, self.area)
+        }
+    }
+}
+
+/// What every receiver of one shot reads.
+pub(super) struct Shot<'a> {
+    pub(super) mesh: &'a Mesh,
+    pub(super) shooter: &'a Patch,
+    /// Ray ends on the shooter, `TARGETS`² of them, row after row (see
+    /// [`super::ray_ends::target_cell`]).
+    pub(super) targets: &'a [DVec3],
+    /// The same points lifted off the shooter by `offset`, as the rays take them.
+    pub(super) lifted_targets: &'a [Vec3],
+    /// The shooter's elements.
+    pub(super) shooter_elements: &'a [ShooterElement],
+    /// Every element's vertex mean (see `MeshTables::vertex_means`).
+    pub(super) vertex_means: &'a [DVec3],
+    /// Every element's circumradius.
+    pub(super) element_radii: &'a [f64],
+    /// Every element's corners lifted off it by `offset`, in single precision: where its
+    /// rays start (see `MeshTables::lifted_corners`).
+    pub(super) lifted_corners: &'a [[Vec3A; 4]],
+    /// How the shooter's unshot radiosity is spread, when it is uneven.
+    pub(super) uneven: Option<Uneven<'a>>,
+    pub(super) accel: &'a dyn RayQuery,
+    pub(super) boxes: &'a OccluderBoxes,
+    pub(super) blockers: &'a Blockers,
+    pub(super) params: &'a SolverParams,
+    /// Ray origins and targets are lifted this far off their surfaces.
+    pub(super) offset: f64,
+    /// Key of the random streams: the shooter, so that every shot of it draws the same rays.
+    pub(super) stream: u64,
+    /// Key of the one-ray receivers' hashes (see `four_units`).
+    pub(super) single_key: u64,
+    /// The shooter's circumradius about its centre.
+    pub(super) shooter_radius: f64,
+    /// Strata of the pilot and of the penumbra rays.
+    pub(super) pilot: Strata,
+    pub(super) penumbra: Strata,
+}
+
+/// Memory one shot fills and its receivers read, kept between shots to avoid allocating in
+/// the loop; nothing in it outlives the shot.
+pub(super) struct ShotScratch {
+    /// Per receiving patch, what this shot decided for all its elements.
+    pub(super) plans: Vec<PatchPlan>,
+    /// Per element, what it received from the shooter's first pass (and penumbra rays).
+    pub(super) factors: Vec<Received>,
+    /// Per element, whether it takes penumbra rays from the current shooter.
+    pub(super) penumbra: Vec<bool>,
+    /// The shooter's elements.
+    pub(super) shooter_elements: Vec<ShooterElement>,
+    /// Ray ends on the shooter (see [`super::ray_ends`]).
+    pub(super) targets: Vec<DVec3>,
+    /// `targets` lifted off the shooter by the ray offset, in single precision: ray ends.
+    pub(super) lifted_targets: Vec<Vec3>,
+    /// Clusters of an uneven shooter's elements (see [`super::uneven`]).
+    pub(super) clusters: Vec<Cluster>,
+    pub(super) cluster_order: Vec<u32>,
+}
+
+impl ShotScratch {
+    /// Scratch for `mesh`.
+    pub(super) fn new(mesh: &Mesh) -> Self {
+        let n = mesh.elements.len();
+        Self {
+            plans: vec![PatchPlan::default(); mesh.patches.len()],
+            factors: vec![Received::default(); n],
+            penumbra: vec![false; n],
+            shooter_elements: Vec::new(),
+            targets: Vec::new(),
+            lifted_targets: Vec::new(),
+            clusters: Vec::new(),
+            cluster_order: Vec::new(),
+        }
+    }
+
+    /// Copies the elements of `shooter` into [`ShotScratch::shooter_elements`].
+    pub(super) fn load_shooter(&mut self, mesh: &Mesh, shooter: &Patch, element_radii: &[f64]) {
+        self.shooter_elements.clear();
+        for e in shooter.elements.start..shooter.elements.end {
+            self.shooter_elements.push(ShooterElement::new(mesh, e as usize, element_radii[e as usize]));
+        }
+    }
+}

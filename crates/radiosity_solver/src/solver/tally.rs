@@ -1,0 +1,161 @@
+//! The physics state of a solve: radiosity B and unshot radiosity ΔB per element, unshot
+//! power per patch, and the power bookkeeping (emitted = absorbed + unshot + escaped).
+
+use radiosity_core::{Mesh, Rgb};
+use rayon::prelude::*;
+
+use super::SolverError;
+use super::mesh_tables::MeshTables;
+use super::row::Row;
+
+/// Power bookkeeping per channel: emitted = absorbed + unshot + escaped, to round-off.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EnergyBalance {
+    /// Σ E·A.
+    pub emitted: Rgb,
+    /// Power absorbed by surfaces, (1 − ρ) of what they received.
+    pub absorbed: Rgb,
+    /// Power not yet shot, Σ ΔB·A.
+    pub unshot: Rgb,
+    /// Power shot that reached no element (left an open scene).
+    pub escaped: Rgb,
+}
+
+/// Radiosity, unshot radiosity and power tallies.
+pub(super) struct Tally {
+    /// B per element, W/unit².
+    pub(super) radiosity: Vec<Rgb>,
+    /// ΔB per element, W/unit².
+    pub(super) unshot: Vec<Rgb>,
+    /// Σ ΔB·A over each patch's elements, W.
+    pub(super) patch_unshot_power: Vec<Rgb>,
+    /// Σ E·A, W.
+    pub(super) emitted: Rgb,
+    absorbed: Rgb,
+    escaped: Rgb,
+    /// Σ |unshot power| / Σ emitted power, summed over channels.
+    pub(super) unshot_fraction: f64,
+}
+
+/// Below this many elements a shot is applied on one thread (a parallel pass costs more).
+const APPLY_PARALLEL_MIN: usize = 32_768;
+
+/// Receiving spans per parallel task when a shot is applied.
+const APPLY_SPANS_PER_TASK: usize = 16;
+
+impl Tally {
+    /// Shot 0: B = E and ΔB = E on every element.
+    ///
+    /// # Errors
+    /// [`SolverError::NoEmission`] when nothing emits.
+    pub(super) fn new(mesh: &Mesh) -> Result<Self, SolverError> {
+        let n = mesh.elements.len();
+        let emission: Vec<Rgb> = (0..n).map(|e| mesh.element_material(e).emission).collect();
+        let emitted: Rgb = mesh.elements.iter().zip(&emission).map(|(el, e)| *e * el.area).sum();
+        if emitted.sum() <= 0.0 {
+            return Err(SolverError::NoEmission);
+        }
+        let mut tally = Self {
+            radiosity: emission.clone(),
+            unshot: emission,
+            patch_unshot_power: vec![Rgb::ZERO; mesh.patches.len()],
+            emitted,
+            absorbed: Rgb::ZERO,
+            escaped: Rgb::ZERO,
+            unshot_fraction: 1.0,
+        };
+        for (p, patch) in mesh.patches.iter().enumerate() {
+            tally.patch_unshot_power[p] = (patch.elements.start..patch.elements.end)
+                .map(|e| tally.unshot[e as usize] * mesh.elements[e as usize].area)
+                .sum();
+        }
+        tally.update_unshot_fraction();
+        Ok(tally)
+    }
+
+    /// Recomputes the unshot fraction from the patches' unshot power.
+    pub(super) fn update_unshot_fraction(&mut self) {
+        let total: f64 = self.patch_unshot_power.iter().map(|p| p.abs().sum()).sum();
+        self.unshot_fraction = total / self.emitted.sum();
+    }
+
+    /// The patch with the largest |unshot power| (summed over channels); ties go to the lower
+    /// index so the choice is deterministic.
+    pub(super) fn brightest_patch(&self) -> usize {
+        let mut best = (0, f64::NEG_INFINITY);
+        for (p, power) in self.patch_unshot_power.iter().enumerate() {
+            let v = power.abs().sum();
+            if v > best.1 {
+                best = (p, v);
+            }
+        }
+        best.0
+    }
+
+    /// Shoots ω times the shooter's unshot radiosity through its row of form factors: every
+    /// receiving element j gains ρ_j · ω ΔB_i · F_{j→i} in B_j and ΔB_j (Cohen et al. 1988,
+    /// with F_{j→i} already the reciprocal form), and the shooter keeps (1 − ω) ΔB_i.
+    pub(super) fn shoot(&mut self, mesh: &Mesh, tables: &MeshTables, shooter: usize, row: &Row, omega: f64) {
+        let patch = &mesh.patches[shooter];
+        let shot_b = self.patch_unshot_power[shooter] * (omega / patch.area);
+        // Each receiving span (one patch, of one reflectance) takes ρ × the shot's radiosity
+        // times F per element, and its Σ F·A; spans own disjoint elements, so they may run
+        // in parallel. The sums over spans then run in span order: the same numbers for any
+        // thread count.
+        let mut spans = Vec::with_capacity(row.spans.len());
+        let (mut radiosity, mut unshot) = (&mut self.radiosity[..], &mut self.unshot[..]);
+        let (mut at, mut offset) = (0, 0);
+        for &(first, count) in &row.spans {
+            let (first, count) = (first as usize, count as usize);
+            let (r, rest_r) = std::mem::take(&mut radiosity)[first - at..].split_at_mut(count);
+            let (u, rest_u) = std::mem::take(&mut unshot)[first - at..].split_at_mut(count);
+            (radiosity, unshot, at) = (rest_r, rest_u, first + count);
+            let rho = tables.patch_reflectance[mesh.elements[first].patch as usize];
+            let area = &tables.element_area[first..first + count];
+            spans.push((rho * shot_b, &row.factors[offset..offset + count], area, r, u));
+            offset += count;
+        }
+        let receive = |(per_factor, factors, area, radiosity, unshot): &mut (
+            Rgb,
+            &[f32],
+            &[f64],
+            &mut [Rgb],
+            &mut [Rgb],
+        )| {
+            let mut seen = 0.0;
+            for k in 0..factors.len() {
+                let f = f64::from(factors[k]);
+                let reflected = *per_factor * f; // ρ × irradiance from this shot, W/unit²
+                radiosity[k] += reflected;
+                unshot[k] += reflected;
+                seen += f * area[k];
+            }
+            seen
+        };
+        let seen: Vec<f64> = if mesh.elements.len() < APPLY_PARALLEL_MIN || rayon::current_num_threads() == 1
+        {
+            spans.iter_mut().map(receive).collect()
+        } else {
+            spans.par_iter_mut().with_min_len(APPLY_SPANS_PER_TASK).map(receive).collect()
+        };
+        let mut received = Rgb::ZERO;
+        for (&(first, _), (span, seen)) in row.spans.iter().zip(spans.iter().zip(seen)) {
+            let gained = span.0 * seen;
+            let span_received = shot_b * seen;
+            received += span_received;
+            self.absorbed += span_received - gained;
+            self.patch_unshot_power[mesh.elements[first as usize].patch as usize] += gained;
+        }
+        self.escaped += shot_b * patch.area - received;
+        for e in patch.elements.start..patch.elements.end {
+            self.unshot[e as usize] *= 1.0 - omega;
+        }
+        self.patch_unshot_power[shooter] *= 1.0 - omega;
+    }
+
+    /// Power bookkeeping, with the unshot power summed fresh from the elements.
+    pub(super) fn energy(&self, mesh: &Mesh) -> EnergyBalance {
+        let unshot = self.unshot.iter().zip(&mesh.elements).map(|(u, el)| *u * el.area).sum();
+        EnergyBalance { emitted: self.emitted, absorbed: self.absorbed, unshot, escaped: self.escaped }
+    }
+}

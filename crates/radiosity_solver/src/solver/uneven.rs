@@ -1,0 +1,195 @@
+//! Uneven shooters: a patch whose unshot radiosity is far from even over its elements (a
+//! floor patch half under a block) is seen brighter or darker than its mean, depending on
+//! which part of it a receiver sees. Receivers that touch such a shooter weight their form
+//! factor by the density of the part they see; clusters of nearby shooter elements keep that
+//! weighting cheap.
+
+use glam::DVec3;
+
+use super::shot::ShooterElement;
+use crate::form_factor::point_to_point;
+use crate::shaft::bounds;
+
+/// A shooter with an element whose unshot density strays from the mean by more than this
+/// share weights the form factors of the receivers that touch it (see `receive`). The density
+/// is fixed at the shooter's first shot, so only strong, lasting structure is trusted:
+/// shadows and contact lines (a block standing on the patch: dark under it on every shot),
+/// not the gentle gradients of indirect light, which change from shot to shot. Measured: at
+/// 0.05 the ρ = 0.5 furnace's elements drift 2.4 % from E/(1 − ρ); at 0.5 they stay within
+/// its 0.5 % test, and the Cornell box's coarse patches match 35 mm shooters to 0.8 % RMS.
+pub(super) const NONUNIFORM: f64 = 0.5;
+
+/// Up to [`CLUSTER`] nearby elements of an uneven shooter, so that a receiver needs to visit
+/// the elements of only the clusters it is close to (see [`density_weight`]).
+#[derive(Clone, Debug)]
+pub(super) struct Cluster {
+    /// Its elements, as a range of [`Uneven::order`].
+    members: std::ops::Range<usize>,
+    centre: DVec3,
+    /// Radius about `centre` that holds all its elements.
+    radius: f64,
+    area: f64,
+    /// Area-weighted mean density of its elements.
+    density: f64,
+}
+
+/// Most elements in one [`Cluster`].
+const CLUSTER: usize = 16;
+
+/// How an uneven shooter's unshot radiosity is spread over its elements.
+#[derive(Clone, Copy)]
+pub(super) struct Uneven<'a> {
+    /// Per shooter element, its unshot radiosity over the shooter's mean.
+    pub(super) density: &'a [f64],
+    pub(super) clusters: &'a [Cluster],
+    /// Shooter element indices, cluster after cluster.
+    pub(super) order: &'a [u32],
+}
+
+/// Cuts the shooter's elements into clusters of at most [`CLUSTER`] nearby ones: fills
+/// `order` with the element indices, cluster after cluster, and `clusters` with the pieces.
+pub(super) fn cluster_elements(
+    elements: &[ShooterElement],
+    density: &[f64],
+    order: &mut Vec<u32>,
+    clusters: &mut Vec<Cluster>,
+) {
+    order.clear();
+    clusters.clear();
+    order.extend(0..elements.len() as u32);
+    build_clusters(order, 0, elements, density, clusters);
+}
+
+/// Cuts `order` (indices into `elements`) by median splits along the longest extent of the
+/// element centres until each piece holds at most [`CLUSTER`] elements; appends the pieces.
+fn build_clusters(
+    order: &mut [u32],
+    base: usize,
+    elements: &[ShooterElement],
+    density: &[f64],
+    out: &mut Vec<Cluster>,
+) {
+    let el = |k: &u32| &elements[*k as usize];
+    if order.len() > CLUSTER {
+        let (lo, hi) = bounds(order.iter().map(|k| &el(k).centre));
+        let axis = (hi - lo).max_position();
+        let mid = order.len() / 2;
+        order.select_nth_unstable_by(mid, |a, b| el(a).centre[axis].total_cmp(&el(b).centre[axis]));
+        let (left, right) = order.split_at_mut(mid);
+        build_clusters(left, base, elements, density, out);
+        build_clusters(right, base + mid, elements, density, out);
+        return;
+    }
+    let area: f64 = order.iter().map(|k| el(k).area).sum();
+    let centre = order.iter().map(|k| el(k).centre * el(k).area).sum::<DVec3>() / area;
+    let radius = order.iter().map(|k| el(k).centre.distance(centre) + el(k).radius).fold(0.0, f64::max);
+    let density = order.iter().map(|k| density[*k as usize] * el(k).area).sum::<f64>() / area;
+    out.push(Cluster { members: base..base + order.len(), centre, radius, area, density });
+}
+
+/// Σ_k d_k F_{p→k} / Σ_k F_{p→k} over the shooter's elements k: how much brighter than its
+/// mean the shooter looks from `p`; 1 when `p` sees none of it.
+/// Clusters more than four radii away count as one element.
+pub(super) fn density_weight(
+    p: DVec3,
+    n: DVec3,
+    ns: DVec3,
+    uneven: &Uneven,
+    elements: &[ShooterElement],
+) -> f64 {
+    let (mut weighted, mut plain) = (0.0, 0.0);
+    for c in uneven.clusters {
+        if c.centre.distance_squared(p) >= 16.0 * c.radius * c.radius {
+            let f = point_to_point(p, n, c.centre, ns, c.area);
+            weighted += c.density * f;
+            plain += f;
+            continue;
+        }
+        for &k in &uneven.order[c.members.clone()] {
+            let f = elements[k as usize].factor_from(p, n, ns);
+            weighted += uneven.density[k as usize] * f;
+            plain += f;
+        }
+    }
+    if plain > 0.0 { weighted / plain } else { 1.0 }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A `k × k` grid of unit squares in the plane z = 0, facing +z.
+    fn grid(k: usize) -> Vec<ShooterElement> {
+        let mut out = Vec::new();
+        for j in 0..k {
+            for i in 0..k {
+                let (x, y) = (i as f64, j as f64);
+                let corners = [
+                    DVec3::new(x, y, 0.0),
+                    DVec3::new(x + 1.0, y, 0.0),
+                    DVec3::new(x + 1.0, y + 1.0, 0.0),
+                    DVec3::new(x, y + 1.0, 0.0),
+                ];
+                let centre = DVec3::new(x + 0.5, y + 0.5, 0.0);
+                out.push(ShooterElement { corners, count: 4, centre, radius: 0.5f64.sqrt(), area: 1.0 });
+            }
+        }
+        out
+    }
+
+    /// Every element lands in exactly one cluster of at most [`CLUSTER`], each cluster's
+    /// sphere holds its elements, and its area and density are its elements' sum and
+    /// area-weighted mean.
+    #[test]
+    fn clusters_partition_the_elements_and_bound_them() {
+        let elements = grid(9);
+        let density: Vec<f64> = (0..elements.len()).map(|k| (k % 7) as f64 * 0.3).collect();
+        let (mut order, mut clusters) = (Vec::new(), Vec::new());
+        cluster_elements(&elements, &density, &mut order, &mut clusters);
+        let mut seen = vec![0; elements.len()];
+        let mut next = 0;
+        for c in &clusters {
+            assert_eq!(c.members.start, next, "clusters tile the order");
+            next = c.members.end;
+            assert!(!c.members.is_empty() && c.members.len() <= CLUSTER);
+            let members = &order[c.members.clone()];
+            let area: f64 = members.iter().map(|&k| elements[k as usize].area).sum();
+            let mean = members.iter().map(|&k| density[k as usize]).sum::<f64>() / members.len() as f64;
+            assert!((c.area - area).abs() < 1e-12 && (c.density - mean).abs() < 1e-12);
+            for &k in members {
+                seen[k as usize] += 1;
+                for p in elements[k as usize].corners() {
+                    assert!(p.distance(c.centre) <= c.radius + 1e-12, "corner outside its cluster");
+                }
+            }
+        }
+        assert_eq!(next, order.len());
+        assert!(seen.iter().all(|&n| n == 1));
+        assert!(clusters.len() >= 81 / CLUSTER);
+    }
+
+    /// An even shooter weighs 1 from anywhere; a shooter bright on one half looks brighter
+    /// from above that half than from above the other, near and far (one cluster's mean).
+    #[test]
+    fn density_weight_follows_the_part_a_receiver_sees() {
+        let elements = grid(8);
+        let (mut order, mut clusters) = (Vec::new(), Vec::new());
+        let even = vec![1.0; elements.len()];
+        cluster_elements(&elements, &even, &mut order, &mut clusters);
+        let uneven = Uneven { density: &even, clusters: &clusters, order: &order };
+        let down = -DVec3::Z;
+        for p in [DVec3::new(1.0, 4.0, 0.5), DVec3::new(4.0, 4.0, 100.0)] {
+            let w = density_weight(p, down, DVec3::Z, &uneven, &elements);
+            assert!((w - 1.0).abs() < 1e-12, "{p}: {w}");
+        }
+        // Left half (x < 4) twice the mean, right half empty.
+        let density: Vec<f64> = elements.iter().map(|e| if e.centre.x < 4.0 { 2.0 } else { 0.0 }).collect();
+        cluster_elements(&elements, &density, &mut order, &mut clusters);
+        let uneven = Uneven { density: &density, clusters: &clusters, order: &order };
+        let over_left = density_weight(DVec3::new(1.0, 4.0, 0.5), down, DVec3::Z, &uneven, &elements);
+        let over_right = density_weight(DVec3::new(7.0, 4.0, 0.5), down, DVec3::Z, &uneven, &elements);
+        assert!(over_left > 1.8 && over_right < 0.2, "{over_left}, {over_right}");
+        let far = density_weight(DVec3::new(4.0, 4.0, 1000.0), down, DVec3::Z, &uneven, &elements);
+        assert!((far - 1.0).abs() < 1e-3, "{far}");
+    }
+}
