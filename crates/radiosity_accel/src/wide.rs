@@ -117,7 +117,6 @@ impl SlabRay {
     /// within `[tmin, tmax]` (bit per child).
     #[inline(always)]
     fn boxes(&self, node: &Node, tmin: f32, tmax: f32) -> ([Vec4; GROUPS], u32) {
-        let origin = &self.lanes.origin;
         let mut nears = [Vec4::ZERO; GROUPS];
         let mut hits = 0;
         for (g, nears) in nears.iter_mut().enumerate() {
@@ -129,8 +128,8 @@ impl SlabRay {
                 } else {
                     (node.min[a][g], node.max[a][g])
                 };
-                near = near.max((lo - origin[a]) * self.inv[a]);
-                far = far.min((hi - origin[a]) * self.inv[a]);
+                near = near.max((lo - self.lanes.origin[a]) * self.inv[a]);
+                far = far.min((hi - self.lanes.origin[a]) * self.inv[a]);
             }
             *nears = near;
             hits |= near.cmple(far).bitmask() << (4 * g);
