@@ -118,6 +118,7 @@ fn unoccluded(shot: &Shot, plan: &PatchPlan, e: usize) -> f64 {
 
 /// The first pass for the elements of one receiving patch (`first` is its first element,
 /// `out` its slice): their unoccluded form factors, then their pilot rays.
+#[inline]
 pub(super) fn receive_patch(shot: &Shot, plan: &PatchPlan, first: usize, out: &mut [Received]) {
     out.fill(Received::default());
     if !plan.live {
@@ -166,6 +167,7 @@ fn unoccluded_factors(shot: &Shot, plan: &PatchPlan, first: usize, out: &mut [Re
 
 /// One pilot ray per element against the patch's candidate list: four elements' rays share
 /// a packet (the same rays as one packet each, a quarter of the tests).
+#[inline]
 fn single_rays_in_packets(shot: &Shot, plan: &PatchPlan, first: usize, out: &mut [Received]) {
     let mut order = [0u32; FEW];
     let candidates = &mut order[..plan.candidates.len()];
