@@ -136,12 +136,14 @@ impl Comparison {
     }
 }
 
-/// A difference in standard errors; an exact reference (no noise: a light that only emits)
-/// makes any difference beyond round-off infinitely significant.
+/// A difference in standard errors. An exact reference (a light that only emits: every path
+/// gives its emission) has a standard error of round-off only; below 1e-9 of the value it
+/// counts as 1e-9 of the value, so round-off never reads as a significant difference.
 fn z_score(diff: f64, stderr: f64, reference: f64) -> f64 {
-    if stderr > 0.0 {
-        diff / stderr
-    } else if diff.abs() <= 1e-9 * reference.abs() {
+    let floor = 1e-9 * reference.abs();
+    if stderr.max(floor) > 0.0 {
+        diff / stderr.max(floor)
+    } else if diff == 0.0 {
         0.0
     } else {
         diff.signum() * f64::INFINITY
