@@ -80,6 +80,9 @@ fn figures(a: &[f64], b: &[f64]) -> ChannelFigures {
     }
 }
 
+/// One value of a pixel: a channel or the luminance.
+type Channel = fn(&Rgb) -> f64;
+
 /// Blue (−range) through white (0) to red (+range).
 fn diverging(d: f64, range: f64) -> [u8; 3] {
     let t = (d / range).clamp(-1.0, 1.0);
@@ -126,8 +129,8 @@ pub fn run(a: CompareArgs) -> Result<()> {
             pb.height()
         )));
     }
-    let channel = |img: &HdrImage, f: fn(&Rgb) -> f64| img.pixels().iter().map(f).collect::<Vec<f64>>();
-    let getters: [(&str, fn(&Rgb) -> f64); 4] =
+    let channel = |img: &HdrImage, f: Channel| img.pixels().iter().map(f).collect::<Vec<f64>>();
+    let getters: [(&str, Channel); 4] =
         [("r", |p| p.r), ("g", |p| p.g), ("b", |p| p.b), ("Y", |p| p.luminance())];
     let all: Vec<(&str, ChannelFigures)> =
         getters.iter().map(|&(name, f)| (name, figures(&channel(&pa, f), &channel(&pb, f)))).collect();

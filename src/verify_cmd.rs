@@ -474,6 +474,7 @@ fn compare_elements(
             "element": e,
             "object": mesh.object_names[mesh.element_object(*e)],
             "area": mesh.elements[*e].area,
+            "centre": mesh.elements[*e].centre.to_array(),
             "radiosity": c.solve.to_array(),
             "reference": c.reference.mean.to_array(),
             "stderr": c.reference.stderr.to_array(),

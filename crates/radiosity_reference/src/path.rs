@@ -127,7 +127,7 @@ impl Geometry {
             if q <= 0.0 || rng.next_f64() >= q {
                 break;
             }
-            throughput = throughput * (1.0 / q);
+            throughput *= 1.0 / q;
             x = y;
         }
         b
