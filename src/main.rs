@@ -2,11 +2,13 @@
 
 mod alloc;
 mod bench_cmd;
+mod compare_cmd;
 mod export_cmd;
 mod info_cmd;
 mod prepare;
 mod render_cmd;
 mod solve_cmd;
+mod verify_cmd;
 mod view_cmd;
 
 use std::process::ExitCode;
@@ -41,6 +43,10 @@ enum Command {
     View(view_cmd::ViewArgs),
     /// Solve a scene and write the lit mesh (glTF, GLB, PLY) with baked colours, and lightmaps.
     Export(export_cmd::ExportArgs),
+    /// Solve a scene and check it against an independent Monte Carlo reference, per object.
+    Verify(verify_cmd::VerifyArgs),
+    /// Compare two linear pictures (.exr / .pfm): per-channel errors and a difference picture.
+    Compare(compare_cmd::CompareArgs),
 }
 
 fn main() -> ExitCode {
@@ -53,6 +59,8 @@ fn main() -> ExitCode {
         Command::Tonemap(a) => render_cmd::run_tonemap(a),
         Command::View(a) => view_cmd::run(a),
         Command::Export(a) => export_cmd::run(a),
+        Command::Verify(a) => verify_cmd::run(a),
+        Command::Compare(a) => compare_cmd::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -96,6 +96,13 @@ pub struct RenderArgs {
     pub fov: Option<f64>,
     #[command(flatten)]
     pub tone: ToneOpts,
+    /// Render with the independent Monte Carlo reference (a diffuse path tracer of the input
+    /// geometry) instead of the radiosity solution, for `radiosity compare`.
+    #[arg(long)]
+    pub reference: bool,
+    /// Paths per pixel of `--reference`.
+    #[arg(long, default_value_t = 256, value_name = "N")]
+    pub reference_spp: u32,
     /// Overwrite existing output files.
     #[arg(long)]
     pub force: bool,
@@ -179,6 +186,17 @@ pub fn run(a: RenderArgs) -> Result<()> {
         a.fov.unwrap_or(base.fov_y_deg),
     )
     .context("camera options")?;
+    if a.reference {
+        let radiance = crate::verify_cmd::reference_picture(
+            &prepared,
+            &camera,
+            a.width,
+            a.height,
+            a.reference_spp,
+            a.solve.seed,
+        )?;
+        return write_pictures(&a, &radiance);
+    }
 
     let (solver, report) = run_solver(&prepared)?;
     let solution = solver.solution();
@@ -202,16 +220,21 @@ pub fn run(a: RenderArgs) -> Result<()> {
         params.samples_per_pixel,
         render_secs
     );
+    write_pictures(&a, &rendering.radiance)
+}
+
+/// Writes the picture to every output asked for.
+fn write_pictures(a: &RenderArgs, radiance: &HdrImage) -> Result<()> {
     if let Some(path) = &a.output {
-        let ev = write_tonemapped(path, &rendering.radiance, &a.tone)?;
+        let ev = write_tonemapped(path, radiance, &a.tone)?;
         eprintln!("wrote {} (exposure {ev:+.2} EV, {})", path.display(), ToneOperator::from(a.tone.tonemap));
     }
     if let Some(path) = &a.exr {
-        write_exr(path, &rendering.radiance).context("cannot write the EXR")?;
+        write_exr(path, radiance).context("cannot write the EXR")?;
         eprintln!("wrote {} (linear radiance)", path.display());
     }
     if let Some(path) = &a.pfm {
-        write_pfm(path, &rendering.radiance).context("cannot write the PFM")?;
+        write_pfm(path, radiance).context("cannot write the PFM")?;
         eprintln!("wrote {} (linear radiance)", path.display());
     }
     Ok(())

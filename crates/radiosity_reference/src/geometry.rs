@@ -1,0 +1,320 @@
+//! The scene's input geometry as the estimator sees it: every input polygon (fan-triangulated
+//! for the BVH, sampled by area), every sphere (exact, intersected analytically), one list of
+//! primitives per object, and the emitters with their powers.
+//!
+//! Nothing here comes from the mesh: the reference must not share the solver's subdivision.
+
+use radiosity_accel::{Bvh, RayQuery};
+use radiosity_core::glam::{DVec3, Vec3};
+use radiosity_core::{Facing, Polygon, Rgb, Scene, Shape};
+
+/// One piece of an object's surface.
+#[derive(Clone, Debug)]
+pub(crate) enum Primitive {
+    /// A planar convex polygon: its fan triangles are `triangles` in [`Geometry::triangles`].
+    Polygon {
+        /// Unit normal of the lit side.
+        normal: DVec3,
+        /// First fan triangle and count.
+        first_triangle: usize,
+        /// Number of fan triangles.
+        triangle_count: usize,
+    },
+    /// A sphere, lit from outside (`inward` false) or from inside.
+    Sphere {
+        /// Centre.
+        center: DVec3,
+        /// Radius, > 0.
+        radius: f64,
+        /// Lit from inside.
+        inward: bool,
+    },
+}
+
+/// A primitive with its object and area.
+#[derive(Clone, Debug)]
+pub(crate) struct Piece {
+    pub object: u32,
+    pub area: f64,
+    pub shape: Primitive,
+}
+
+/// A surface point reached by a ray or drawn on an object.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SurfacePoint {
+    /// Position, world space.
+    pub p: DVec3,
+    /// Unit normal of the lit side.
+    pub n: DVec3,
+    /// The object.
+    pub object: u32,
+}
+
+/// What a ray meets first.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct RayHit {
+    /// The point and its lit-side normal.
+    pub point: SurfacePoint,
+    /// True when the ray meets the lit side (radiosity surfaces are one-sided).
+    pub front: bool,
+}
+
+/// Per object: name, material, area, and its pieces with a cumulative area table.
+#[derive(Clone, Debug)]
+pub(crate) struct ObjectGeometry {
+    pub name: String,
+    pub reflectance: Rgb,
+    pub emission: Rgb,
+    pub area: f64,
+    /// Indices into [`Geometry::pieces`].
+    pub pieces: Vec<u32>,
+    /// Cumulative areas of `pieces`, last = `area`.
+    pub cdf: Vec<f64>,
+}
+
+/// The whole scene for the estimator.
+pub(crate) struct Geometry {
+    pub pieces: Vec<Piece>,
+    /// Fan triangles of every polygon, in f64.
+    pub triangles: Vec<[DVec3; 3]>,
+    /// The piece of each triangle.
+    pub triangle_piece: Vec<u32>,
+    /// Cumulative areas of each polygon's fan triangles (indexed like `triangles`), relative
+    /// to the polygon's first triangle.
+    pub triangle_cdf: Vec<f64>,
+    pub bvh: Bvh,
+    /// Pieces that are spheres (tested analytically on every ray).
+    pub spheres: Vec<u32>,
+    pub objects: Vec<ObjectGeometry>,
+    /// Emitting pieces and cumulative emitted power (channel sum) to choose them by.
+    pub emitters: Vec<u32>,
+    pub emitter_cdf: Vec<f64>,
+    /// Distance rays start off their surface: 1e-5 of the scene's diagonal (far above the
+    /// BVH's single-precision error, far below any feature).
+    pub offset: f64,
+}
+
+/// Index of the first entry of the non-decreasing `cdf` that exceeds `u · total`.
+pub(crate) fn pick(cdf: &[f64], u: f64) -> usize {
+    let total = *cdf.last().expect("non-empty table");
+    let x = u * total;
+    cdf.partition_point(|&c| c <= x).min(cdf.len() - 1)
+}
+
+fn triangle_area(t: &[DVec3; 3]) -> f64 {
+    0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length()
+}
+
+impl Geometry {
+    pub fn new(scene: &Scene) -> Self {
+        let mut g = Geometry {
+            pieces: Vec::new(),
+            triangles: Vec::new(),
+            triangle_piece: Vec::new(),
+            triangle_cdf: Vec::new(),
+            bvh: Bvh::new(&[]),
+            spheres: Vec::new(),
+            objects: Vec::new(),
+            emitters: Vec::new(),
+            emitter_cdf: Vec::new(),
+            offset: 0.0,
+        };
+        for (oi, o) in scene.objects.iter().enumerate() {
+            let material = &scene.materials[o.material];
+            let mut object = ObjectGeometry {
+                name: o.name.clone(),
+                reflectance: material.reflectance,
+                emission: material.emission,
+                area: 0.0,
+                pieces: Vec::new(),
+                cdf: Vec::new(),
+            };
+            let mut add = |g: &mut Geometry, piece: Piece| {
+                object.area += piece.area;
+                object.pieces.push(g.pieces.len() as u32);
+                object.cdf.push(object.area);
+                g.pieces.push(piece);
+            };
+            match &o.shape {
+                Shape::Polygons(ps) => {
+                    for p in ps {
+                        let piece = g.polygon(oi, p);
+                        add(&mut g, piece);
+                    }
+                }
+                Shape::Mesh(m) => {
+                    for p in m.polygons() {
+                        let piece = g.polygon(oi, p);
+                        add(&mut g, piece);
+                    }
+                }
+                Shape::Sphere(s) => {
+                    g.spheres.push(g.pieces.len() as u32);
+                    let piece = Piece {
+                        object: oi as u32,
+                        area: 4.0 * std::f64::consts::PI * s.radius * s.radius,
+                        shape: Primitive::Sphere {
+                            center: s.center,
+                            radius: s.radius,
+                            inward: s.facing == Facing::Inward,
+                        },
+                    };
+                    add(&mut g, piece);
+                }
+            }
+            g.objects.push(object);
+        }
+        let mut power = 0.0;
+        for (i, piece) in g.pieces.iter().enumerate() {
+            let e = g.objects[piece.object as usize].emission.sum();
+            if e > 0.0 {
+                power += e * piece.area;
+                g.emitters.push(i as u32);
+                g.emitter_cdf.push(power);
+            }
+        }
+        let f32_triangles: Vec<[Vec3; 3]> = g.triangles.iter().map(|t| t.map(|v| v.as_vec3())).collect();
+        g.bvh = Bvh::new(&f32_triangles);
+        let (lo, hi) = scene.bounds();
+        g.offset = 1e-5 * (hi - lo).length().max(f64::MIN_POSITIVE);
+        g
+    }
+
+    fn polygon(&mut self, object: usize, p: &Polygon) -> Piece {
+        let v = p.vertices();
+        let first_triangle = self.triangles.len();
+        let piece = self.pieces.len() as u32;
+        let mut acc = 0.0;
+        for i in 1..v.len() - 1 {
+            let t = [v[0], v[i], v[i + 1]];
+            acc += triangle_area(&t);
+            self.triangles.push(t);
+            self.triangle_piece.push(piece);
+            self.triangle_cdf.push(acc);
+        }
+        Piece {
+            object: object as u32,
+            area: p.area(),
+            shape: Primitive::Polygon { normal: p.normal(), first_triangle, triangle_count: v.len() - 2 },
+        }
+    }
+
+    /// A point drawn uniformly by area on `piece` from three uniform numbers.
+    pub fn sample_piece(&self, piece: u32, u: [f64; 3]) -> SurfacePoint {
+        let pc = &self.pieces[piece as usize];
+        match pc.shape {
+            Primitive::Polygon { normal, first_triangle, triangle_count } => {
+                let cdf = &self.triangle_cdf[first_triangle..first_triangle + triangle_count];
+                let t = &self.triangles[first_triangle + pick(cdf, u[0])];
+                SurfacePoint { p: uniform_in_triangle(t, u[1], u[2]), n: normal, object: pc.object }
+            }
+            Primitive::Sphere { center, radius, inward } => {
+                // Uniform on the sphere: z uniform in [−1, 1] (Archimedes' hat-box theorem).
+                let z = 1.0 - 2.0 * u[1];
+                let r = (1.0 - z * z).max(0.0).sqrt();
+                let phi = 2.0 * std::f64::consts::PI * u[2];
+                let d = DVec3::new(r * phi.cos(), r * phi.sin(), z);
+                SurfacePoint { p: center + d * radius, n: if inward { -d } else { d }, object: pc.object }
+            }
+        }
+    }
+
+    /// A point drawn uniformly by area on object `object`.
+    pub fn sample_object(&self, object: u32, u: [f64; 4]) -> SurfacePoint {
+        let o = &self.objects[object as usize];
+        let piece = o.pieces[pick(&o.cdf, u[0])];
+        self.sample_piece(piece, [u[1], u[2], u[3]])
+    }
+
+    /// The first surface along `origin + t·dir` (`dir` unit), t > 0.
+    pub fn intersect(&self, origin: DVec3, dir: DVec3) -> Option<RayHit> {
+        let mut best: Option<(f64, SurfacePoint)> = None;
+        if let Some(hit) = self.bvh.closest_hit(origin.as_vec3(), dir.as_vec3(), f32::MAX) {
+            let piece_index = self.triangle_piece[hit.triangle as usize];
+            let piece = &self.pieces[piece_index as usize];
+            let Primitive::Polygon { normal, .. } = piece.shape else {
+                unreachable!("triangles are polygons")
+            };
+            // The hit again in double precision, on the polygon's plane.
+            let t0 = self.triangles[hit.triangle as usize][0];
+            let denom = normal.dot(dir);
+            let t = if denom.abs() > 1e-12 { normal.dot(t0 - origin) / denom } else { f64::from(hit.t) };
+            best = Some((t, SurfacePoint { p: origin + dir * t, n: normal, object: piece.object }));
+        }
+        for &s in &self.spheres {
+            let piece = &self.pieces[s as usize];
+            let Primitive::Sphere { center, radius, inward } = piece.shape else { continue };
+            let limit = best.map_or(f64::INFINITY, |b| b.0);
+            if let Some(t) = sphere_hit(center, radius, origin, dir, 1e-3 * self.offset, limit) {
+                let p = origin + dir * t;
+                let out = (p - center) / radius;
+                best =
+                    Some((t, SurfacePoint { p, n: if inward { -out } else { out }, object: piece.object }));
+            }
+        }
+        best.map(|(_, point)| RayHit { point, front: point.n.dot(dir) < 0.0 })
+    }
+
+    /// True when something lies strictly between `from` and `to` (both ends excluded by
+    /// 1e-4 of the segment, as the BVH does).
+    pub fn occluded(&self, from: DVec3, to: DVec3) -> bool {
+        if self.bvh.occluded(from.as_vec3(), to.as_vec3()) {
+            return true;
+        }
+        let d = to - from;
+        let len = d.length();
+        self.spheres.iter().any(|&s| {
+            let Primitive::Sphere { center, radius, .. } = self.pieces[s as usize].shape else {
+                return false;
+            };
+            sphere_hit(center, radius, from, d / len, 1e-4 * len, (1.0 - 1e-4) * len).is_some()
+        })
+    }
+}
+
+/// Uniform point in a triangle from two uniform numbers (Osada et al. 2002, eq. 1).
+fn uniform_in_triangle(t: &[DVec3; 3], u: f64, v: f64) -> DVec3 {
+    let s = u.sqrt();
+    t[0] * (1.0 - s) + t[1] * (s * (1.0 - v)) + t[2] * (s * v)
+}
+
+/// Smallest root t of |o + t·d − c| = r in (t_min, t_max) (`d` unit).
+fn sphere_hit(center: DVec3, radius: f64, o: DVec3, d: DVec3, t_min: f64, t_max: f64) -> Option<f64> {
+    let oc = o - center;
+    let b = oc.dot(d);
+    // c computed as (|oc| − r)(|oc| + r) keeps precision for points near the surface.
+    let l = oc.length();
+    let c = (l - radius) * (l + radius);
+    let disc = b * b - c;
+    if disc < 0.0 {
+        return None;
+    }
+    let sq = disc.sqrt();
+    // Numerically stable pair of roots (Press et al., Numerical Recipes §5.6).
+    let q = -(b + sq.copysign(b));
+    let (t1, t2) = if q != 0.0 { (q, c / q) } else { (-b, -b) };
+    let (t1, t2) = (t1.min(t2), t1.max(t2));
+    [t1, t2].into_iter().find(|&t| t > t_min && t < t_max)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sphere_roots_are_found_from_outside_and_inside() {
+        let t = sphere_hit(DVec3::ZERO, 1.0, DVec3::new(0.0, 0.0, -3.0), DVec3::Z, 0.0, f64::INFINITY);
+        assert!((t.unwrap() - 2.0).abs() < 1e-12);
+        let t = sphere_hit(DVec3::ZERO, 1.0, DVec3::ZERO, DVec3::Z, 0.0, f64::INFINITY);
+        assert!((t.unwrap() - 1.0).abs() < 1e-12);
+        assert!(sphere_hit(DVec3::ZERO, 1.0, DVec3::new(0.0, 2.0, -3.0), DVec3::Z, 0.0, 9.0).is_none());
+    }
+
+    #[test]
+    fn pick_follows_the_table() {
+        let cdf = [1.0, 1.0, 3.0];
+        assert_eq!(pick(&cdf, 0.0), 0);
+        assert_eq!(pick(&cdf, 0.5), 2);
+        assert_eq!(pick(&cdf, 0.9999), 2);
+    }
+}

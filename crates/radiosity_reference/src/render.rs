@@ -1,0 +1,97 @@
+//! Pictures by path tracing: the radiance the camera sees, B/π of the first surface a ray
+//! meets, with B estimated by a path from that point.
+
+use radiosity_core::glam::DVec3;
+use radiosity_core::random::Rng;
+use radiosity_core::{Camera, Rgb};
+use rayon::prelude::*;
+
+use crate::geometry::Geometry;
+use crate::{Picture, PictureParams};
+
+/// Task key of the pixels' streams.
+const PIXEL_TASK: u64 = 0x7069_7800_0000_0000; // "pix"
+
+/// Primary ray directions of a pinhole camera, the same mapping as the radiosity renderer's
+/// (right = forward × up, film y down from the top edge), so pictures compare pixel by pixel.
+struct CameraRays {
+    forward: DVec3,
+    right: DVec3,
+    up: DVec3,
+    half_height: f64,
+    aspect: f64,
+    width: f64,
+    height: f64,
+}
+
+impl CameraRays {
+    fn new(camera: &Camera, width: u32, height: u32) -> Self {
+        let forward = (camera.look_at - camera.position).normalize();
+        let right = forward.cross(camera.up).normalize();
+        let up = right.cross(forward);
+        Self {
+            forward,
+            right,
+            up,
+            half_height: (camera.fov_y_deg.to_radians() * 0.5).tan(),
+            aspect: f64::from(width) / f64::from(height),
+            width: f64::from(width),
+            height: f64::from(height),
+        }
+    }
+
+    fn direction(&self, px: f64, py: f64) -> DVec3 {
+        let sx = (2.0 * px / self.width - 1.0) * self.aspect * self.half_height;
+        let sy = (1.0 - 2.0 * py / self.height) * self.half_height;
+        (self.forward + self.right * sx + self.up * sy).normalize()
+    }
+}
+
+pub(crate) fn render(
+    g: &Geometry,
+    camera: &Camera,
+    params: &PictureParams,
+    row_done: &(dyn Fn() + Sync),
+) -> Picture {
+    let (w, h) = (params.width as usize, params.height as usize);
+    let rays = CameraRays::new(camera, params.width, params.height);
+    let n = params.samples_per_pixel.max(1);
+    let m = f64::from(n).sqrt().floor() as u32; // strata per side, as the radiosity renderer
+    let mut radiance = vec![Rgb::ZERO; w * h];
+    let mut stderr = vec![Rgb::ZERO; w * h];
+    radiance.par_chunks_mut(w).zip(stderr.par_chunks_mut(w)).enumerate().for_each(|(y, (row, se_row))| {
+        for x in 0..w {
+            let mut rng = Rng::for_task(params.seed, PIXEL_TASK, (y * w + x) as u64);
+            let (mut sum, mut sum_sq) = (Rgb::ZERO, Rgb::ZERO);
+            for i in 0..n {
+                let (jx, jy) = (rng.next_f64(), rng.next_f64());
+                let (sx, sy) = if i < m * m {
+                    ((f64::from(i % m) + jx) / f64::from(m), (f64::from(i / m) + jy) / f64::from(m))
+                } else {
+                    (jx, jy)
+                };
+                let dir = rays.direction(x as f64 + sx, y as f64 + sy);
+                let l = match g.intersect(camera.position, dir) {
+                    Some(hit) if hit.front => {
+                        g.radiosity_at(hit.point, u32::MAX, &mut rng) * std::f64::consts::FRAC_1_PI
+                    }
+                    _ => Rgb::ZERO,
+                };
+                sum += l;
+                sum_sq += l * l;
+            }
+            let k = f64::from(n);
+            let mean = sum / k;
+            row[x] = mean;
+            // Sample variance of the pixel's samples over n: the pixel's own standard error
+            // (conservative for the stratified film positions).
+            se_row[x] = if n > 1 {
+                ((sum_sq - mean * mean * k) / (k - 1.0) / k).map(|v| v.max(0.0).sqrt())
+            } else {
+                Rgb::splat(f64::INFINITY)
+            };
+        }
+        row_done();
+    });
+    Picture { width: params.width, height: params.height, radiance, stderr }
+}

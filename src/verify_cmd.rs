@@ -1,0 +1,535 @@
+//! `radiosity verify`: solve a scene as `solve` would, estimate the same quantities with the
+//! independent Monte Carlo reference (`radiosity_reference`), and print both side by side with
+//! their difference in per cent and in standard errors; and the reference picture behind
+//! `render --reference`.
+
+use std::io::IsTerminal;
+use std::sync::Arc;
+use std::time::Duration;
+
+use anyhow::Result;
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use radiosity_core::random::Rng;
+use radiosity_core::{Camera, Mesh, Rgb};
+use radiosity_image::HdrImage;
+use radiosity_reference::{Estimate, EstimateParams, PathBudget, PictureParams, Progress, Reference, Region};
+use serde_json::{Value, json};
+
+use crate::prepare::{InputError, Prepared, SolveOpts, check_writable, prepare, run_solver, write_output};
+
+/// Arguments of `radiosity verify`.
+#[derive(Args)]
+pub struct VerifyArgs {
+    /// Scene file (.toml), model file or built-in name (cornell, furnace, seed-room, two-plates).
+    pub scene: String,
+    /// Paths per object for the reference (a fixed count); default: as many as it takes to
+    /// bring every channel's standard error to --stderr-target of its mean (at most 2^26).
+    /// `--time-limit S` (a solve option) also stops the reference after S seconds.
+    #[arg(long)]
+    pub paths: Option<u64>,
+    /// Standard error to reach, relative to the mean, when --paths is not given.
+    #[arg(long, default_value_t = 0.001, value_name = "FRACTION")]
+    pub stderr_target: f64,
+    /// Count at most N reflections in the reference (default: all). With a single-patch
+    /// light, `--reflections 1 --max-shots 1` compares the direct light alone: the solver's
+    /// form factors and visibility, without the inter-reflection.
+    #[arg(long, value_name = "N")]
+    pub reflections: Option<u32>,
+    /// Also compare a sample of this many elements (default 200 when the flag is given alone):
+    /// their solve value against a reference estimate over each element.
+    #[arg(long, num_args = 0..=1, default_missing_value = "200", value_name = "N")]
+    pub elements: Option<usize>,
+    /// Reference paths per sampled element.
+    #[arg(long, default_value_t = 65_536, value_name = "N")]
+    pub element_paths: u64,
+    /// Write the JSON report here (`-` for stdout).
+    #[arg(long)]
+    pub json: Option<String>,
+    /// Overwrite an existing report file.
+    #[arg(long)]
+    pub force: bool,
+    /// Multiply every reflectance the solver sees (not the reference) by this factor: a
+    /// deliberately wrong solve, to check that `verify` notices.
+    #[arg(long, hide = true)]
+    pub solve_reflectance_scale: Option<f64>,
+    #[command(flatten)]
+    pub solve: SolveOpts,
+}
+
+fn input(msg: String) -> anyhow::Error {
+    InputError(msg).into()
+}
+
+/// Scales the reflectance of every material the mesh carries (and so that the solver sees)
+/// by `factor`, leaving the scene — and so the reference — alone: the test hook behind
+/// `--solve-reflectance-scale`.
+///
+/// # Errors
+/// A factor that is not finite and > 0, or that takes a reflectance to 1 or above.
+pub fn scale_solver_reflectance(mesh: &mut Mesh, factor: f64) -> Result<()> {
+    let top = mesh.materials.iter().map(|m| m.reflectance.max_channel()).fold(0.0, f64::max);
+    if !(factor.is_finite() && factor > 0.0 && top * factor < 1.0) {
+        return Err(input(format!(
+            "--solve-reflectance-scale must be > 0 and keep every reflectance below 1, got {factor}"
+        )));
+    }
+    for m in &mut mesh.materials {
+        m.reflectance *= factor;
+    }
+    Ok(())
+}
+
+/// A progress bar for the reference on stderr when it is a terminal.
+fn reference_bar(what: &str) -> ProgressBar {
+    if !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(1);
+    let template = format!("{{spinner}} {what} [{{bar:30}}] {{msg}}");
+    bar.set_style(ProgressStyle::with_template(&template).expect("valid template").progress_chars("=> "));
+    bar
+}
+
+fn report_progress(bar: &ProgressBar, p: Progress) {
+    bar.set_length(p.paths_planned.max(1));
+    bar.set_position(p.paths_done);
+    let secs = p.elapsed.as_secs_f64();
+    bar.set_message(format!(
+        "{:.1} M paths, {:.2} M paths/s, {:.0} s",
+        p.paths_done as f64 / 1e6,
+        p.paths_done as f64 / secs.max(1e-9) / 1e6,
+        secs
+    ));
+}
+
+/// One solve value against its reference estimate.
+#[derive(Clone, Copy, Debug)]
+struct Comparison {
+    solve: Rgb,
+    reference: Estimate,
+}
+
+impl Comparison {
+    /// (solve − reference) / reference per channel, in per cent (`None` where the reference
+    /// is 0).
+    fn percent(&self) -> [Option<f64>; 3] {
+        let (s, r) = (self.solve.to_array(), self.reference.mean.to_array());
+        [0, 1, 2].map(|i| (r[i] != 0.0).then(|| (s[i] - r[i]) / r[i] * 100.0))
+    }
+
+    /// (solve − reference) / standard error per channel.
+    fn sigma(&self) -> [f64; 3] {
+        let (s, r, e) =
+            (self.solve.to_array(), self.reference.mean.to_array(), self.reference.stderr.to_array());
+        [0, 1, 2].map(|i| z_score(s[i] - r[i], e[i], r[i]))
+    }
+
+    fn luminance_percent(&self) -> Option<f64> {
+        let r = self.reference.luminance;
+        (r != 0.0).then(|| (self.solve.luminance() - r) / r * 100.0)
+    }
+
+    fn luminance_sigma(&self) -> f64 {
+        let r = self.reference.luminance;
+        z_score(self.solve.luminance() - r, self.reference.luminance_stderr, r)
+    }
+}
+
+/// A difference in standard errors. An exact reference (a light that only emits: every path
+/// gives its emission) has a standard error of round-off only; below 1e-9 of the value it
+/// counts as 1e-9 of the value, so round-off never reads as a significant difference.
+fn z_score(diff: f64, stderr: f64, reference: f64) -> f64 {
+    let floor = 1e-9 * reference.abs();
+    if stderr.max(floor) > 0.0 {
+        diff / stderr.max(floor)
+    } else if diff == 0.0 {
+        0.0
+    } else {
+        diff.signum() * f64::INFINITY
+    }
+}
+
+/// A number for JSON: non-finite values become null.
+fn num(x: f64) -> Value {
+    if x.is_finite() { json!(x) } else { Value::Null }
+}
+
+fn fmt_pct(p: Option<f64>) -> String {
+    p.map_or_else(|| "—".into(), |p| format!("{p:+.2}"))
+}
+
+fn fmt_sigma(z: f64) -> String {
+    if z.is_finite() { format!("{z:+.1}") } else { format!("{}∞", if z > 0.0 { "+" } else { "−" }) }
+}
+
+fn median(mut v: Vec<f64>) -> Option<f64> {
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    Some(if n % 2 == 1 { v[n / 2] } else { 0.5 * (v[n / 2 - 1] + v[n / 2]) })
+}
+
+/// Runs `verify`.
+pub fn run(a: VerifyArgs) -> Result<()> {
+    if a.paths == Some(0) {
+        return Err(input("--paths must be at least 1".into()));
+    }
+    if !(a.stderr_target.is_finite() && a.stderr_target > 0.0 && a.stderr_target < 1.0) {
+        return Err(input(format!("--stderr-target must be in (0, 1), got {}", a.stderr_target)));
+    }
+    if a.element_paths == 0 {
+        return Err(input("--element-paths must be at least 1".into()));
+    }
+    if let Some(path) = &a.json
+        && path != "-"
+    {
+        check_writable(std::path::Path::new(path), a.force)?;
+    }
+    let mut prepared = prepare(&a.scene, &a.solve)?;
+    if let Some(k) = a.solve_reflectance_scale {
+        scale_solver_reflectance(Arc::make_mut(&mut prepared.mesh), k)?;
+    }
+    let (solver, report) = run_solver(&prepared)?;
+    let Prepared { scene, mesh, .. } = &prepared;
+    let solution = solver.solution();
+    let solved = solution.object_radiosity(mesh);
+    let solve_secs = report.elapsed.as_secs_f64();
+    let stop = report.stop_reason.map_or("running", |s| s.as_str());
+    eprintln!(
+        "{}: solved {} patches, {} elements, {} shots, {:.3} s, unshot {:.4} %, {}",
+        scene.name,
+        mesh.patches.len(),
+        mesh.elements.len(),
+        report.total_shots,
+        solve_secs,
+        report.unshot_fraction * 100.0,
+        stop
+    );
+
+    let reference = Reference::new(scene);
+    let budget = match a.paths {
+        Some(paths) => PathBudget::Fixed { paths },
+        None => PathBudget::Adaptive { relative_stderr: a.stderr_target, max_paths: 1 << 26 },
+    };
+    let time_limit = a.solve.time_limit.map(Duration::from_secs_f64);
+    let max_reflections = a.reflections.unwrap_or(u32::MAX);
+    let params = EstimateParams { budget, seed: a.solve.seed, time_limit, max_reflections };
+    let bar = reference_bar("reference");
+    let estimates = reference.estimate_objects(&params, &|p| report_progress(&bar, p));
+    bar.finish_and_clear();
+    let ref_secs = estimates.elapsed.as_secs_f64();
+    eprintln!(
+        "reference: {:.1} M paths in {:.1} s ({:.2} M paths/s){}",
+        estimates.paths as f64 / 1e6,
+        ref_secs,
+        estimates.paths as f64 / ref_secs.max(1e-9) / 1e6,
+        if estimates.timed_out { ", stopped by the time limit" } else { "" }
+    );
+
+    let rows: Vec<Comparison> = solved
+        .iter()
+        .zip(&estimates.objects)
+        .map(|(s, r)| Comparison { solve: s.radiosity, reference: r.estimate })
+        .collect();
+
+    // The table: luminance for the eye, per-channel differences beside it.
+    let mut table = format!(
+        "{:<20} {:>10} {:>11} {:>11} {:>9} {:>8} {:>8}   {:>22}\n",
+        "object", "area", "solve Y", "reference Y", "± σ %", "diff %", "diff σ", "diff % [r g b]"
+    );
+    for (o, c) in solved.iter().zip(&rows) {
+        let rel_se = if c.reference.luminance > 0.0 {
+            c.reference.luminance_stderr / c.reference.luminance * 100.0
+        } else {
+            0.0
+        };
+        let per = c.percent().map(fmt_pct);
+        table += &format!(
+            "{:<20} {:>10.4e} {:>11.5e} {:>11.5e} {:>9.3} {:>8} {:>8}   {:>7} {:>7} {:>7}\n",
+            o.name,
+            o.area,
+            c.solve.luminance(),
+            c.reference.luminance,
+            rel_se,
+            fmt_pct(c.luminance_percent()),
+            fmt_sigma(c.luminance_sigma()),
+            per[0],
+            per[1],
+            per[2]
+        );
+    }
+    // Objects that are dark in both (nothing to compare) are left out of the summary.
+    let judged: Vec<(usize, f64, f64)> = rows
+        .iter()
+        .enumerate()
+        .filter_map(|(i, c)| c.luminance_percent().map(|p| (i, p, c.luminance_sigma())))
+        .collect();
+    let over = judged.iter().filter(|(_, _, z)| z.abs() > 3.0).count();
+    let worst = judged.iter().max_by(|x, y| x.1.abs().total_cmp(&y.1.abs()));
+    let median_abs = median(judged.iter().map(|j| j.1.abs()).collect());
+    let area_weighted = {
+        let (mut sum, mut area) = (0.0, 0.0);
+        for &(i, p, _) in &judged {
+            sum += p * solved[i].area;
+            area += solved[i].area;
+        }
+        (area > 0.0).then(|| sum / area)
+    };
+    let summary = match worst {
+        Some(&(i, p, z)) => format!(
+            "{over} of {} objects differ by more than 3 σ; worst {} {:+.2} % ({} σ), median |difference| {:.2} %, area-weighted mean {:+.2} %",
+            judged.len(),
+            solved[i].name,
+            p,
+            fmt_sigma(z),
+            median_abs.unwrap_or(0.0),
+            area_weighted.unwrap_or(0.0)
+        ),
+        None => "no object has light to compare".into(),
+    };
+    table += &summary;
+    table.push('\n');
+
+    // A sample of elements: local errors (shadow edges, contacts) that object means hide.
+    let element_part = match a.elements {
+        Some(count) if count > 0 => Some(compare_elements(
+            &reference,
+            mesh,
+            &solution.element_radiosity,
+            count,
+            a.element_paths,
+            a.solve.seed,
+            max_reflections,
+        )?),
+        _ => None,
+    };
+    if let Some(part) = &element_part {
+        table += &part.text;
+    }
+    if a.json.as_deref() != Some("-") {
+        let mut out = std::io::stdout().lock();
+        match std::io::Write::write_all(&mut out, table.as_bytes())
+            .and_then(|()| std::io::Write::flush(&mut out))
+        {
+            Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => return Err(e.into()),
+            _ => {}
+        }
+    }
+    if let Some(path) = &a.json {
+        let objects: Vec<Value> = solved
+            .iter()
+            .zip(&rows)
+            .zip(&estimates.objects)
+            .map(|((o, c), r)| {
+                json!({
+                    "name": o.name,
+                    "area": o.area,
+                    "radiosity": o.radiosity.to_array(),
+                    "reference": c.reference.mean.to_array(),
+                    "stderr": c.reference.stderr.to_array(),
+                    "paths": r.estimate.paths,
+                    "difference_percent": c.percent().map(|p| p.map_or(Value::Null, num)),
+                    "difference_sigma": c.sigma().map(num),
+                    "luminance": {
+                        "radiosity": c.solve.luminance(),
+                        "reference": c.reference.luminance,
+                        "stderr": c.reference.luminance_stderr,
+                        "difference_percent": c.luminance_percent().map_or(Value::Null, num),
+                        "difference_sigma": num(c.luminance_sigma()),
+                    },
+                })
+            })
+            .collect();
+        let mut doc = json!({
+            "scene": scene.name,
+            "patches": mesh.patches.len(),
+            "elements": mesh.elements.len(),
+            "shots": report.total_shots,
+            "unshot_fraction": report.unshot_fraction,
+            "stop_reason": stop,
+            "solve_seconds": solve_secs,
+            "paths": estimates.paths,
+            "seconds": ref_secs,
+            "timed_out": estimates.timed_out,
+            "seed": a.solve.seed,
+            "reflections": a.reflections,
+            "objects": objects,
+            "summary": {
+                "text": summary,
+                "objects": judged.len(),
+                "over_3_sigma": over,
+                "worst": worst.map(|&(i, p, z)| json!({"name": solved[i].name, "difference_percent": num(p), "difference_sigma": num(z)})),
+                "median_abs_difference_percent": median_abs,
+                "area_weighted_difference_percent": area_weighted,
+            },
+        });
+        if let Some(part) = element_part {
+            doc["element_sample"] = part.json;
+        }
+        write_output(path, &serde_json::to_string_pretty(&doc)?, a.force)?;
+    }
+    Ok(())
+}
+
+/// What the element sample adds to the table and to the report.
+struct ElementPart {
+    text: String,
+    json: Value,
+}
+
+/// Compares `count` elements drawn at random (seeded) with reference estimates over each.
+fn compare_elements(
+    reference: &Reference,
+    mesh: &Mesh,
+    element_radiosity: &[Rgb],
+    count: usize,
+    paths: u64,
+    seed: u64,
+    max_reflections: u32,
+) -> Result<ElementPart> {
+    // A partial Fisher–Yates shuffle: `count` distinct elements, the same for a seed.
+    let n = mesh.elements.len();
+    let mut order: Vec<usize> = (0..n).collect();
+    let mut rng = Rng::for_task(seed, 0x656c_656d, 0); // "elem"
+    let k = count.min(n);
+    for i in 0..k {
+        let j = i + (rng.next_u64() % (n - i) as u64) as usize;
+        order.swap(i, j);
+    }
+    let mut sample = order[..k].to_vec();
+    sample.sort_unstable();
+    let regions: Vec<Region> = sample
+        .iter()
+        .map(|&e| Region { object: mesh.element_object(e), corners: mesh.element_corners(e).collect() })
+        .collect();
+    let params = EstimateParams {
+        budget: PathBudget::Fixed { paths },
+        seed,
+        max_reflections,
+        ..EstimateParams::default()
+    };
+    let bar = reference_bar("elements");
+    let estimates = reference.estimate_regions(&regions, &params, &|p| report_progress(&bar, p))?;
+    bar.finish_and_clear();
+
+    let rows: Vec<(usize, Comparison)> = sample
+        .iter()
+        .zip(&estimates)
+        .map(|(&e, r)| (e, Comparison { solve: element_radiosity[e], reference: *r }))
+        .collect();
+    // Relative differences in luminance, over the elements the reference sees lit; the
+    // noise part is what the reference's own standard errors alone would give.
+    let lit: Vec<&(usize, Comparison)> = rows.iter().filter(|(_, c)| c.reference.luminance > 0.0).collect();
+    let m = lit.len().max(1) as f64;
+    let rms =
+        (lit.iter().map(|(_, c)| (c.luminance_percent().unwrap_or(0.0)).powi(2)).sum::<f64>() / m).sqrt();
+    let noise = (lit
+        .iter()
+        .map(|(_, c)| (c.reference.luminance_stderr / c.reference.luminance * 100.0).powi(2))
+        .sum::<f64>()
+        / m)
+        .sqrt();
+    let beyond = (rms * rms - noise * noise).max(0.0).sqrt();
+    let mean = lit.iter().map(|(_, c)| c.luminance_percent().unwrap_or(0.0)).sum::<f64>() / m;
+
+    let mut text = format!(
+        "\n{} elements sampled, {} paths each: RMS difference {:.2} % (reference noise alone {:.2} %, beyond noise {:.2} %), mean {:+.2} %\n",
+        rows.len(),
+        paths,
+        rms,
+        noise,
+        beyond,
+        mean
+    );
+    let mut worst: Vec<&(usize, Comparison)> = lit.clone();
+    worst.sort_by(|x, y| y.1.luminance_sigma().abs().total_cmp(&x.1.luminance_sigma().abs()));
+    let shown = worst.len().min(20);
+    text += &format!(
+        "the {shown} largest in σ:\n{:>9} {:<20} {:>11} {:>11} {:>9} {:>8} {:>8}\n",
+        "element", "object", "solve Y", "reference Y", "± σ %", "diff %", "diff σ"
+    );
+    for (e, c) in &worst[..shown] {
+        text += &format!(
+            "{:>9} {:<20} {:>11.5e} {:>11.5e} {:>9.3} {:>8} {:>8}\n",
+            e,
+            mesh.object_names[mesh.element_object(*e)],
+            c.solve.luminance(),
+            c.reference.luminance,
+            c.reference.luminance_stderr / c.reference.luminance * 100.0,
+            fmt_pct(c.luminance_percent()),
+            fmt_sigma(c.luminance_sigma())
+        );
+    }
+    let json = json!({
+        "count": rows.len(),
+        "paths_per_element": paths,
+        "rms_difference_percent": rms,
+        "rms_noise_percent": noise,
+        "rms_beyond_noise_percent": beyond,
+        "mean_difference_percent": mean,
+        "elements": rows.iter().map(|(e, c)| json!({
+            "element": e,
+            "object": mesh.object_names[mesh.element_object(*e)],
+            "area": mesh.elements[*e].area,
+            "centre": mesh.elements[*e].centre.to_array(),
+            "radiosity": c.solve.to_array(),
+            "reference": c.reference.mean.to_array(),
+            "stderr": c.reference.stderr.to_array(),
+        })).collect::<Vec<_>>(),
+    });
+    Ok(ElementPart { text, json })
+}
+
+/// Renders `camera`'s view of the prepared scene with the reference estimator, printing how
+/// long it took and how noisy it is: the picture behind `render --reference`.
+///
+/// # Errors
+/// Picture settings out of range (exit code 2).
+pub fn reference_picture(
+    prepared: &Prepared,
+    camera: &Camera,
+    width: u32,
+    height: u32,
+    samples_per_pixel: u32,
+    seed: u64,
+) -> Result<HdrImage> {
+    let reference = Reference::new(&prepared.scene);
+    let params = PictureParams { width, height, samples_per_pixel, seed };
+    let bar = if std::io::stderr().is_terminal() {
+        let bar = ProgressBar::new(u64::from(height));
+        bar.set_style(
+            ProgressStyle::with_template("{spinner} reference [{bar:30}] {pos}/{len} rows, ETA {eta}")
+                .expect("valid template")
+                .progress_chars("=> "),
+        );
+        bar
+    } else {
+        ProgressBar::hidden()
+    };
+    let start = std::time::Instant::now();
+    let picture = reference.render(camera, &params, &|| bar.inc(1)).map_err(|e| input(e.to_string()))?;
+    bar.finish_and_clear();
+    // The noise floor of any comparison with this picture: the pixels' relative standard
+    // error in luminance (bounded by the channels' own).
+    let (mut sum, mut count) = (0.0, 0usize);
+    for (l, s) in picture.radiance.iter().zip(&picture.stderr) {
+        let y = l.luminance();
+        if y > 0.0 && s.is_finite() {
+            sum += s.luminance() / y;
+            count += 1;
+        }
+    }
+    eprintln!(
+        "{}: reference picture {}×{} at {} paths per pixel in {:.1} s; mean relative standard error per pixel {}",
+        prepared.scene.name,
+        width,
+        height,
+        samples_per_pixel,
+        start.elapsed().as_secs_f64(),
+        if count > 0 { format!("{:.2} %", sum / count as f64 * 100.0) } else { "—".into() }
+    );
+    Ok(HdrImage::from_pixels(width, height, picture.radiance))
+}
