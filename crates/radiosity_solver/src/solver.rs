@@ -269,6 +269,10 @@ pub struct Solver {
     radiosity: Vec<Rgb>,
     unshot: Vec<Rgb>,
     patch_unshot_power: Vec<Rgb>,
+    /// Per element, the radiosity it reflected straight from emission (first bounce).
+    direct: Vec<Rgb>,
+    /// Per patch, the part of its unshot power that is its own emission, not yet shot.
+    patch_unshot_emission: Vec<Rgb>,
     vertex_area: Vec<f64>,
     /// Element areas, packed for the shot loop.
     element_area: Vec<f64>,
@@ -548,8 +552,13 @@ impl Solver {
             .iter()
             .map(|p| mesh.materials[mesh.surfaces[p.surface as usize].material as usize].reflectance)
             .collect();
+        let patch_unshot_emission = (mesh.patches.iter())
+            .map(|p| p.elements.clone().map(|e| emission[e as usize] * mesh.elements[e as usize].area).sum())
+            .collect();
         let mut s = Self {
             patch_unshot_power: vec![Rgb::ZERO; mesh.patches.len()],
+            direct: vec![Rgb::ZERO; n],
+            patch_unshot_emission,
             plans: vec![PatchPlan::default(); mesh.patches.len()],
             plan_rows: vec![None; mesh.patches.len()],
             plan_entries: 0,
@@ -723,6 +732,8 @@ impl Solver {
         Solution {
             vertex_radiosity: vertex_average(&self.mesh, &element_radiosity, &self.vertex_area),
             element_radiosity,
+            vertex_direct: vertex_average(&self.mesh, &self.direct, &self.vertex_area),
+            element_direct: self.direct.clone(),
             element_unshot: self.unshot.clone(),
             shots: self.shots,
             unshot_fraction: self.unshot_fraction,
@@ -831,10 +842,32 @@ impl Solver {
             self.patch_unshot_power[mesh.elements[first as usize].patch as usize] += gained;
         }
         self.escaped += shot_b * patch.area - received;
+        self.tally_direct(shooter, row, omega);
         for e in patch.elements.start..patch.elements.end {
             self.unshot[e as usize] *= 1.0 - omega;
         }
         self.patch_unshot_power[shooter] *= 1.0 - omega;
+    }
+
+    /// Adds to each receiver the part of this shot that is the shooter's own emission: the
+    /// direct light a final gather recomputes by shadow rays (Chen et al. 1991) and must not
+    /// count twice. Only emitters' shots carry any, so the extra pass is rare.
+    fn tally_direct(&mut self, shooter: usize, row: &Row, omega: f64) {
+        let emission = self.patch_unshot_emission[shooter];
+        if emission.max_channel() <= 0.0 {
+            return;
+        }
+        let shot_e = emission * (omega / self.mesh.patches[shooter].area);
+        self.patch_unshot_emission[shooter] *= 1.0 - omega;
+        let mut offset = 0;
+        for &(first, count) in &row.spans {
+            let (first, count) = (first as usize, count as usize);
+            let rho = self.patch_reflectance[self.mesh.elements[first].patch as usize];
+            for (k, f) in row.factors[offset..offset + count].iter().enumerate() {
+                self.direct[first + k] += rho * shot_e * f64::from(*f);
+            }
+            offset += count;
+        }
     }
 
     /// Fixes where on `shooter` its rays end, from its elements' unshot power at its first
