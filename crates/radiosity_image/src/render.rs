@@ -32,6 +32,8 @@ use crate::gather::{self, DirectMis, Emitters, Gather};
 
 /// Task key of the pixels' streams (`Rng::for_task(seed, PIXEL_TASK, pixel)`).
 const PIXEL_TASK: u64 = 0x7069_7865_6c73; // "pixels"
+/// Task key of gathered texels' streams.
+const TEXEL_TASK: u64 = 0x7465_7865_6c73; // "texels"
 
 /// How radiosity is taken at a hit point.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -378,7 +380,11 @@ impl Renderer {
                         sum += match params.gather {
                             Gather::None => hit.radiance,
                             _ if !hit.front_facing => Rgb::ZERO,
-                            gather => self.gathered_radiance(solution, &hit, gather, params, i, &mut rng),
+                            gather => {
+                                let e = hit.element as usize;
+                                self.gathered_sample(solution, e, hit.p_world, gather, params, i, &mut rng)
+                                    / PI
+                            }
                         };
                     }
                 }
@@ -397,20 +403,53 @@ impl Renderer {
 }
 
 impl Renderer {
-    /// Radiance leaving a front-facing `hit` towards the eye with a final gather, for sample
-    /// `sample` of the pixel (see the `gather` module for the estimators).
-    fn gathered_radiance(
+    /// Radiosity B (W/unit²) leaving point `p` of element `e` (on its plane), gathered with
+    /// `params.gather` from `params.samples_per_pixel` samples stratified as a pixel's are,
+    /// from the stream keyed by `(params.seed, key)`: a lightmap's texels, where `key` names
+    /// the texel. [`Gather::None`] gives the solution interpolated as [`Shading::Smooth`].
+    ///
+    /// # Errors
+    /// [`RenderError::BadParameter`], [`RenderError::SolutionMismatch`] and
+    /// [`RenderError::NoDirectPart`] as [`Renderer::render`]; an element index out of range is
+    /// a bug in the caller (panics).
+    pub fn gathered_radiosity(
         &self,
         solution: &Solution,
-        hit: &SurfaceHit,
+        e: usize,
+        p: DVec3,
+        params: &RenderParams,
+        key: u64,
+    ) -> Result<Rgb, RenderError> {
+        params.validate()?;
+        self.check(solution)?;
+        if params.gather == Gather::None {
+            return Ok(self.interpolate(solution, e, p));
+        }
+        if params.gather == Gather::Direct && solution.vertex_direct.len() != self.mesh.positions.len() {
+            return Err(RenderError::NoDirectPart);
+        }
+        let mut rng = Rng::for_task(params.seed, TEXEL_TASK, key);
+        let n = params.samples_per_pixel;
+        let sum: Rgb =
+            (0..n).map(|i| self.gathered_sample(solution, e, p, params.gather, params, i, &mut rng)).sum();
+        Ok(sum / f64::from(n))
+    }
+
+    /// One sample of the radiosity leaving `x` on element `e` with a final gather, sample
+    /// `sample` of its pixel or texel (see the `gather` module for the estimators).
+    #[allow(clippy::too_many_arguments)]
+    fn gathered_sample(
+        &self,
+        solution: &Solution,
+        e: usize,
+        x: DVec3,
         gather: Gather,
         params: &RenderParams,
         sample: u32,
         rng: &mut Rng,
     ) -> Rgb {
-        let e = hit.element as usize;
         let material = self.mesh.element_material(e);
-        let (x, n) = (hit.p_world, self.mesh.elements[e].normal);
+        let n = self.mesh.elements[e].normal;
         let lights = if self.emitters.is_empty() { 0 } else { params.shadow_rays };
         let cosines = match gather {
             Gather::Full => params.gather_rays,
@@ -441,7 +480,7 @@ impl Renderer {
             .map(|c| c.max(0.0)),
             _ => material.reflectance * reflected,
         };
-        (material.emission + material.reflectance * direct + indirect) / PI
+        material.emission + material.reflectance * direct + indirect
     }
 
     /// `mis.cosines` cosine-weighted rays from `x` (normal `n`), stratified over the pixel's
