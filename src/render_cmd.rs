@@ -11,8 +11,8 @@ use glam::DVec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use radiosity_core::Camera;
 use radiosity_image::{
-    Exposure, HdrImage, RenderParams, Renderer, Shading, ToneOperator, ToneParams, read_hdr, tone_map_image,
-    write_exr, write_pfm, write_png,
+    Exposure, Gather, HdrImage, RenderParams, Renderer, Shading, ToneOperator, ToneParams, read_hdr,
+    tone_map_image, write_exr, write_pfm, write_png,
 };
 
 use crate::prepare::{InputError, SolveOpts, check_writable, prepare, run_solver};
@@ -45,6 +45,27 @@ pub enum ShadingArg {
     Smooth,
     /// Each element's own radiosity: shows the mesh.
     Flat,
+}
+
+/// Final gather on the command line.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum GatherArg {
+    /// The radiosity solution only, interpolated over the mesh.
+    None,
+    /// Direct light by shadow rays per pixel; indirect light from the solution.
+    Direct,
+    /// Direct light by shadow rays; indirect by one bounce of gathering rays.
+    Full,
+}
+
+impl From<GatherArg> for Gather {
+    fn from(a: GatherArg) -> Self {
+        match a {
+            GatherArg::None => Gather::None,
+            GatherArg::Direct => Gather::Direct,
+            GatherArg::Full => Gather::Full,
+        }
+    }
 }
 
 /// Exposure and operator, shared by `render` and `tonemap`.
@@ -85,6 +106,16 @@ pub struct RenderArgs {
     /// Radiosity at a hit point: interpolated from vertices, or per element.
     #[arg(long, value_enum, default_value_t = ShadingArg::Smooth)]
     pub shading: ShadingArg,
+    /// Final gather: `none` (the radiosity mesh as the viewer shows it), `direct` (direct light
+    /// by shadow rays per pixel, sharp shadows), `full` (also one bounce of gathering rays).
+    #[arg(long, value_enum, default_value_t = GatherArg::None)]
+    pub gather: GatherArg,
+    /// Shadow rays per sample towards the emitters, with a gather.
+    #[arg(long, default_value_t = RenderParams::default().shadow_rays)]
+    pub shadow_rays: u32,
+    /// Gathering rays per sample with `--gather full`.
+    #[arg(long, default_value_t = RenderParams::default().gather_rays)]
+    pub gather_rays: u32,
     /// Eye position `x,y,z` (default: the scene's [camera], or one framing the scene).
     #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
     pub camera_position: Option<DVec3>,
@@ -172,6 +203,9 @@ pub fn run(a: RenderArgs) -> Result<()> {
             ShadingArg::Flat => Shading::Flat,
         },
         seed: a.solve.seed,
+        gather: a.gather.into(),
+        shadow_rays: a.shadow_rays,
+        gather_rays: a.gather_rays,
     };
     params.validate().map_err(|e| input(e.to_string()))?;
     for path in [&a.output, &a.exr, &a.pfm].into_iter().flatten() {
@@ -208,7 +242,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let render_secs = start.elapsed().as_secs_f64();
 
     eprintln!(
-        "{}: {} elements, {} shots, unshot {:.4} % ({}), solved in {:.2} s; rendered {}×{} at {} spp in {:.2} s",
+        "{}: {} elements, {} shots, unshot {:.4} % ({}), solved in {:.2} s; rendered {}×{} at {} spp (gather {}) in {:.2} s",
         prepared.scene.name,
         prepared.mesh.elements.len(),
         report.total_shots,
@@ -218,6 +252,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         params.width,
         params.height,
         params.samples_per_pixel,
+        params.gather.as_str(),
         render_secs
     );
     write_pictures(&a, &rendering.radiance)

@@ -25,6 +25,7 @@
 #![forbid(unsafe_code)]
 
 mod files;
+mod gather;
 mod hdr;
 mod metrics;
 mod render;
@@ -34,6 +35,7 @@ pub use files::{
     HdrFormat, ImageFileError, decode_pfm, encode_pfm, read_exr, read_hdr, read_pfm, read_png, write_exr,
     write_hdr, write_pfm, write_png,
 };
+pub use gather::Gather;
 pub use hdr::HdrImage;
 pub use metrics::{ObjectPixels, difference_image, object_mean_radiance};
 pub use render::{RenderError, RenderParams, Renderer, Rendering, Shading, SurfaceHit};

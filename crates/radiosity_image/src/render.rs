@@ -28,9 +28,12 @@ use rayon::prelude::*;
 use thiserror::Error;
 
 use crate::HdrImage;
+use crate::gather::{self, DirectMis, Emitters, Gather};
 
 /// Task key of the pixels' streams (`Rng::for_task(seed, PIXEL_TASK, pixel)`).
 const PIXEL_TASK: u64 = 0x7069_7865_6c73; // "pixels"
+/// Task key of gathered texels' streams.
+const TEXEL_TASK: u64 = 0x7465_7865_6c73; // "texels"
 
 /// How radiosity is taken at a hit point.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -65,11 +68,27 @@ pub struct RenderParams {
     pub shading: Shading,
     /// Seed of the jitter. Default 0.
     pub seed: u64,
+    /// Where the light of a pixel comes from. Default [`Gather::None`] (the solution only).
+    pub gather: Gather,
+    /// Shadow rays to the emitters per sample with a gather, in 1..=1024. Default 2 (32 per
+    /// pixel at 16 samples, stratified over the emitters).
+    pub shadow_rays: u32,
+    /// Gathering rays per sample with [`Gather::Full`], in 1..=1024. Default 8.
+    pub gather_rays: u32,
 }
 
 impl Default for RenderParams {
     fn default() -> Self {
-        Self { width: 640, height: 480, samples_per_pixel: 16, shading: Shading::Smooth, seed: 0 }
+        Self {
+            width: 640,
+            height: 480,
+            samples_per_pixel: 16,
+            shading: Shading::Smooth,
+            seed: 0,
+            gather: Gather::None,
+            shadow_rays: 2,
+            gather_rays: 8,
+        }
     }
 }
 
@@ -78,6 +97,8 @@ impl RenderParams {
     pub const MAX_SIDE: u32 = 16384;
     /// Largest number of samples per pixel accepted.
     pub const MAX_SAMPLES: u32 = 4096;
+    /// Largest number of shadow or gathering rays per sample accepted.
+    pub const MAX_GATHER_RAYS: u32 = 1024;
 
     /// Small and quick, for thumbnails and tests: 160 × 120, 4 samples per pixel.
     pub fn preview() -> Self {
@@ -107,7 +128,9 @@ impl RenderParams {
         };
         check("width", self.width, Self::MAX_SIDE)?;
         check("height", self.height, Self::MAX_SIDE)?;
-        check("samples_per_pixel", self.samples_per_pixel, Self::MAX_SAMPLES)
+        check("samples_per_pixel", self.samples_per_pixel, Self::MAX_SAMPLES)?;
+        check("shadow_rays", self.shadow_rays, Self::MAX_GATHER_RAYS)?;
+        check("gather_rays", self.gather_rays, Self::MAX_GATHER_RAYS)
     }
 }
 
@@ -124,6 +147,9 @@ pub enum RenderError {
         /// The accepted range.
         expected: String,
     },
+    /// [`Gather::Direct`] needs the solution's direct part, which this solution does not hold.
+    #[error("--gather direct needs the solver's direct-light part, which this solution does not hold")]
+    NoDirectPart,
     /// The solution was computed for another mesh.
     #[error(
         "the solution does not fit the mesh: {solution_elements} element and {solution_vertices} vertex values for {mesh_elements} elements and {mesh_vertices} vertices"
@@ -175,6 +201,11 @@ pub struct Renderer {
     accel: Bvh,
     /// Element of every triangle given to the BVH.
     triangle_element: Vec<u32>,
+    /// The emitting elements, for shadow rays.
+    emitters: Emitters,
+    /// How far a secondary ray's origin is lifted off its surface: 1e-6 of the scene's
+    /// diagonal, far above f32 round-off of positions, far below any feature.
+    lift: f64,
 }
 
 impl Renderer {
@@ -186,7 +217,10 @@ impl Renderer {
             .map(|(e, t)| (e, t.map(|i| mesh.positions[i as usize].as_vec3())))
             .unzip();
         let accel = Bvh::new(&triangles);
-        Self { mesh, accel, triangle_element }
+        let emitters = Emitters::new(&mesh);
+        let (lo, hi) = mesh.bounds();
+        let lift = 1e-6 * (hi - lo).length().max(f64::MIN_POSITIVE);
+        Self { mesh, accel, triangle_element, emitters, lift }
     }
 
     /// The mesh being drawn.
@@ -264,10 +298,15 @@ impl Renderer {
 
     /// Radiosity at `p` (on element `e`'s plane), interpolated from its vertices.
     fn interpolate(&self, solution: &Solution, e: usize, p: DVec3) -> Rgb {
+        self.interpolate_values(&solution.vertex_radiosity, e, p)
+    }
+
+    /// Any per-vertex quantity at `p` (on element `e`'s plane), interpolated from `e`'s vertices.
+    fn interpolate_values(&self, vertex_values: &[Rgb], e: usize, p: DVec3) -> Rgb {
         let el = &self.mesh.elements[e];
         let idx = el.vertex_indices();
         let pos = |k: usize| self.mesh.positions[idx[k] as usize];
-        let val = |k: usize| solution.vertex_radiosity[idx[k] as usize];
+        let val = |k: usize| vertex_values[idx[k] as usize];
         // Work in 2D on the element's plane, in units of the element's size, so that the
         // tolerances below are relative.
         let origin = pos(0);
@@ -315,6 +354,9 @@ impl Renderer {
     ) -> Result<Rendering, RenderError> {
         params.validate()?;
         self.check(solution)?;
+        if params.gather == Gather::Direct && solution.vertex_direct.len() != self.mesh.positions.len() {
+            return Err(RenderError::NoDirectPart);
+        }
         let (w, h) = (params.width as usize, params.height as usize);
         let rays = CameraRays::new(camera, params.width, params.height);
         let mut pixels = vec![Rgb::ZERO; w * h];
@@ -335,7 +377,15 @@ impl Renderer {
                     };
                     let dir = rays.direction(x as f64 + sx, y as f64 + sy);
                     if let Some(hit) = self.trace_unchecked(solution, camera.position, dir, params.shading) {
-                        sum += hit.radiance;
+                        sum += match params.gather {
+                            Gather::None => hit.radiance,
+                            _ if !hit.front_facing => Rgb::ZERO,
+                            gather => {
+                                let e = hit.element as usize;
+                                self.gathered_sample(solution, e, hit.p_world, gather, params, i, &mut rng)
+                                    / PI
+                            }
+                        };
                     }
                 }
                 row[x] = sum / f64::from(n);
@@ -350,6 +400,150 @@ impl Renderer {
         });
         Ok(Rendering { radiance: HdrImage::from_pixels(params.width, params.height, pixels), object_ids })
     }
+}
+
+impl Renderer {
+    /// Radiosity B (W/unit²) leaving point `p` of element `e` (on its plane), gathered with
+    /// `params.gather` from `params.samples_per_pixel` samples stratified as a pixel's are,
+    /// from the stream keyed by `(params.seed, key)`: a lightmap's texels, where `key` names
+    /// the texel. [`Gather::None`] gives the solution interpolated as [`Shading::Smooth`].
+    ///
+    /// # Errors
+    /// [`RenderError::BadParameter`], [`RenderError::SolutionMismatch`] and
+    /// [`RenderError::NoDirectPart`] as [`Renderer::render`]; an element index out of range is
+    /// a bug in the caller (panics).
+    pub fn gathered_radiosity(
+        &self,
+        solution: &Solution,
+        e: usize,
+        p: DVec3,
+        params: &RenderParams,
+        key: u64,
+    ) -> Result<Rgb, RenderError> {
+        params.validate()?;
+        self.check(solution)?;
+        if params.gather == Gather::None {
+            return Ok(self.interpolate(solution, e, p));
+        }
+        if params.gather == Gather::Direct && solution.vertex_direct.len() != self.mesh.positions.len() {
+            return Err(RenderError::NoDirectPart);
+        }
+        let mut rng = Rng::for_task(params.seed, TEXEL_TASK, key);
+        let n = params.samples_per_pixel;
+        let sum: Rgb =
+            (0..n).map(|i| self.gathered_sample(solution, e, p, params.gather, params, i, &mut rng)).sum();
+        Ok(sum / f64::from(n))
+    }
+
+    /// One sample of the radiosity leaving `x` on element `e` with a final gather, sample
+    /// `sample` of its pixel or texel (see the `gather` module for the estimators).
+    #[allow(clippy::too_many_arguments)]
+    fn gathered_sample(
+        &self,
+        solution: &Solution,
+        e: usize,
+        x: DVec3,
+        gather: Gather,
+        params: &RenderParams,
+        sample: u32,
+        rng: &mut Rng,
+    ) -> Rgb {
+        let material = self.mesh.element_material(e);
+        let n = self.mesh.elements[e].normal;
+        let lights = if self.emitters.is_empty() { 0 } else { params.shadow_rays };
+        let cosines = match gather {
+            Gather::Full => params.gather_rays,
+            _ if lights > 0 => params.shadow_rays,
+            _ => 0,
+        };
+        let mis = DirectMis { lights, cosines };
+        let strata = params.samples_per_pixel * lights;
+        let mut direct = gather::emitter_samples(
+            &self.emitters,
+            &self.accel,
+            x,
+            n,
+            self.lift,
+            sample * lights,
+            strata,
+            mis,
+            rng,
+        );
+        let (cosine_direct, reflected) = self.cosine_rays(solution, x, n, params, sample, mis, rng);
+        direct += cosine_direct;
+        let indirect = match gather {
+            // What the solver's radiosity holds besides emission and direct light, as it is
+            // at x; clamped because the direct part and the total are interpolated apart.
+            Gather::Direct => (self.interpolate(solution, e, x)
+                - material.emission
+                - self.interpolate_values(&solution.vertex_direct, e, x))
+            .map(|c| c.max(0.0)),
+            _ => material.reflectance * reflected,
+        };
+        material.emission + material.reflectance * direct + indirect
+    }
+
+    /// `mis.cosines` cosine-weighted rays from `x` (normal `n`), stratified over the pixel's
+    /// samples: returns their half of the direct irradiance (emission where they land, MIS
+    /// weighted) and the irradiance from the light the solution reflects (B − E where they
+    /// land: ∫ L cos θ dω with pdf cos θ / π is π · mean(L), and L = (B − E)/π).
+    #[allow(clippy::too_many_arguments)]
+    fn cosine_rays(
+        &self,
+        solution: &Solution,
+        x: DVec3,
+        n: DVec3,
+        params: &RenderParams,
+        sample: u32,
+        mis: DirectMis,
+        rng: &mut Rng,
+    ) -> (Rgb, Rgb) {
+        let count = mis.cosines;
+        if count == 0 {
+            return (Rgb::ZERO, Rgb::ZERO);
+        }
+        let (columns, rows) = grid(params.samples_per_pixel * count);
+        let origin = x + n * self.lift;
+        let (mut direct, mut reflected) = (Rgb::ZERO, Rgb::ZERO);
+        for j in sample * count..(sample + 1) * count {
+            let (cx, cy) = (j % columns, j / columns);
+            let u = (f64::from(cx) + rng.next_f64()) / f64::from(columns);
+            let v = (f64::from(cy) + rng.next_f64()) / f64::from(rows);
+            let dir = gather::cosine_direction(n, u, v);
+            let Some(hit) = self.accel.closest_hit(origin.as_vec3(), dir.as_vec3(), f32::MAX) else {
+                continue;
+            };
+            let e = self.triangle_element[hit.triangle as usize] as usize;
+            let el = &self.mesh.elements[e];
+            let denom = el.normal.dot(dir);
+            if denom >= 0.0 {
+                continue; // the back of a one-sided surface: nothing leaves it
+            }
+            let distance = el.normal.dot(el.centre - origin) / denom;
+            let emission = self.mesh.element_material(e).emission;
+            if emission.max_channel() > 0.0 {
+                let pdf_area = self.emitters.pdf_area_of(emission);
+                direct += mis.term(emission, n.dot(dir), -denom, distance * distance, pdf_area);
+            }
+            if params.gather == Gather::Full {
+                let y = origin + dir * distance;
+                let b = match params.shading {
+                    Shading::Flat => solution.element_radiosity[e],
+                    Shading::Smooth => self.interpolate(solution, e, y),
+                };
+                reflected += (b - emission).map(|c| c.max(0.0));
+            }
+        }
+        (direct, reflected / f64::from(count))
+    }
+}
+
+/// An exact grid for `count` strata: columns × rows = count with the columns the smallest
+/// divisor not below √count (every cell gets exactly one sample: no cell left unsampled).
+fn grid(count: u32) -> (u32, u32) {
+    let count = count.max(1);
+    let columns = (1..=count).find(|&c| c * c >= count && count.is_multiple_of(c)).unwrap_or(count);
+    (columns, count / columns)
 }
 
 /// Primary ray directions of a pinhole camera.

@@ -33,7 +33,14 @@ fn closed_furnace_shows_the_same_radiance_in_every_pixel() {
     for target in targets {
         let camera = Camera::try_new(centre, target, DVec3::Y + DVec3::X * 0.1, 100.0).unwrap();
         for shading in [Shading::Smooth, Shading::Flat] {
-            let params = RenderParams { width: 48, height: 40, samples_per_pixel: 4, shading, seed: 3 };
+            let params = RenderParams {
+                width: 48,
+                height: 40,
+                samples_per_pixel: 4,
+                shading,
+                seed: 3,
+                ..RenderParams::default()
+            };
             let picture = renderer.render(&solution, &camera, &params).unwrap();
             for (i, p) in picture.radiance.pixels().iter().enumerate() {
                 for c in p.to_array() {

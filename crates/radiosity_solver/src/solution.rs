@@ -10,6 +10,12 @@ pub struct Solution {
     /// Radiosity interpolated at every mesh vertex: the area-weighted mean of the elements
     /// around it, all on one surface (vertices are never shared across surfaces).
     pub vertex_radiosity: Vec<Rgb>,
+    /// Of each element's radiosity, the part reflected straight from the emitters' own
+    /// emission (ρ · H_direct): what a final gather recomputes per pixel by shadow rays, kept
+    /// apart so it is not counted twice. Empty when the solver does not track it.
+    pub element_direct: Vec<Rgb>,
+    /// [`Solution::element_direct`] interpolated at every vertex, like `vertex_radiosity`.
+    pub vertex_direct: Vec<Rgb>,
     /// Unshot radiosity ΔB of every element (what it still has to shoot).
     pub element_unshot: Vec<Rgb>,
     /// Shots done when the snapshot was taken.

@@ -13,8 +13,9 @@ use std::time::{Duration, Instant};
 
 use eframe::egui::{self, Color32, Key, Pos2, Rect, Sense, Vec2};
 use eframe::{egui_wgpu, wgpu};
+use radiosity_core::Camera;
 use radiosity_core::{MeshParams, Scene};
-use radiosity_image::ToneOperator;
+use radiosity_image::{Exposure, Gather, SrgbImage, ToneOperator, ToneParams, tone_map_image};
 
 use crate::ViewerOptions;
 use crate::camera::{FlyCamera, MoveInput, SceneExtent};
@@ -22,6 +23,7 @@ use crate::render::{
     DisplayMode, FrameParams, RenderTarget, SceneRenderer, Wireframe, auto_exposure_ev, false_colour,
     false_colour_range,
 };
+use crate::still::{Still, StillJob, StillPoll};
 use crate::worker::{SolveJob, SolveWorker, Status, WorkerOptions, WorkerState};
 
 /// Mouse-look sensitivity, radians per point dragged.
@@ -36,7 +38,7 @@ const BACKGROUND: [f32; 4] = [0.11, 0.11, 0.12, 1.0];
 
 /// The key hint shown under the 3D view.
 pub const KEY_HINT: &str = "WASD/arrows move · Q/E or Ctrl/Space down/up · drag to look · wheel: speed · \
-                            Shift: run · R reset · F frame all · P screenshot";
+                            Shift: run · R reset · F frame all · P screenshot · G render still";
 
 /// What the user chose to see: camera and display settings. Kept apart from runtime state
 /// (GPU buffers, keys held, the worker) so a restart or a re-mesh never loses it.
@@ -136,6 +138,10 @@ pub struct ViewerApp {
     last_dt: f64,
     /// When a scripted run reached its mark, and the frame rate while it was solving.
     mark: Option<(Instant, f64)>,
+    /// A still being rendered with a final gather (G).
+    still_job: Option<StillJob>,
+    /// The last still, tone mapped onto a texture, shown in its own window until closed.
+    still: Option<(Still, egui::TextureHandle, SrgbImage)>,
 }
 
 /// With continuous redraw, how long a scripted run keeps drawing after its mark before the
@@ -225,6 +231,8 @@ impl ViewerApp {
             last_frame: None,
             last_dt: 0.0,
             mark: None,
+            still_job: None,
+            still: None,
         })
     }
 
@@ -380,7 +388,7 @@ impl ViewerApp {
         if ctx.egui_wants_keyboard_input() {
             return moving;
         }
-        let (input, reset, frame_all, shot) = ctx.input(|i| {
+        let (input, reset, frame_all, shot, still) = ctx.input(|i| {
             let axis = |pos: &[Key], neg: &[Key]| {
                 let p = pos.iter().any(|k| i.key_down(*k));
                 let n = neg.iter().any(|k| i.key_down(*k));
@@ -398,6 +406,7 @@ impl ViewerApp {
                 i.key_pressed(Key::R),
                 i.key_pressed(Key::F),
                 i.key_pressed(Key::P),
+                i.key_pressed(Key::G),
             )
         });
         if input.is_moving() {
@@ -412,6 +421,9 @@ impl ViewerApp {
         }
         if shot {
             self.save_view_png();
+        }
+        if still {
+            self.start_still(ctx);
         }
         moving
     }
@@ -439,6 +451,89 @@ impl ViewerApp {
             Ok(()) => format!("wrote {}", path.display()),
             Err(e) => format!("cannot write {}: {e}", path.display()),
         });
+    }
+
+    /// G: renders the current view with a final gather in the background (see `still`).
+    fn start_still(&mut self, ctx: &egui::Context) {
+        if self.still_job.is_some() {
+            return;
+        }
+        let Some(snap) = &self.shown else { return };
+        let cam = &self.view.camera;
+        let camera = match Camera::try_new(cam.position, cam.position + cam.forward(), cam.up, cam.fov_y_deg)
+        {
+            Ok(c) => c,
+            Err(e) => {
+                self.message = Some(format!("cannot render a still: {e}"));
+                return;
+            }
+        };
+        let ctx = ctx.clone();
+        self.still_job = Some(StillJob::spawn(
+            snap.mesh.clone(),
+            snap.solution.clone(),
+            camera,
+            self.view_size,
+            Gather::Direct,
+            move || ctx.request_repaint(),
+        ));
+    }
+
+    /// Takes a finished still onto a texture, tone mapped as the view is.
+    fn poll_still(&mut self, ctx: &egui::Context) {
+        let Some(job) = &self.still_job else { return };
+        let StillPoll::Done(result) = job.poll() else { return };
+        self.still_job = None;
+        match result {
+            Ok(still) => {
+                let ev = if self.view.auto_exposure {
+                    Exposure::Auto.ev_for(&still.radiance)
+                } else {
+                    self.view.exposure_ev
+                };
+                let srgb = tone_map_image(&still.radiance, &ToneParams::new(ev, self.view.operator));
+                let image =
+                    egui::ColorImage::from_rgb([srgb.width as usize, srgb.height as usize], &srgb.as_bytes());
+                let texture = ctx.load_texture("still", image, egui::TextureOptions::LINEAR);
+                self.message = Some(format!(
+                    "still rendered in {:.1} s (gather {}, {} shots)",
+                    still.seconds,
+                    still.gather.as_str(),
+                    still.shots
+                ));
+                self.still = Some((still, texture, srgb));
+            }
+            Err(e) => self.message = Some(format!("cannot render a still: {e}")),
+        }
+    }
+
+    /// The last still in its own window, with Save and Close.
+    fn still_window(&mut self, ctx: &egui::Context) {
+        let Some((still, texture, srgb)) = &self.still else { return };
+        let mut open = true;
+        let mut save = false;
+        let caption =
+            format!("gather {}, {} shots, {:.1} s", still.gather.as_str(), still.shots, still.seconds);
+        egui::Window::new("Still").open(&mut open).resizable(true).show(ctx, |ui| {
+            ui.weak(caption);
+            let size = texture.size_vec2();
+            let fit = (ui.available_width() / size.x).min(1.0);
+            ui.image((texture.id(), size * fit));
+            save = ui.button("Save PNG").clicked();
+        });
+        if save {
+            let path = unique_path(&self.screenshot_dir, "still");
+            let written = image::RgbImage::from_raw(srgb.width, srgb.height, srgb.as_bytes())
+                .ok_or_else(|| "the still's size does not match its pixels".to_owned())
+                .and_then(|img| img.save(&path).map_err(|e| e.to_string()));
+            self.message = Some(match written {
+                Ok(()) => format!("wrote {}", path.display()),
+                Err(e) => format!("cannot write {}: {e}", path.display()),
+            });
+        }
+        if !open {
+            self.still = None;
+        }
     }
 
     /// The frame's settings for a view of `size_px` pixels.
@@ -637,6 +732,19 @@ impl ViewerApp {
                 "draw every frame, not only when something changes (shows the highest frame rate)",
             );
         });
+        ui.horizontal(|ui| {
+            let idle = self.still_job.is_none() && self.shown.is_some();
+            let button = ui.add_enabled(idle, egui::Button::new("Render still (G)")).on_hover_text(
+                "render this view on the CPU with direct light by shadow rays (sharp shadows), in the background",
+            );
+            if button.clicked() {
+                self.start_still(&ctx);
+            }
+            if let Some(job) = &self.still_job {
+                ui.spinner();
+                ui.label(format!("{:.0} s", job.started.elapsed().as_secs_f64()));
+            }
+        });
         if let Some(m) = &self.message {
             ui.label(m);
         }
@@ -772,6 +880,7 @@ impl eframe::App for ViewerApp {
         }
         self.poll_loading();
         self.sync_snapshot();
+        self.poll_still(&ctx);
 
         egui::Panel::right("radiosity_panel").default_size(300.0).min_size(240.0).show(ui, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| self.panel(ui));
@@ -818,6 +927,7 @@ impl eframe::App for ViewerApp {
             ui.painter().rect_filled(hint_rect, 0.0, Color32::from_black_alpha(140));
             ui.painter().galley(hint_rect.min + Vec2::new(8.0, 4.0), galley, Color32::from_gray(220));
         });
+        self.still_window(&ctx);
         self.scripted_capture(&ctx);
         let busy = matches!(self.status.state, WorkerState::Meshing) || self.loading.is_some();
         if moving || adapting || self.continuous || busy || self.capture.is_some() || self.scripted.is_some()
@@ -1082,6 +1192,40 @@ mod tests {
         h.key_press(Key::P);
         h.step();
         assert!(dir.join("cornell-box-100shots-2.png").exists());
+        let _ = std::fs::remove_dir_all(dir);
+    }
+
+    /// G renders the view with a gather in the background; the still arrives in its window
+    /// with the view's aspect, red on the left and green on the right, and Save writes it.
+    #[test]
+    fn g_renders_a_still_in_the_background_and_save_writes_it() {
+        let dir = temp_dir("still");
+        let mut h = harness("cornell", Some(100), &dir);
+        step_until(&mut h, "100 shots on screen", |a| {
+            a.shown.as_ref().is_some_and(|s| s.solution.shots == 100)
+        });
+        h.key_press(Key::G);
+        h.step();
+        assert!(h.state().still_job.is_some(), "G starts a still");
+        step_until(&mut h, "the still", |a| a.still.is_some());
+        let message = h.state().message.clone().unwrap_or_default();
+        assert!(message.starts_with("still rendered"), "{message}");
+        let (still, _, srgb) = h.state().still.as_ref().unwrap();
+        assert_eq!(still.gather, Gather::Direct);
+        let [w, h_px] = h.state().view_size;
+        let aspect = f64::from(srgb.width) / f64::from(srgb.height);
+        assert!((aspect - f64::from(w) / f64::from(h_px)).abs() < 0.01, "aspect {aspect}");
+        let px = |x: u32, y: u32| srgb.pixels[(y * srgb.width + x) as usize];
+        let (left, right) =
+            (px(srgb.width * 17 / 100, srgb.height / 2), px(srgb.width * 83 / 100, srgb.height / 2));
+        assert!(left[0] > 2 * left[1], "red on the left: {left:?}");
+        assert!(right[1] > right[0], "green on the right: {right:?}");
+        // A new window lays itself out unseen on its first frame.
+        h.step();
+        h.step();
+        h.get_by_label("Save PNG").click();
+        h.step();
+        assert!(dir.join("still.png").exists(), "{:?}", h.state().message);
         let _ = std::fs::remove_dir_all(dir);
     }
 }

@@ -12,6 +12,7 @@
 mod app;
 pub mod camera;
 pub mod render;
+mod still;
 pub mod worker;
 
 use std::path::PathBuf;

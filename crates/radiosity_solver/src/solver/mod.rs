@@ -168,6 +168,8 @@ impl Solver {
         Solution {
             vertex_radiosity: vertex_average(&self.mesh, &element_radiosity, &self.tables.vertex_area),
             element_radiosity,
+            vertex_direct: vertex_average(&self.mesh, &tally.direct, &self.tables.vertex_area),
+            element_direct: tally.direct.clone(),
             element_unshot: tally.unshot.clone(),
             shots: self.progress.shots,
             unshot_fraction: tally.unshot_fraction,

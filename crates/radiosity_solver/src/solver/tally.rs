@@ -29,6 +29,12 @@ pub(super) struct Tally {
     pub(super) unshot: Vec<Rgb>,
     /// Σ ΔB·A over each patch's elements, W.
     pub(super) patch_unshot_power: Vec<Rgb>,
+    /// Per element, the radiosity it reflected straight from the emitters' own emission (the
+    /// first bounce of direct light), W/unit²: what a final gather recomputes per pixel by
+    /// shadow rays (Chen et al. 1991) and must not count twice.
+    pub(super) direct: Vec<Rgb>,
+    /// Per patch, the part of its unshot power that is its own emission, not yet shot, W.
+    patch_unshot_emission: Vec<Rgb>,
     /// Σ E·A, W.
     pub(super) emitted: Rgb,
     absorbed: Rgb,
@@ -55,7 +61,12 @@ impl Tally {
         if emitted.sum() <= 0.0 {
             return Err(SolverError::NoEmission);
         }
+        let patch_unshot_emission = (mesh.patches.iter())
+            .map(|p| p.elements.clone().map(|e| emission[e as usize] * mesh.elements[e as usize].area).sum())
+            .collect();
         let mut tally = Self {
+            direct: vec![Rgb::ZERO; n],
+            patch_unshot_emission,
             radiosity: emission.clone(),
             unshot: emission,
             patch_unshot_power: vec![Rgb::ZERO; mesh.patches.len()],
@@ -147,10 +158,31 @@ impl Tally {
             self.patch_unshot_power[mesh.elements[first as usize].patch as usize] += gained;
         }
         self.escaped += shot_b * patch.area - received;
+        self.tally_direct(mesh, tables, shooter, row, omega);
         for e in patch.elements.start..patch.elements.end {
             self.unshot[e as usize] *= 1.0 - omega;
         }
         self.patch_unshot_power[shooter] *= 1.0 - omega;
+    }
+
+    /// Adds to each receiver the part of this shot that is the shooter's own emission (its
+    /// direct light). Only emitters' shots carry any, so the extra pass is rare.
+    fn tally_direct(&mut self, mesh: &Mesh, tables: &MeshTables, shooter: usize, row: &Row, omega: f64) {
+        let emission = self.patch_unshot_emission[shooter];
+        if emission.max_channel() <= 0.0 {
+            return;
+        }
+        let shot_e = emission * (omega / mesh.patches[shooter].area);
+        self.patch_unshot_emission[shooter] *= 1.0 - omega;
+        let mut offset = 0;
+        for &(first, count) in &row.spans {
+            let (first, count) = (first as usize, count as usize);
+            let per_factor = tables.patch_reflectance[mesh.elements[first].patch as usize] * shot_e;
+            for (k, f) in row.factors[offset..offset + count].iter().enumerate() {
+                self.direct[first + k] += per_factor * f64::from(*f);
+            }
+            offset += count;
+        }
     }
 
     /// Power bookkeeping, with the unshot power summed fresh from the elements.

@@ -1,0 +1,321 @@
+//! Final gather: what varies fast is computed per pixel, what varies slowly is taken from the
+//! radiosity solution (Chen, Rushmeier, Miller & Turner 1991, "A progressive multi-pass
+//! method for global illumination"; Lightscape's ray-traced direct light and 3ds Max's
+//! regathering are the same idea).
+//!
+//! At a visible point x (normal n, reflectance ρ, emission E) the outgoing radiosity is
+//!
+//!   B(x) = E(x) + ρ(x) · (H_direct(x) + H_indirect(x)),
+//!
+//! H the irradiance (W/unit²) from the emitters and from every other surface.
+//!
+//! * **Direct** (`H_direct`): next-event estimation over the emitters' area. An emitter element
+//!   is chosen in proportion to its power Σ_c E_c·A (stratified over the pixel's samples), a
+//!   point y uniformly on it, and one shadow ray tells whether y is seen:
+//!   H ≈ (E_y/π) · cos θ_x cos θ_y / r² · V(x, y) / p(y), with p(y) = P(element) / A_element
+//!   (the area form of the rendering equation, Kajiya 1986; Shirley, Wang & Zimmerman 1996
+//!   for sampling lights by power). Exact penumbrae: the emitters are sampled over their true
+//!   polygons, not the mesh's visibility estimates.
+//! * **Indirect**, two ways:
+//!   - [`Gather::Direct`]: the solution's own indirect part, interpolated smoothly like
+//!     [`Shading::Smooth`](crate::Shading::Smooth): B − E − B_direct, where B_direct is what the
+//!     solver received from the emitters' own emission (kept apart by the solver for this, so
+//!     the direct light is not counted twice).
+//!   - [`Gather::Full`]: one bounce of gathering. Cosine-weighted rays from x look the
+//!     solution up where they land and take its *reflected* radiosity B − E there (the
+//!     emission is the direct part, already sampled): H_indirect ≈ π · mean(L) = mean(B − E).
+//!     This removes the mesh from everything one bounce away from the eye: contact shadows
+//!     and corners come out as sharp as the direct light.
+
+use std::f64::consts::PI;
+
+use glam::DVec3;
+use radiosity_accel::RayQuery;
+use radiosity_core::random::Rng;
+use radiosity_core::{Mesh, Rgb};
+
+/// How a picture's pixels get their light.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Gather {
+    /// The radiosity solution only, interpolated over the mesh (what the viewer shows).
+    #[default]
+    None,
+    /// Direct light by shadow rays to the emitters per pixel; indirect light from the
+    /// solution.
+    Direct,
+    /// Direct light by shadow rays, indirect light by one bounce of gathering rays that look
+    /// the solution up where they land.
+    Full,
+}
+
+impl Gather {
+    /// The name on the command line: `none`, `direct` or `full`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Gather::None => "none",
+            Gather::Direct => "direct",
+            Gather::Full => "full",
+        }
+    }
+}
+
+/// The emitting elements of a mesh, for sampling points on them by power.
+pub(crate) struct Emitters {
+    /// One entry per emitting triangle (a quad element gives two): corners, the element's
+    /// normal, emission, and its share of the total power.
+    triangles: Vec<EmitterTriangle>,
+    /// Cumulative power share, ending at 1.
+    cdf: Vec<f64>,
+    /// Σ over emitting triangles of Σ_c E_c · area.
+    total_power: f64,
+}
+
+struct EmitterTriangle {
+    corners: [DVec3; 3],
+    normal: DVec3,
+    emission: Rgb,
+    /// Probability density per unit area of a point drawn on it: P(triangle) / area.
+    pdf_area: f64,
+}
+
+/// A point drawn on an emitter.
+pub(crate) struct EmitterSample {
+    /// The point, world space.
+    pub point: DVec3,
+    /// The emitter's unit normal (it emits towards this side only).
+    pub normal: DVec3,
+    /// Its emission E (exitance), W/unit².
+    pub emission: Rgb,
+    /// Density of the point per unit area over all emitters.
+    pub pdf_area: f64,
+}
+
+impl Emitters {
+    /// Collects the emitting elements of `mesh` (none: an empty set that samples nothing).
+    pub(crate) fn new(mesh: &Mesh) -> Self {
+        let mut parts = Vec::new();
+        for (e, el) in mesh.elements.iter().enumerate() {
+            let emission = mesh.element_material(e).emission;
+            if emission.max_channel() <= 0.0 {
+                continue;
+            }
+            let idx = el.vertex_indices();
+            let p = |k: usize| mesh.positions[idx[k] as usize];
+            let tris: &[[usize; 3]] = if idx.len() == 4 { &[[0, 1, 2], [0, 2, 3]] } else { &[[0, 1, 2]] };
+            for t in tris {
+                let corners = [p(t[0]), p(t[1]), p(t[2])];
+                let area = 0.5 * (corners[1] - corners[0]).cross(corners[2] - corners[0]).length();
+                if area > 0.0 {
+                    parts.push((corners, el.normal, emission, area));
+                }
+            }
+        }
+        let total: f64 = parts.iter().map(|(_, _, e, a)| e.sum() * a).sum();
+        let mut cdf = Vec::with_capacity(parts.len());
+        let mut running = 0.0;
+        let triangles = parts
+            .into_iter()
+            .map(|(corners, normal, emission, area)| {
+                let share = emission.sum() * area / total;
+                running += share;
+                cdf.push(running);
+                EmitterTriangle { corners, normal, emission, pdf_area: share / area }
+            })
+            .collect();
+        if let Some(last) = cdf.last_mut() {
+            *last = 1.0;
+        }
+        Self { triangles, cdf, total_power: total }
+    }
+
+    /// Density per unit area with which [`Emitters::sample`] draws a point of an emitter of
+    /// emission `emission`: its share of the power over its area, Σ_c E_c / Σ power.
+    pub(crate) fn pdf_area_of(&self, emission: Rgb) -> f64 {
+        if self.total_power > 0.0 { emission.sum() / self.total_power } else { 0.0 }
+    }
+
+    /// True when there is nothing to sample.
+    pub(crate) fn is_empty(&self) -> bool {
+        self.triangles.is_empty()
+    }
+
+    /// The point for `(u, v)` ∈ [0, 1)²: `u` picks the triangle by power and, rescaled
+    /// within the triangle's share, is the point's first coordinate, `v` the second (so
+    /// stratified `u` gives points stratified over the emitters). `None` when there are none.
+    pub(crate) fn sample(&self, u: f64, v: f64) -> Option<EmitterSample> {
+        let k = self.cdf.partition_point(|&c| c <= u).min(self.triangles.len().checked_sub(1)?);
+        let lo = if k == 0 { 0.0 } else { self.cdf[k - 1] };
+        let width = self.cdf[k] - lo;
+        let s = if width > 0.0 { ((u - lo) / width).clamp(0.0, 1.0) } else { 0.5 };
+        let t = &self.triangles[k];
+        // Uniform on the triangle (Shirley's square-to-triangle map).
+        let r = s.sqrt();
+        let point = t.corners[0] * (1.0 - r) + t.corners[1] * (r * (1.0 - v)) + t.corners[2] * (r * v);
+        Some(EmitterSample { point, normal: t.normal, emission: t.emission, pdf_area: t.pdf_area })
+    }
+}
+
+/// How many samples each of the two direct-light strategies takes per pixel sample: points
+/// drawn on the emitters (`lights`) and cosine-weighted directions that happen to hit one
+/// (`cosines`). Their estimates are combined by the balance heuristic (Veach & Guibas 1995,
+/// multiple importance sampling): sampling the emitters' area alone has unbounded variance
+/// next to a large emitter (the 1/r² of a wall meeting an emitting wall — every corner of a
+/// furnace), sampling directions alone misses small lamps; together each covers the other.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct DirectMis {
+    /// Points drawn on the emitters per sample.
+    pub lights: u32,
+    /// Cosine-weighted directions per sample.
+    pub cosines: u32,
+}
+
+impl DirectMis {
+    /// The weighted contribution to the irradiance H at a point from one sample of either
+    /// strategy that sees emission `emission` at distance² `r2` with cosines `cos_x` (at the
+    /// receiver) and `cos_y` (at the emitter), where the emitter-area strategy's density is
+    /// `pdf_area` per unit area: (E/π) cos θ_x / (n_l p_l + n_c p_c), both densities per
+    /// unit solid angle (p_l = pdf_area · r² / cos θ_y, p_c = cos θ_x / π). Summed over all
+    /// samples of both strategies it is an unbiased estimate of H.
+    pub(crate) fn term(self, emission: Rgb, cos_x: f64, cos_y: f64, r2: f64, pdf_area: f64) -> Rgb {
+        if cos_x <= 0.0 || cos_y <= 0.0 {
+            return Rgb::ZERO;
+        }
+        let p_light = pdf_area * r2 / cos_y;
+        let p_cosine = cos_x / PI;
+        let denominator = f64::from(self.lights) * p_light + f64::from(self.cosines) * p_cosine;
+        if denominator <= 0.0 || !denominator.is_finite() {
+            return Rgb::ZERO;
+        }
+        emission * (cos_x / PI / denominator)
+    }
+}
+
+/// The emitter-area half of the direct irradiance at `x` (unit normal `n`): `mis.lights`
+/// shadow rays whose emitter coordinates are stratified in `strata` cells starting at
+/// `first` (so the samples of one pixel share one stratification), jittered by `rng`, each
+/// weighted by [`DirectMis::term`]. `lift` moves the shadow ray's origin off the surface.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn emitter_samples(
+    emitters: &Emitters,
+    rays: &dyn RayQuery,
+    x: DVec3,
+    n: DVec3,
+    lift: f64,
+    first: u32,
+    strata: u32,
+    mis: DirectMis,
+    rng: &mut Rng,
+) -> Rgb {
+    let mut sum = Rgb::ZERO;
+    let origin = x + n * lift;
+    for i in first..first + mis.lights {
+        let u = (f64::from(i % strata) + rng.next_f64()) / f64::from(strata);
+        let Some(s) = emitters.sample(u, rng.next_f64()) else {
+            return Rgb::ZERO;
+        };
+        let d = s.point - x;
+        let r2 = d.length_squared();
+        if r2 <= 0.0 {
+            continue;
+        }
+        let dir = d / r2.sqrt();
+        let (cos_x, cos_y) = (n.dot(dir), -s.normal.dot(dir));
+        if cos_x <= 0.0 || cos_y <= 0.0 || rays.occluded(origin.as_vec3(), s.point.as_vec3()) {
+            continue;
+        }
+        sum += mis.term(s.emission, cos_x, cos_y, r2, s.pdf_area);
+    }
+    sum
+}
+
+/// A cosine-weighted unit direction about `n` for `(u, v)` ∈ [0, 1)² (Malley's method:
+/// uniform on the disc, projected up), pdf cos θ / π.
+pub(crate) fn cosine_direction(n: DVec3, u: f64, v: f64) -> DVec3 {
+    let (t, b) = n.any_orthonormal_pair();
+    let r = u.sqrt();
+    let phi = 2.0 * PI * v;
+    let z = (1.0 - u).max(0.0).sqrt();
+    (t * (r * phi.cos()) + b * (r * phi.sin()) + n * z).normalize()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use radiosity_core::{Material, MeshParams, Object, Polygon, Scene, Shape};
+
+    fn square(z: f64, half: f64, up: bool) -> Vec<DVec3> {
+        let mut v = vec![
+            DVec3::new(-half, -half, z),
+            DVec3::new(half, -half, z),
+            DVec3::new(half, half, z),
+            DVec3::new(-half, half, z),
+        ];
+        if !up {
+            v.reverse();
+        }
+        v
+    }
+
+    /// Irradiance at the centre of a plane under a parallel square emitter, against the
+    /// closed form for a point under a coaxial square (Howell's catalogue, B-? / the
+    /// differential element to a parallel rectangle, Lambert's polygon formula): with 4 096
+    /// stratified shadow rays the estimate is within 0.5 % (the integrand is smooth; the
+    /// variance of stratified samples falls as N^(-2) per dimension).
+    #[test]
+    fn direct_light_under_a_square_emitter_matches_the_closed_form() {
+        let emission = 10.0;
+        let (h, half) = (1.0, 0.5);
+        let light = Material::try_new("light", Rgb::ZERO, Rgb::splat(emission)).unwrap();
+        let grey = Material::try_new("grey", Rgb::splat(0.5), Rgb::ZERO).unwrap();
+        let polygon = |name: &str, vertices: Vec<DVec3>, material: usize| Object {
+            name: name.into(),
+            material,
+            shape: Shape::Polygons(vec![Polygon::try_new(vertices).unwrap()]),
+        };
+        let scene = Scene::try_new(
+            "lamp over a floor",
+            None,
+            vec![light, grey],
+            vec![polygon("lamp", square(h, half, false), 0), polygon("floor", square(0.0, 4.0, true), 1)],
+        )
+        .unwrap();
+        let mesh = Mesh::build(&scene, &MeshParams::try_new(0.5, 0.25).unwrap()).unwrap();
+        let emitters = Emitters::new(&mesh);
+        assert!(!emitters.is_empty());
+        let rays = radiosity_accel::BruteForce::new(&[]);
+        let mut rng = Rng::for_task(0, 0, 0);
+        let n = 4096;
+        let mis = DirectMis { lights: n, cosines: 0 };
+        let h_est = emitter_samples(&emitters, &rays, DVec3::ZERO, DVec3::Z, 1e-6, 0, n, mis, &mut rng);
+        // Point on the axis of a parallel square of side a at height h: the view factor is
+        // 4 × that of a rectangle a/2 × a/2 with a corner above the point (Howell C-? for a
+        // differential area to a parallel rectangle): F = (1/2π) Σ [X/√(1+X²) atan(Y/√(1+X²)) + …].
+        let (x, y) = (half / h, half / h);
+        let corner = (x / (1.0 + x * x).sqrt() * (y / (1.0 + x * x).sqrt()).atan()
+            + y / (1.0 + y * y).sqrt() * (x / (1.0 + y * y).sqrt()).atan())
+            / (2.0 * PI);
+        let expected = emission * 4.0 * corner;
+        let got = h_est.to_array()[0];
+        assert!((got / expected - 1.0).abs() < 5e-3, "irradiance {got} vs closed form {expected}");
+    }
+
+    /// Cosine-weighted directions lie in the upper hemisphere and have mean cos θ = 2/3
+    /// (∫ cos θ · cos θ/π dω = 2/3).
+    #[test]
+    fn cosine_directions_have_the_right_mean() {
+        let n = DVec3::new(0.3, -0.4, 0.5).normalize();
+        let mut rng = Rng::for_task(1, 2, 3);
+        let count = 100_000;
+        let mut sum = 0.0;
+        for _ in 0..count {
+            let d = cosine_direction(n, rng.next_f64(), rng.next_f64());
+            assert!((d.length() - 1.0).abs() < 1e-9);
+            let c = d.dot(n);
+            assert!(c >= -1e-12);
+            sum += c;
+        }
+        // Standard deviation of cos θ under this pdf: √(1/2 − 4/9) ≈ 0.236; 5 σ over 10⁵.
+        let mean = sum / f64::from(count);
+        assert!((mean - 2.0 / 3.0).abs() < 5.0 * 0.236 / (f64::from(count)).sqrt(), "mean cos {mean}");
+    }
+}
