@@ -817,7 +817,7 @@ mod tests {
         let fly = crate::FlyCamera::from_scene_camera(&camera, &crate::SceneExtent::new(lo, hi));
         let aspect = f64::from(params.width) / f64::from(params.height);
         let gpu = auto_exposure_ev(
-            &mesh,
+            mesh,
             &solution,
             fly.clip_from_view(aspect) * fly.view_from_world(),
             fly.position,

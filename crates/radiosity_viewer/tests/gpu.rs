@@ -208,7 +208,7 @@ fn offscreen_cornell_shows_red_left_and_green_right() {
     ] {
         let mut renderer = SceneRenderer::new(&device, COLOR_FORMAT, 1);
         let target = RenderTarget::new(&device, [w, h], COLOR_FORMAT, 1);
-        renderer.set_mesh(&device, &mesh);
+        renderer.set_mesh(&device, mesh);
         renderer.set_solution(&queue, &solution, mode);
         let frame = FrameParams {
             clip_from_world: camera.clip_from_view(aspect) * camera.view_from_world(),
@@ -264,7 +264,7 @@ fn any_target_format_gives_the_same_picture() {
     };
     let picture = |format, samples| {
         let mut renderer = SceneRenderer::new(&device, format, samples);
-        renderer.set_mesh(&device, &mesh);
+        renderer.set_mesh(&device, mesh);
         renderer.set_solution(&queue, &solution, DisplayMode::Smooth);
         let target = RenderTarget::new(&device, [w, h], format, samples);
         renderer.draw(&device, &queue, &target, &frame);
