@@ -21,7 +21,7 @@ use glam::{DVec3, Vec3};
 use radiosity_accel::{Bvh, RayQuery};
 use radiosity_core::random::XorShift64;
 use radiosity_core::{Mesh, MeshParams, Scene, Shape};
-use radiosity_solver::{Solver, SolverParams, occluder_triangles};
+use radiosity_solver::{Problem, SolverParams};
 use rayon::prelude::*;
 use serde_json::json;
 
@@ -199,10 +199,9 @@ fn solve_case(
 ) -> Result<serde_json::Value> {
     alloc::reset_peak();
     let before = alloc::live();
-    let mesh = Arc::new(mesh()?);
-    let accel = Arc::new(Bvh::new(&occluder_triangles(&mesh)));
-    let (patches, elements) = (mesh.patches.len(), mesh.elements.len());
-    let mut solver = Solver::new(mesh, accel, params)?;
+    let problem = Problem::from_mesh(Arc::new(mesh()?));
+    let (patches, elements) = (problem.mesh().patches.len(), problem.mesh().elements.len());
+    let mut solver = problem.solver(params)?;
     let r = solver.solve();
     let peak = alloc::peak().saturating_sub(before);
     let secs = r.elapsed.as_secs_f64();
@@ -233,11 +232,11 @@ pub fn run(a: BenchArgs) -> Result<()> {
     }
     let threads = rayon::current_num_threads();
     println!("radiosity bench ({threads} threads)");
-    let cornell = radiosity_io::resolve_scene("cornell")?;
+    let cornell = radiosity_core::cornell_box();
     let mut cases = vec![occlusion_case(&cornell, a.dump_rays.as_deref(), a.force)?];
 
     // (b) The source document's case: ~100 facets, 1000 shots (it took about a minute).
-    let seed = radiosity_io::resolve_scene("seed-room")?;
+    let seed = radiosity_io::resolve_scene("seed-room")?.scene;
     let (lo, hi) = seed.bounds();
     let size = ((hi - lo).length() / 5.0).max(1e-6);
     let mut params = MeshParams::try_new(size, size)?;

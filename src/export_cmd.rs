@@ -5,8 +5,8 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use clap::Args;
+use radiosity_export::{ExportFormat, VertexColours};
 use radiosity_image::{HdrImage, ToneOperator, ToneParams};
-use radiosity_io::{ExportFormat, VertexColours};
 
 use crate::prepare::{InputError, SolveOpts, check_writable, prepare, run_solver};
 use crate::render_cmd::ToneOpts;
@@ -60,7 +60,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
     let prepared = prepare(&a.scene, &a.solve)?;
     let (solver, report) = run_solver(&prepared)?;
     let solution = solver.solution();
-    let mesh = &prepared.mesh;
+    let mesh = prepared.problem.mesh();
 
     // The exposure for display colours: fixed, or the log-average radiance over the elements
     // mapped to middle grey (there is no picture to measure, so the scene itself is used).
@@ -74,9 +74,9 @@ pub fn run(a: ExportArgs) -> Result<()> {
     let mode =
         if a.tonemapped { VertexColours::Display(tone) } else { VertexColours::Linear { exposure_ev: ev } };
     let bytes = match format {
-        ExportFormat::Glb => radiosity_io::glb_bytes(mesh, &solution, mode),
-        ExportFormat::Gltf => radiosity_io::gltf_text(mesh, &solution, mode).into_bytes(),
-        ExportFormat::Ply => radiosity_io::ply_bytes(mesh, &solution, tone),
+        ExportFormat::Glb => radiosity_export::glb_bytes(mesh, &solution, mode),
+        ExportFormat::Gltf => radiosity_export::gltf_text(mesh, &solution, mode).into_bytes(),
+        ExportFormat::Ply => radiosity_export::ply_bytes(mesh, &solution, tone),
     };
     std::fs::write(&a.output, bytes).with_context(|| format!("cannot write {}", a.output.display()))?;
     eprintln!(
@@ -97,7 +97,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
     };
     eprintln!("wrote {} ({} vertices, {colours})", a.output.display(), mesh.positions.len());
     if let Some(dir) = &a.lightmap {
-        let written = radiosity_io::write_lightmaps(dir, mesh, &solution).map_err(anyhow::Error::msg)?;
+        let written = radiosity_export::write_lightmaps(dir, mesh, &solution).map_err(anyhow::Error::msg)?;
         eprintln!("wrote {} lightmap files into {}", written.len(), dir.display());
     }
     Ok(())

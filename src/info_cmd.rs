@@ -18,7 +18,7 @@ pub struct InfoArgs {
 /// Runs `info`.
 pub fn run(a: InfoArgs) -> Result<()> {
     let p = prepare(&a.scene, &a.solve)?;
-    let (scene, mesh) = (&p.scene, &p.mesh);
+    let (scene, mesh) = (&p.scene, p.problem.mesh());
     let (lo, hi) = mesh.bounds();
     println!("scene      {}", scene.name);
     println!("bounds     {:?} .. {:?}", lo.to_array(), hi.to_array());

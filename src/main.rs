@@ -65,7 +65,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {}", prepare::one_line(&e));
+            eprintln!("error: {}", radiosity_core::one_line(e.as_ref()));
             ExitCode::from(prepare::exit_code(&e))
         }
     }

@@ -3,16 +3,14 @@
 
 use std::io::IsTerminal;
 use std::path::Path;
-use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
-use radiosity_accel::Bvh;
-use radiosity_core::{Mesh, MeshParams, Scene};
+use radiosity_core::{MeshParams, Scene};
 use radiosity_solver::{
-    Ambient, FormFactorMethod, Overshoot, Solver, SolverParams, StepBudget, StepReport, occluder_triangles,
+    Ambient, FormFactorMethod, Overshoot, Problem, Solver, SolverParams, StepBudget, StepReport,
 };
 
 /// An error in what the user gave us (a file, an option): exit code 2.
@@ -30,11 +28,6 @@ pub fn exit_code(e: &anyhow::Error) -> u8 {
             || c.is::<radiosity_solver::SolverError>()
     });
     if input { 2 } else { 1 }
-}
-
-/// The error and its causes on one line.
-pub fn one_line(e: &anyhow::Error) -> String {
-    e.chain().map(|c| c.to_string()).collect::<Vec<_>>().join(": ")
 }
 
 /// Form factor choice on the command line.
@@ -106,10 +99,8 @@ pub struct SolveOpts {
 pub struct Prepared {
     /// The scene as loaded (light scale applied).
     pub scene: Scene,
-    /// Its mesh.
-    pub mesh: Arc<Mesh>,
-    /// Ray queries over its occluders.
-    pub accel: Arc<Bvh>,
+    /// Its mesh and the ray queries over its occluders.
+    pub problem: Problem,
     /// Solver settings from the scene and the options.
     pub params: SolverParams,
 }
@@ -141,7 +132,7 @@ pub fn settings(scene_arg: &str, o: &SolveOpts) -> Result<Settings> {
     }
     // A model file given where a scene is expected loads as a scene of its parts; what the
     // loader dropped or defaulted (degenerate faces, a missing MTL) is said once, here.
-    let radiosity_io::LoadedScene { scene, warnings } = radiosity_io::resolve_scene_warned(scene_arg)?;
+    let radiosity_io::LoadedScene { scene, warnings } = radiosity_io::resolve_scene(scene_arg)?;
     for w in &warnings {
         eprintln!("warning: {w}");
     }
@@ -182,7 +173,7 @@ pub fn settings(scene_arg: &str, o: &SolveOpts) -> Result<Settings> {
     Ok(Settings { scene, mesh_params, solver_params })
 }
 
-/// [`settings`], then the light scale, the mesh and the ray-query structure; sets the
+/// [`settings`], then the light scale and the [`Problem`] (mesh and ray queries); sets the
 /// global thread pool when `--threads` is given.
 ///
 /// # Errors
@@ -194,9 +185,8 @@ pub fn prepare(scene_arg: &str, o: &SolveOpts) -> Result<Prepared> {
         let _ = rayon::ThreadPoolBuilder::new().num_threads(t).build_global();
     }
     scene.scale_emission(o.light_scale);
-    let mesh = Arc::new(Mesh::build(&scene, &mesh_params)?);
-    let accel = Arc::new(Bvh::new(&occluder_triangles(&mesh)));
-    Ok(Prepared { scene, mesh, accel, params: solver_params })
+    let problem = Problem::new(&scene, &mesh_params)?;
+    Ok(Prepared { scene, problem, params: solver_params })
 }
 
 /// Runs the solver to a stop criterion, with a progress bar on stderr when it is a terminal.
@@ -204,7 +194,7 @@ pub fn prepare(scene_arg: &str, o: &SolveOpts) -> Result<Prepared> {
 /// # Errors
 /// Solver parameter errors (exit code 2).
 pub fn run_solver(p: &Prepared) -> Result<(Solver, StepReport)> {
-    let mut solver = Solver::new(p.mesh.clone(), p.accel.clone(), p.params.clone())?;
+    let mut solver = p.problem.solver(p.params.clone())?;
     let bar = if std::io::stderr().is_terminal() {
         let bar = ProgressBar::new(1000);
         bar.set_style(

@@ -235,7 +235,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let (solver, report) = run_solver(&prepared)?;
     let solution = solver.solution();
     let start = Instant::now();
-    let renderer = Renderer::new(prepared.mesh.clone());
+    let renderer = Renderer::new(prepared.problem.mesh().clone());
     let progress = bar(u64::from(params.height), "rendering");
     let rendering = renderer.render_with_progress(&solution, &camera, &params, &|| progress.inc(1))?;
     progress.finish_and_clear();
@@ -244,7 +244,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     eprintln!(
         "{}: {} elements, {} shots, unshot {:.4} % ({}), solved in {:.2} s; rendered {}×{} at {} spp (gather {}) in {:.2} s",
         prepared.scene.name,
-        prepared.mesh.elements.len(),
+        prepared.problem.mesh().elements.len(),
         report.total_shots,
         report.unshot_fraction * 100.0,
         report.stop_reason.map_or("running", |s| s.as_str()),

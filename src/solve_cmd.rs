@@ -30,7 +30,8 @@ pub fn run(a: SolveArgs) -> Result<()> {
         crate::prepare::check_writable(std::path::Path::new(path), a.force)?;
     }
     let (solver, report) = run_solver(&prepared)?;
-    let Prepared { scene, mesh, .. } = &prepared;
+    let Prepared { scene, problem, .. } = &prepared;
+    let mesh = problem.mesh();
     let solution = solver.solution();
     let objects = solution.object_radiosity(mesh);
     let secs = report.elapsed.as_secs_f64();

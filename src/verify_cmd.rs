@@ -14,6 +14,7 @@ use radiosity_core::random::Rng;
 use radiosity_core::{Camera, Mesh, Rgb};
 use radiosity_image::HdrImage;
 use radiosity_reference::{Estimate, EstimateParams, PathBudget, PictureParams, Progress, Reference, Region};
+use radiosity_solver::Problem;
 use serde_json::{Value, json};
 
 use crate::prepare::{InputError, Prepared, SolveOpts, check_writable, prepare, run_solver, write_output};
@@ -190,10 +191,15 @@ pub fn run(a: VerifyArgs) -> Result<()> {
     }
     let mut prepared = prepare(&a.scene, &a.solve)?;
     if let Some(k) = a.solve_reflectance_scale {
-        scale_solver_reflectance(Arc::make_mut(&mut prepared.mesh), k)?;
+        // The same mesh and ray queries, only the reflectances the solver sees are scaled.
+        let mut mesh = Mesh::clone(prepared.problem.mesh());
+        scale_solver_reflectance(&mut mesh, k)?;
+        let rays = prepared.problem.ray_queries().clone();
+        prepared.problem = Problem::with_ray_queries(Arc::new(mesh), rays);
     }
     let (solver, report) = run_solver(&prepared)?;
-    let Prepared { scene, mesh, .. } = &prepared;
+    let Prepared { scene, problem, .. } = &prepared;
+    let mesh = problem.mesh();
     let solution = solver.solution();
     let solved = solution.object_radiosity(mesh);
     let solve_secs = report.elapsed.as_secs_f64();

@@ -14,17 +14,14 @@
 //! the density weighting 3.2 % and 25 % (with 4 rays from every shooter). Bounds: 1.5 % and
 //! 8 %.
 
-use std::sync::Arc;
-
-use radiosity_accel::Bvh;
-use radiosity_core::{Mesh, MeshParams};
-use radiosity_solver::{Solver, SolverParams, occluder_triangles};
+use radiosity_core::{MeshParams, cornell_box};
+use radiosity_solver::{Problem, Solver, SolverParams};
 
 fn object_means(patch: f64, element: f64) -> Vec<(String, f64, [f64; 3])> {
-    let scene = radiosity_io::builtin_scene("cornell").unwrap();
-    let mesh = Arc::new(Mesh::build(&scene, &MeshParams::try_new(patch, element).unwrap()).unwrap());
-    let accel = Arc::new(Bvh::new(&occluder_triangles(&mesh)));
-    let mut solver = Solver::new(Arc::clone(&mesh), accel, SolverParams::default()).unwrap();
+    let scene = cornell_box();
+    let problem = Problem::new(&scene, &MeshParams::try_new(patch, element).unwrap()).unwrap();
+    let mesh = problem.mesh();
+    let mut solver = problem.solver(SolverParams::default()).unwrap();
     solver.solve();
     let areas: Vec<f64> = (0..mesh.object_names.len())
         .map(|o| {
@@ -36,7 +33,7 @@ fn object_means(patch: f64, element: f64) -> Vec<(String, f64, [f64; 3])> {
         .collect();
     solver
         .solution()
-        .object_radiosity(&mesh)
+        .object_radiosity(mesh)
         .into_iter()
         .zip(areas)
         .map(|(o, area)| (o.name, area, o.radiosity.to_array()))
@@ -82,9 +79,11 @@ fn coarse_patches_agree_with_elements_shooting_for_themselves() {
 /// with 4 first rays, 0.06 % with 8. Bound: 0.4 %.
 #[test]
 fn penumbra_rays_leave_direct_light_unbiased() {
-    let mesh = cornell_15k();
+    let problem = cornell_15k();
     let solve = |params: SolverParams| {
-        solved(&mesh, SolverParams { max_shots: Some(1), ..params }).solution().object_radiosity(&mesh)
+        solved(&problem, SolverParams { max_shots: Some(1), ..params })
+            .solution()
+            .object_radiosity(problem.mesh())
     };
     let fast = solve(SolverParams::default());
     let many = solve(SolverParams { visibility_rays: 256, penumbra_rays: 0, ..SolverParams::default() });
@@ -114,9 +113,10 @@ fn penumbra_rays_leave_direct_light_unbiased() {
 /// shooters' ray-end tables between seeds alone is 0.2–0.5 %).
 #[test]
 fn bright_shooters_get_the_rays_and_the_noise_drops() {
-    let mesh = cornell_15k();
+    let problem = cornell_15k();
+    let mesh = problem.mesh();
     let solve = |params: SolverParams| {
-        let solver = solved(&mesh, params);
+        let solver = solved(&problem, params);
         (solver.solution(), solver.rays())
     };
     let old = SolverParams { visibility_rays: 4, bright_share: 0.0, ..SolverParams::default() };
@@ -140,10 +140,10 @@ fn bright_shooters_get_the_rays_and_the_noise_drops() {
         }
         (sum / area).sqrt() / (mean / area)
     };
-    let reference = many.object_radiosity(&mesh);
+    let reference = many.object_radiosity(mesh);
     let bias = |s: &radiosity_solver::Solution| {
         let (mut sum, mut weight) = (0.0, 0.0);
-        for (o, m) in s.object_radiosity(&mesh).iter().zip(&reference) {
+        for (o, m) in s.object_radiosity(mesh).iter().zip(&reference) {
             if o.name == "light" {
                 continue;
             }
@@ -164,16 +164,15 @@ fn bright_shooters_get_the_rays_and_the_noise_drops() {
 }
 
 /// The Cornell box at 15.6 k elements (its own patches, 14.3 mm elements).
-fn cornell_15k() -> Arc<Mesh> {
-    let scene = radiosity_io::builtin_scene("cornell").unwrap();
+fn cornell_15k() -> Problem {
+    let scene = cornell_box();
     let params = MeshParams::try_new(scene.mesh_params().patch_size.max(14.3), 14.3).unwrap();
-    Arc::new(Mesh::build(&scene, &params).unwrap())
+    Problem::new(&scene, &params).unwrap()
 }
 
-/// A solver of `mesh` with `params`, run to its stop.
-fn solved(mesh: &Arc<Mesh>, params: SolverParams) -> Solver {
-    let accel = Arc::new(Bvh::new(&occluder_triangles(mesh)));
-    let mut solver = Solver::new(Arc::clone(mesh), accel, params).unwrap();
+/// A solver of `problem` with `params`, run to its stop.
+fn solved(problem: &Problem, params: SolverParams) -> Solver {
+    let mut solver = problem.solver(params).unwrap();
     solver.solve();
     solver
 }

@@ -13,27 +13,27 @@
 //! dim one, whose shot is small). So: every element within 1e-5 relative, except at
 //! most 0.1 % of elements, none of them off by more than 5 %; per-object means within 1e-4.
 
-use std::sync::Arc;
+use radiosity_core::{Scene, furnace_box, two_plates, unit_cube_floor_light};
+use radiosity_solver::{Problem, Solution, SolverParams};
 
-use radiosity_accel::Bvh;
-use radiosity_core::{Mesh, Scene, furnace_box, two_plates, unit_cube_floor_light};
-use radiosity_solver::{Solution, Solver, SolverParams, occluder_triangles};
-
-fn solve(mesh: &Arc<Mesh>, reference_path: bool, max_shots: u64) -> Solution {
-    solve_with(mesh, SolverParams { reference_path, max_shots: Some(max_shots), ..SolverParams::default() })
+fn solve(problem: &Problem, reference_path: bool, max_shots: u64) -> Solution {
+    solve_with(
+        problem,
+        SolverParams { reference_path, max_shots: Some(max_shots), ..SolverParams::default() },
+    )
 }
 
-fn solve_with(mesh: &Arc<Mesh>, params: SolverParams) -> Solution {
-    let accel = Arc::new(Bvh::new(&occluder_triangles(mesh)));
-    let mut solver = Solver::new(Arc::clone(mesh), accel, params).unwrap();
+fn solve_with(problem: &Problem, params: SolverParams) -> Solution {
+    let mut solver = problem.solver(params).unwrap();
     solver.solve();
     solver.solution()
 }
 
 fn compare(name: &str, scene: &Scene, max_shots: u64) {
-    let mesh = Arc::new(Mesh::build(scene, &scene.mesh_params()).unwrap());
-    let fast = solve(&mesh, false, max_shots);
-    let reference = solve(&mesh, true, max_shots);
+    let problem = Problem::new(scene, &scene.mesh_params()).unwrap();
+    let mesh = problem.mesh();
+    let fast = solve(&problem, false, max_shots);
+    let reference = solve(&problem, true, max_shots);
     assert_eq!(fast.shots, reference.shots, "{name}");
     let mut off = 0;
     for (e, (a, b)) in fast.element_radiosity.iter().zip(&reference.element_radiosity).enumerate() {
@@ -48,7 +48,7 @@ fn compare(name: &str, scene: &Scene, max_shots: u64) {
     }
     let n = mesh.elements.len();
     assert!(off * 1000 <= n, "{name}: {off} of {n} elements differ");
-    let (fo, ro) = (fast.object_radiosity(&mesh), reference.object_radiosity(&mesh));
+    let (fo, ro) = (fast.object_radiosity(mesh), reference.object_radiosity(mesh));
     for (f, r) in fo.iter().zip(&ro) {
         for (x, y) in [(f.radiosity.r, r.radiosity.r), (f.radiosity.g, r.radiosity.g)] {
             assert!((x - y).abs() <= 1e-4 * y.abs().max(1e-12), "{name}: {}: {x} vs {y}", f.name);
@@ -80,9 +80,13 @@ fn the_seed_room_solves_the_same_on_both_paths() {
 #[test]
 fn kept_rows_change_nothing_whatever_the_budget() {
     let scene = radiosity_io::builtin_scene("cornell").unwrap();
-    let mesh = Arc::new(Mesh::build(&scene, &scene.mesh_params()).unwrap());
+    let problem = Problem::new(&scene, &scene.mesh_params()).unwrap();
+    let mesh = problem.mesh();
     let with = |row_cache_bytes| {
-        solve_with(&mesh, SolverParams { max_shots: Some(400), row_cache_bytes, ..SolverParams::default() })
+        solve_with(
+            &problem,
+            SolverParams { max_shots: Some(400), row_cache_bytes, ..SolverParams::default() },
+        )
     };
     let all = with(usize::MAX);
     // One row of the Cornell box is at most 4 bytes per element: this keeps about ten.
@@ -101,11 +105,12 @@ fn kept_rows_change_nothing_whatever_the_budget() {
 fn one_and_two_threads_agree_on_a_large_cornell_box() {
     let scene = radiosity_io::builtin_scene("cornell").unwrap();
     let params = radiosity_core::MeshParams::try_new(scene.mesh_params().patch_size, 9.0).unwrap();
-    let mesh = Arc::new(Mesh::build(&scene, &params).unwrap());
+    let problem = Problem::new(&scene, &params).unwrap();
+    let mesh = problem.mesh();
     assert!(mesh.elements.len() > 32_768, "{} elements", mesh.elements.len());
     let run = |threads| {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-        pool.install(|| solve_with(&mesh, SolverParams { max_shots: Some(60), ..SolverParams::default() }))
+        pool.install(|| solve_with(&problem, SolverParams { max_shots: Some(60), ..SolverParams::default() }))
     };
     let (one, two) = (run(1), run(2));
     assert_eq!(one.shots, 60);

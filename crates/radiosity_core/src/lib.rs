@@ -10,16 +10,20 @@
 mod canonical;
 mod color;
 mod mesh;
+mod one_line;
 pub mod random;
 mod scene;
+mod srgb;
 
-pub use canonical::{furnace_box, furnace_sphere, two_plates, unit_cube_floor_light};
+pub use canonical::{cornell_box, furnace_box, furnace_sphere, two_plates, unit_cube_floor_light};
 pub use color::Rgb;
 pub use mesh::{Element, MAX_ELEMENTS, Mesh, MeshError, MeshParams, Patch, Surface};
+pub use one_line::{escape_controls, one_line};
 pub use scene::{
     Camera, Facing, Material, Object, Polygon, PolygonMesh, Scene, SceneError, Shape, SolverSettings, Sphere,
-    box_faces,
+    box_faces, unique_names,
 };
+pub use srgb::{encode_srgb, srgb_decode, srgb_encode};
 
 /// Re-export of the vector maths used in the public API.
 pub use glam;

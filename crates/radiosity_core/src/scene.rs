@@ -604,6 +604,19 @@ impl Scene {
     }
 }
 
+/// Makes names unique in place by appending `#2`, `#3`, … to repeats, in order (the first
+/// keeps its name): object names from model files, file names derived from object names.
+pub fn unique_names(names: &mut [String]) {
+    let mut seen: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
+    for name in names.iter_mut() {
+        let count = seen.entry(name.clone()).or_insert(0);
+        *count += 1;
+        if *count > 1 {
+            *name = format!("{name}#{count}");
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -11,12 +11,12 @@
 //!   applied to luminance with the colour scaled by L_d / L (so hue is kept), then clamped.
 //! * [`ToneOperator::Aces`]: Narkowicz 2015, "ACES Filmic Tone Mapping Curve", the rational fit
 //!   f(x) = x(2.51x + 0.03) / (x(2.43x + 0.59) + 0.14) of the ACES RRT + sRGB ODT, per channel.
-//! * sRGB encoding: IEC 61966-2-1:1999, c ≤ 0.0031308 → 12.92c, else 1.055 c^(1/2.4) − 0.055.
+//! * sRGB encoding: `radiosity_core::srgb_encode` (IEC 61966-2-1:1999).
 
 use std::fmt;
 use std::str::FromStr;
 
-use radiosity_core::Rgb;
+use radiosity_core::{Rgb, encode_srgb};
 use thiserror::Error;
 
 use crate::HdrImage;
@@ -166,7 +166,7 @@ fn aces_narkowicz(x: f64) -> f64 {
 }
 
 /// Tone maps one linear radiance to display-referred linear colour in [0, 1] per channel
-/// (apply [`encode_srgb`] to get display values).
+/// (apply [`radiosity_core::encode_srgb`] to get display values).
 ///
 /// Negative and NaN channels (which a solver with over-relaxation may briefly produce) are
 /// treated as 0; +∞ maps to 1.
@@ -189,25 +189,6 @@ pub fn tone_map(radiance: Rgb, params: &ToneParams) -> Rgb {
         }
         ToneOperator::Aces => x.map(aces_narkowicz),
     }
-}
-
-/// The sRGB transfer function (IEC 61966-2-1): linear [0, 1] → encoded [0, 1]. Input outside
-/// [0, 1] is clamped first.
-pub fn srgb_encode(linear: f64) -> f64 {
-    let c = if linear > 0.0 { linear.min(1.0) } else { 0.0 };
-    if c <= 0.003_130_8 { 12.92 * c } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 }
-}
-
-/// The inverse sRGB transfer function (IEC 61966-2-1): encoded [0, 1] → linear [0, 1]. Input
-/// outside [0, 1] is clamped first.
-pub fn srgb_decode(encoded: f64) -> f64 {
-    let c = if encoded > 0.0 { encoded.min(1.0) } else { 0.0 };
-    if c <= 0.040_45 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
-}
-
-/// Encodes display-linear colour in [0, 1] to 8-bit sRGB, rounding to nearest.
-pub fn encode_srgb(display: Rgb) -> [u8; 3] {
-    display.to_array().map(|c| (srgb_encode(c) * 255.0).round() as u8)
 }
 
 /// An 8-bit sRGB picture, ready to show or to save as PNG: `[r, g, b]` per pixel, top row
@@ -276,25 +257,6 @@ mod tests {
             }
         }
         assert!((2.54_f64 / 3.16 - 0.803_797).abs() < 1e-6);
-    }
-
-    #[test]
-    fn srgb_matches_known_values_and_round_trips() {
-        for (linear, encoded) in
-            [(0.0, 0.0), (0.003_130_8, 0.040_45), (0.18, 0.461_356), (0.5, 0.735_357), (1.0, 1.0)]
-        {
-            assert!((srgb_encode(linear) - encoded).abs() < 1e-5, "{linear}");
-            assert!((srgb_decode(encoded) - linear).abs() < 1e-5, "{encoded}");
-        }
-        for i in 0..=1000 {
-            let x = f64::from(i) / 1000.0;
-            assert!((srgb_decode(srgb_encode(x)) - x).abs() < 1e-12, "{x}");
-        }
-        // 8-bit round trip: every code value survives decode → encode → round.
-        for code in 0..=255u8 {
-            let lin = srgb_decode(f64::from(code) / 255.0);
-            assert_eq!(encode_srgb(Rgb::splat(lin)), [code; 3]);
-        }
     }
 
     #[test]

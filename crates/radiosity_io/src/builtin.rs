@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use crate::{LoadError, LoadedScene, ModelFormat, Scene, load_scene_warned, parse_scene};
+use crate::{LoadError, LoadedScene, ModelFormat, Scene, load_scene, parse_scene};
 
 /// Built-in scene names with the origin shown in messages and the embedded text.
 const FILES: &[(&str, &str, &str)] = &[
@@ -25,28 +25,20 @@ pub fn builtin_scene(name: &str) -> Option<Scene> {
     FILES
         .iter()
         .find(|(n, _, _)| *n == name)
-        .map(|(_, origin, text)| parse_scene(text, origin).expect("built-in scenes are valid (tested)"))
+        .map(|(_, origin, text)| parse_scene(text, origin).expect("built-in scenes are valid (tested)").scene)
 }
 
-/// A scene from a command-line argument: the file at `arg` when that is an existing file or
+/// A scene and its loader's warnings from a command-line argument: the file at `arg` when that is an existing file or
 /// `arg` ends in `.toml`, `.obj`, `.gltf` or `.glb` (so a mistyped path says "cannot read",
 /// not "unknown scene"), otherwise the built-in scene of that name.
 ///
 /// # Errors
-/// As [`load_scene`](crate::load_scene) for a path; [`LoadError::UnknownScene`], listing the built-ins, for
-/// any other name.
-pub fn resolve_scene(arg: &str) -> Result<Scene, LoadError> {
-    resolve_scene_warned(arg).map(|l| l.scene)
-}
-
-/// [`resolve_scene`] with the loader's warnings (model files: dropped faces, missing MTL).
-///
-/// # Errors
-/// As [`resolve_scene`]; [`LoadError::Model`] for a broken model file.
-pub fn resolve_scene_warned(arg: &str) -> Result<LoadedScene, LoadError> {
+/// As [`load_scene`] for a path; [`LoadError::UnknownScene`], listing the built-ins, for any
+/// other name.
+pub fn resolve_scene(arg: &str) -> Result<LoadedScene, LoadError> {
     let path = Path::new(arg);
     if path.is_file() || arg.ends_with(".toml") || ModelFormat::from_path(path).is_some() {
-        return load_scene_warned(path);
+        return load_scene(path);
     }
     builtin_scene(arg)
         .map(|scene| LoadedScene { scene, warnings: Vec::new() })

@@ -11,12 +11,10 @@ use std::path::Path;
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 use radiosity_core::glam::{DMat4, DVec3};
-use radiosity_core::{Camera, Material, Rgb};
+use radiosity_core::{Camera, Material, Rgb, srgb_decode, unique_names};
 
 use crate::LoadError;
-use crate::model::{
-    DEFAULT_GREY, Model, ModelPart, PartBuilder, Transform, model_error, model_material, unique_names,
-};
+use crate::model::{DEFAULT_GREY, Model, ModelPart, PartBuilder, Transform, model_error, model_material};
 
 /// Checks that `accessor` can be read as `dims` of one of `types` without leaving its buffer.
 fn check_accessor(
@@ -82,7 +80,7 @@ fn mean_linear_colour(image: &gltf::image::Data) -> Option<[f64; 3]> {
         Format::R8G8B8A8 => 4,
         _ => return None,
     };
-    let lut: Vec<f64> = (0..256).map(|v| radiosity_image::srgb_decode(v as f64 / 255.0)).collect();
+    let lut: Vec<f64> = (0..256).map(|v| srgb_decode(v as f64 / 255.0)).collect();
     let mut sum = [0.0; 3];
     let mut n = 0usize;
     for px in image.pixels.chunks_exact(channels) {

@@ -6,6 +6,8 @@
 
 use std::ops::Range;
 
+use radiosity_core::escape_controls;
+
 use crate::LoadError;
 
 /// Builds located errors for one text.
@@ -26,11 +28,11 @@ impl Locator<'_> {
     ) -> LoadError {
         let (line, column) = line_col(self.text, span.start);
         LoadError::At {
-            origin: one_line(self.origin),
+            origin: escape_controls(self.origin),
             line,
             column,
-            key: one_line(&key.into()),
-            message: one_line(&message.into()),
+            key: escape_controls(&key.into()),
+            message: escape_controls(&message.into()),
         }
     }
 
@@ -43,15 +45,6 @@ impl Locator<'_> {
         let message = if message.is_empty() { "invalid TOML".to_owned() } else { message.join("; ") };
         self.at(span.clone(), key_path_at(self.text, span.start), message)
     }
-}
-
-/// `s` with control characters (a newline in a material name, say) escaped, so that an error
-/// stays one line whatever the file holds.
-pub(crate) fn one_line(s: &str) -> String {
-    if !s.chars().any(char::is_control) {
-        return s.to_owned();
-    }
-    s.chars().map(|c| if c.is_control() { c.escape_default().to_string() } else { c.to_string() }).collect()
 }
 
 /// 1-based (line, column) of byte `offset` in `text`; the column counts characters.
@@ -229,11 +222,5 @@ mod tests {
         assert_eq!(line_col("ab\ncd", 4), (2, 2));
         assert_eq!(line_col("ρρ\nx", 4), (1, 3));
         assert_eq!(line_col("ab", 99), (1, 3));
-    }
-
-    #[test]
-    fn control_characters_are_escaped() {
-        assert_eq!(one_line("a\nb\tc"), "a\\nb\\tc");
-        assert_eq!(one_line("plain"), "plain");
     }
 }

@@ -26,7 +26,7 @@ use radiosity_core::glam::{DMat4, DQuat, DVec3};
 use radiosity_core::{Camera, Material, Polygon, PolygonMesh, Rgb, SceneError};
 
 use crate::LoadError;
-use crate::locate::one_line;
+use radiosity_core::escape_controls;
 
 /// Reflectance given to faces whose material is missing or unknown.
 pub const DEFAULT_GREY: f64 = 0.5;
@@ -159,7 +159,7 @@ pub fn parse_model(
 
 /// A model error at `origin` (and `line`, when known).
 pub(crate) fn model_error(origin: &str, line: Option<usize>, message: impl Into<String>) -> LoadError {
-    LoadError::Model { origin: one_line(origin), line, message: one_line(&message.into()) }
+    LoadError::Model { origin: escape_controls(origin), line, message: escape_controls(&message.into()) }
 }
 
 /// A validated material from a model file, with the file named in the error.
@@ -314,18 +314,6 @@ fn ear_clip(pts: &[DVec3]) -> Vec<[usize; 3]> {
         out.push([idx[0], idx[1], idx[2]]);
     }
     out
-}
-
-/// Names made unique by appending `#2`, `#3`, … to repeats, in order.
-pub(crate) fn unique_names(names: &mut [String]) {
-    let mut seen: HashMap<String, usize> = HashMap::new();
-    for name in names.iter_mut() {
-        let count = seen.entry(name.clone()).or_insert(0);
-        *count += 1;
-        if *count > 1 {
-            *name = format!("{name}#{count}");
-        }
-    }
 }
 
 #[cfg(test)]

@@ -9,11 +9,10 @@ use std::io::Cursor;
 use std::path::Path;
 
 use radiosity_core::glam::DVec3;
+use radiosity_core::unique_names;
 
 use crate::LoadError;
-use crate::model::{
-    DEFAULT_GREY, Model, ModelPart, PartBuilder, Transform, model_error, model_material, unique_names,
-};
+use crate::model::{DEFAULT_GREY, Model, ModelPart, PartBuilder, Transform, model_error, model_material};
 
 /// What the line scan learns: the line of every face, in file order.
 struct Scan {

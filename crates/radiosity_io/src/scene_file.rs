@@ -36,17 +36,9 @@ fn all_finite(a: &[f64; 3]) -> bool {
     a.iter().all(|c| c.is_finite())
 }
 
-/// Loads and validates a scene file.
-///
-/// # Errors
-/// [`LoadError::Unreadable`] naming the file when it cannot be read as UTF-8 text; otherwise
-/// as [`parse_scene`], with the path as origin.
-pub fn load_scene(path: &Path) -> Result<Scene, LoadError> {
-    load_scene_warned(path).map(|l| l.scene)
-}
-
 /// A scene and what the loader dropped or defaulted on the way (degenerate faces of a model,
-/// a missing MTL file), one line each, for the user to read.
+/// a missing MTL file), one line each, for the user to read. What every scene loader returns:
+/// a caller that shows nothing to a user may take `.scene` alone.
 #[derive(Clone, Debug)]
 pub struct LoadedScene {
     /// The validated scene.
@@ -55,22 +47,23 @@ pub struct LoadedScene {
     pub warnings: Vec<String>,
 }
 
-/// [`load_scene`] for a TOML scene file or a model file (`.obj`, `.gltf`, `.glb`, chosen by
+/// Loads and validates a TOML scene file or a model file (`.obj`, `.gltf`, `.glb`, chosen by
 /// extension), with the loader's warnings.
 ///
 /// A model file becomes a scene of its parts: named as in the file, the file's camera or none
 /// (the renderer frames the bounds), mesh sizes from the extent.
 ///
 /// # Errors
-/// As [`load_scene`] for TOML; [`LoadError::Model`] for model files, and for a model without
-/// any emitting material.
-pub fn load_scene_warned(path: &Path) -> Result<LoadedScene, LoadError> {
+/// [`LoadError::Unreadable`] naming the file when it cannot be read as UTF-8 text; otherwise
+/// as [`parse_scene`], with the path as origin; [`LoadError::Model`] for model files, and for a
+/// model without any emitting material.
+pub fn load_scene(path: &Path) -> Result<LoadedScene, LoadError> {
     if ModelFormat::from_path(path).is_some() {
         return scene_from_model(path);
     }
     let text = std::fs::read_to_string(path)
         .map_err(|e| LoadError::Unreadable { path: path.to_owned(), reason: e.to_string() })?;
-    parse_scene_warned(&text, &path.display().to_string())
+    parse_scene(&text, &path.display().to_string())
 }
 
 fn scene_from_model(path: &Path) -> Result<LoadedScene, LoadError> {
@@ -94,8 +87,9 @@ fn scene_from_model(path: &Path) -> Result<LoadedScene, LoadError> {
     Ok(LoadedScene { scene, warnings: model.warnings })
 }
 
-/// Parses and validates the text of a scene file; `origin` (usually the path) starts every
-/// error message.
+/// Parses and validates the text of a scene file, with the loader's warnings (from the model
+/// files of `mesh` objects, which are read relative to the folder of `origin`); `origin`
+/// (usually the path) starts every error message.
 ///
 /// The scene's name defaults to the file stem of `origin`; `[mesh]` sets [`Scene::mesh`] and
 /// `[solver]` sets [`Scene::solver`].
@@ -107,17 +101,8 @@ fn scene_from_model(path: &Path) -> Result<LoadedScene, LoadError> {
 /// planar convex non-degenerate polygons of 3+ vertices, radius > 0, box min < max, a usable
 /// camera, sizes > 0, `unshot_threshold` in (0, 1), `max_shots` ≥ 1, `time_limit` > 0, at
 /// least one object and at least one light. TOML's `nan` and `inf` are rejected wherever a
-/// number is validated.
-pub fn parse_scene(text: &str, origin: &str) -> Result<Scene, LoadError> {
-    parse_scene_warned(text, origin).map(|l| l.scene)
-}
-
-/// [`parse_scene`] with the loader's warnings (from the model files of `mesh` objects, which
-/// are read relative to the folder of `origin`).
-///
-/// # Errors
-/// As [`parse_scene`]; [`LoadError::Model`] for a broken model file.
-pub fn parse_scene_warned(text: &str, origin: &str) -> Result<LoadedScene, LoadError> {
+/// number is validated. [`LoadError::Model`] for a broken model file.
+pub fn parse_scene(text: &str, origin: &str) -> Result<LoadedScene, LoadError> {
     let loc = Locator { origin, text };
     let desc: SceneDesc = toml::from_str(text).map_err(|e| loc.toml_error(&e))?;
 

@@ -22,8 +22,10 @@ fn builtins_equal_their_files_on_disk() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
     for name in BUILTIN_SCENES {
         let path = dir.join(format!("{name}.toml"));
-        assert_eq!(load_scene(&path).unwrap(), builtin_scene(name).unwrap(), "{name}");
-        assert_eq!(resolve_scene(path.to_str().unwrap()).unwrap(), builtin_scene(name).unwrap(), "{name}");
+        assert_eq!(load_scene(&path).unwrap().scene, builtin_scene(name).unwrap(), "{name}");
+        let resolved = resolve_scene(path.to_str().unwrap()).unwrap();
+        assert_eq!(resolved.scene, builtin_scene(name).unwrap(), "{name}");
+        assert!(resolved.warnings.is_empty(), "{name}: {:?}", resolved.warnings);
     }
 }
 
@@ -37,9 +39,18 @@ fn two_plates_equals_the_canonical_scene() {
     assert_eq!(builtin_scene("two-plates").unwrap(), radiosity_core::two_plates(1.0, 1.0, 0.5, 1.0));
 }
 
+/// `scenes/cornell.toml` and the library's Cornell box are one scene: tests and benches that
+/// build the box in code solve what the command line solves.
+#[test]
+fn cornell_equals_the_canonical_scene() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+    assert_eq!(load_scene(&dir.join("cornell.toml")).unwrap().scene, radiosity_core::cornell_box());
+    assert_eq!(builtin_scene("cornell").unwrap(), radiosity_core::cornell_box());
+}
+
 #[test]
 fn cornell_is_the_measured_box() {
-    let s = resolve_scene("cornell").unwrap();
+    let s = resolve_scene("cornell").unwrap().scene;
     assert_eq!(s.name, "Cornell box");
     assert_eq!(s.materials.len(), 4);
     assert_eq!(s.objects.len(), 16);

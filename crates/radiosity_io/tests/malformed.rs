@@ -96,7 +96,7 @@ fn check_at(from: &str, to: &str, line: usize, key: &str, needle: &str) {
 
 #[test]
 fn base_scene_is_valid() {
-    let scene = parse_scene(BASE, "base.toml").unwrap();
+    let scene = parse_scene(BASE, "base.toml").unwrap().scene;
     assert_eq!(scene.name, "test");
     assert_eq!(scene.objects.len(), 4);
     assert_eq!(scene.mesh.unwrap().patch_size, 0.25);
@@ -602,5 +602,5 @@ fn errors_from_a_file_name_the_file() {
     );
     // The scene name defaults to the file stem.
     std::fs::write(&path, BASE.replacen("name = \"test\"\n", "", 1)).unwrap();
-    assert_eq!(load_scene(&path).unwrap().name, "radiosity_io_bad_rho");
+    assert_eq!(load_scene(&path).unwrap().scene.name, "radiosity_io_bad_rho");
 }

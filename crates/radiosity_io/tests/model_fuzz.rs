@@ -5,8 +5,9 @@
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::Path;
 
-use radiosity_core::{Mesh, Rgb};
-use radiosity_io::{ModelFormat, Transform, glb_bytes, parse_model, resolve_scene};
+use radiosity_core::{Mesh, Rgb, cornell_box};
+use radiosity_export::{VertexColours, glb_bytes};
+use radiosity_io::{ModelFormat, Transform, parse_model};
 use radiosity_solver::Solution;
 
 use radiosity_core::random::XorShift64;
@@ -139,13 +140,13 @@ fn mutated_gltf_files_never_panic() {
 /// reads positions and indices only).
 #[test]
 fn mutated_glb_files_never_panic() {
-    let scene = resolve_scene("cornell").unwrap();
+    let scene = cornell_box();
     let mesh = Mesh::build(&scene, &scene.mesh_params()).unwrap();
     let solution = Solution {
         vertex_radiosity: (0..mesh.positions.len()).map(|v| Rgb::splat(v as f64 / 1000.0)).collect(),
         ..Solution::default()
     };
-    let glb = glb_bytes(&mesh, &solution, radiosity_io::VertexColours::Linear { exposure_ev: 0.0 });
+    let glb = glb_bytes(&mesh, &solution, VertexColours::Linear { exposure_ev: 0.0 });
     // Its triangles have no material: default grey, so as a model it loads (with a warning).
     fuzz("lit.glb", &glb, ModelFormat::Gltf, None, 0x61b_5eed, 1500);
 }

@@ -3,12 +3,11 @@
 //! in seconds with coplanar triangles sharing one surface.
 
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 use std::time::Instant;
 
 use radiosity_core::{Mesh, MeshParams, Rgb, Scene};
-use radiosity_io::{LoadError, ModelFormat, Transform, load_scene_warned, parse_model, resolve_scene};
-use radiosity_solver::{Solver, SolverParams, occluder_triangles};
+use radiosity_io::{LoadError, ModelFormat, Transform, load_scene, parse_model, resolve_scene};
+use radiosity_solver::{Problem, SolverParams};
 
 fn scenes() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
@@ -16,11 +15,10 @@ fn scenes() -> PathBuf {
 
 /// Per-object mean radiosity of `scene` meshed with `params`, default solver settings.
 fn solve(scene: &Scene, params: &MeshParams) -> Vec<(String, Rgb)> {
-    let mesh = Arc::new(Mesh::build(scene, params).unwrap());
-    let accel = Arc::new(radiosity_accel::Bvh::new(&occluder_triangles(&mesh)));
-    let mut solver = Solver::new(mesh.clone(), accel, SolverParams::default()).unwrap();
+    let problem = Problem::new(scene, params).unwrap();
+    let mut solver = problem.solver(SolverParams::default()).unwrap();
     solver.solve();
-    solver.solution().object_radiosity(&mesh).into_iter().map(|o| (o.name, o.radiosity)).collect()
+    solver.solution().object_radiosity(problem.mesh()).into_iter().map(|o| (o.name, o.radiosity)).collect()
 }
 
 /// The OBJ (quads as in the TOML) and the glTF (each quad as two triangles, which the mesher
@@ -31,11 +29,11 @@ fn solve(scene: &Scene, params: &MeshParams) -> Vec<(String, Rgb)> {
 /// on the short block's shadowed sides between two seeds), which is why the order matters.
 #[test]
 fn cornell_box_as_obj_and_gltf_solves_like_the_toml() {
-    let toml = resolve_scene("cornell").unwrap();
+    let toml = resolve_scene("cornell").unwrap().scene;
     let params = toml.mesh_params();
     let expected = solve(&toml, &params);
     for file in ["cornell.obj", "cornell.gltf"] {
-        let loaded = load_scene_warned(&scenes().join(file)).unwrap();
+        let loaded = load_scene(&scenes().join(file)).unwrap();
         assert!(loaded.warnings.is_empty(), "{file}: {:?}", loaded.warnings);
         let mesh = Mesh::build(&loaded.scene, &params).unwrap();
         let toml_mesh = Mesh::build(&toml, &params).unwrap();
@@ -54,8 +52,8 @@ fn cornell_box_as_obj_and_gltf_solves_like_the_toml() {
 
 #[test]
 fn gltf_camera_and_materials_are_imported() {
-    let s = load_scene_warned(&scenes().join("cornell.gltf")).unwrap().scene;
-    let toml = resolve_scene("cornell").unwrap();
+    let s = load_scene(&scenes().join("cornell.gltf")).unwrap().scene;
+    let toml = resolve_scene("cornell").unwrap().scene;
     let (c, t) = (s.camera.unwrap(), toml.camera.unwrap());
     assert!((c.position - t.position).length() < 1e-3);
     assert!((c.look_at - c.position).normalize().dot((t.look_at - t.position).normalize()) > 1.0 - 1e-9);
@@ -94,7 +92,7 @@ transform = { translate = [1000, 0, 0], scale = [0.5, 1, 2], rotate_y_deg = 90.0
 "#;
     let path = dir.path().join("two.toml");
     std::fs::write(&path, text).unwrap();
-    let s = load_scene_warned(&path).unwrap().scene;
+    let s = load_scene(&path).unwrap().scene;
     assert_eq!(s.objects.len(), 32);
     assert_eq!(s.objects[0].name, "box/floor");
     assert_eq!(s.objects[16].name, "copy/floor");
@@ -109,7 +107,7 @@ transform = { translate = [1000, 0, 0], scale = [0.5, 1, 2], rotate_y_deg = 90.0
     // Mirroring keeps the lit side: the floor still faces up.
     let mirror = text.replace("scale = [0.5, 1, 2]", "scale = [-1, 1, 1]");
     std::fs::write(&path, mirror).unwrap();
-    let s = load_scene_warned(&path).unwrap().scene;
+    let s = load_scene(&path).unwrap().scene;
     let radiosity_core::Shape::Mesh(m) = &s.objects[16].shape else { panic!("a mesh") };
     assert!(m.polygons()[0].normal().y > 0.999);
 }
@@ -117,11 +115,12 @@ transform = { translate = [1000, 0, 0], scale = [0.5, 1, 2], rotate_y_deg = 90.0
 fn obj_error(text: &str) -> String {
     let e =
         parse_model(text.as_bytes(), "model.obj", None, ModelFormat::Obj, &Transform::default()).unwrap_err();
-    one_line(&e)
+    user_message(&e)
 }
 
-fn one_line(e: &LoadError) -> String {
-    let s = e.to_string();
+/// The error as the user reads it, checked to be one line with exit code 2.
+fn user_message(e: &LoadError) -> String {
+    let s = radiosity_core::one_line(e);
     assert_eq!(s.lines().count(), 1, "not one line: {s}");
     assert_eq!(e.exit_code(), 2);
     s
@@ -145,8 +144,8 @@ fn broken_obj_files_are_one_line_errors() {
         "model.obj:3: face 1: vertex index 0 out of range (file has 2 vertices)"
     );
     // A missing file, through the scene loader.
-    let e = load_scene_warned(Path::new("no/such/model.obj")).unwrap_err();
-    assert!(one_line(&e).starts_with("no/such/model.obj: cannot read the model file"), "{e}");
+    let e = load_scene(Path::new("no/such/model.obj")).unwrap_err();
+    assert!(user_message(&e).starts_with("no/such/model.obj: cannot read the model file"), "{e}");
 }
 
 #[test]
@@ -159,8 +158,8 @@ fn reflectance_of_one_is_rejected_at_its_mtl_line() {
     .unwrap();
     let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl snow\nf 1 2 3\n";
     std::fs::write(dir.path().join("m.obj"), obj).unwrap();
-    let e = load_scene_warned(&dir.path().join("m.obj")).unwrap_err();
-    let s = one_line(&e);
+    let e = load_scene(&dir.path().join("m.obj")).unwrap_err();
+    let s = user_message(&e);
     let mtl = dir.path().join("m.mtl").display().to_string();
     assert!(s.starts_with(&format!("{mtl}:6: reflectance of material 'snow' must be in [0, 1)")), "{s}");
 }
@@ -179,8 +178,8 @@ fn a_missing_mtl_gives_grey_and_a_warning_and_no_light_is_an_error() {
         m.warnings
     );
     // As a scene on its own it has no light: said so, naming the file.
-    let e = load_scene_warned(&path).unwrap_err();
-    assert!(one_line(&e).contains("the scene has no light"), "{e}");
+    let e = load_scene(&path).unwrap_err();
+    assert!(user_message(&e).contains("the scene has no light"), "{e}");
 }
 
 #[test]
@@ -253,26 +252,27 @@ fn broken_gltf_files_are_one_line_errors() {
 
     let e = gltf_result(&gltf_with(&tri, &[0, 1, 40], LAMP)).unwrap_err();
     assert_eq!(
-        one_line(&e),
+        user_message(&e),
         "model.gltf: mesh 0 ('tri') primitive 0: triangle 0: vertex index 40 out of range (POSITION has 3 vertices)"
     );
     let nan = [0.0, 0.0, 0.0, f32::NAN, 0.0, 0.0, 0.0, 1.0, 0.0];
     let e = gltf_result(&gltf_with(&nan, &[0, 1, 2], LAMP)).unwrap_err();
     assert!(
-        one_line(&e)
+        user_message(&e)
             .starts_with("model.gltf: mesh 0 ('tri') primitive 0: vertex 1: coordinates must be finite"),
         "{e}"
     );
     let white = r#"{"name":"snow","pbrMetallicRoughness":{"baseColorFactor":[1,1,1,1]}}"#;
     let e = gltf_result(&gltf_with(&tri, &[0, 1, 2], white)).unwrap_err();
     assert!(
-        one_line(&e).starts_with("model.gltf: material 0: reflectance of material 'snow' must be in [0, 1)"),
+        user_message(&e)
+            .starts_with("model.gltf: material 0: reflectance of material 'snow' must be in [0, 1)"),
         "{e}"
     );
     // Zero area only: an error; with another triangle: dropped and counted.
     let flat = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 2.0, 0.0, 0.0];
     let e = gltf_result(&gltf_with(&flat, &[0, 1, 2], LAMP)).unwrap_err();
-    assert_eq!(one_line(&e), "model.gltf: no triangle with an area in the default scene");
+    assert_eq!(user_message(&e), "model.gltf: no triangle with an area in the default scene");
     let both = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 2.0, 0.0, 0.0];
     let m = gltf_result(&gltf_with(&both, &[0, 1, 2, 0, 1, 3], LAMP)).unwrap();
     assert!(m.warnings.iter().any(|w| w.contains("1 degenerate triangle(s)")), "{:?}", m.warnings);
@@ -285,7 +285,7 @@ fn broken_gltf_files_are_one_line_errors() {
     );
     let e = gltf_result(&long).unwrap_err();
     assert!(
-        one_line(&e)
+        user_message(&e)
             .contains("POSITION accessor 0: 300 elements from byte 0 run past its buffer view (36 bytes)"),
         "{e}"
     );
@@ -293,11 +293,11 @@ fn broken_gltf_files_are_one_line_errors() {
         gltf_with(&tri, &[0, 1, 2], LAMP).replacen("\"componentType\":5125", "\"componentType\":5126", 1);
     let e = gltf_result(&float_indices).unwrap_err();
     assert!(
-        one_line(&e).contains("indices accessor 1: expected Scalar of [U8, U16, U32], got Scalar of F32"),
+        user_message(&e).contains("indices accessor 1: expected Scalar of [U8, U16, U32], got Scalar of F32"),
         "{e}"
     );
     let e = gltf_result("{ not json").unwrap_err();
-    assert!(one_line(&e).starts_with("model.gltf: glTF: "), "{e}");
+    assert!(user_message(&e).starts_with("model.gltf: glTF: "), "{e}");
 }
 
 /// A 100k+ triangle OBJ (a flat 230×230 grid of squares, each two triangles, plus a lamp)
@@ -332,7 +332,7 @@ fn a_hundred_thousand_triangles_load_in_seconds() {
     let path = dir.path().join("grid.obj");
     std::fs::write(&path, &text).unwrap();
     let start = Instant::now();
-    let scene = load_scene_warned(&path).unwrap().scene;
+    let scene = load_scene(&path).unwrap().scene;
     let load = start.elapsed().as_secs_f64();
     let radiosity_core::Shape::Mesh(floor) = &scene.objects[0].shape else { panic!("a mesh") };
     assert_eq!(floor.faces().len(), 2 * n * n);
@@ -374,7 +374,7 @@ fn gltf_node_transforms_and_texture_means() {
     let p = m.parts[0].mesh.positions();
     assert_eq!(p[1], radiosity_core::glam::DVec3::new(12.0, 0.0, 0.0));
     let rho = m.materials[0].reflectance;
-    let green = radiosity_image::srgb_decode(188.0 / 255.0);
+    let green = radiosity_core::srgb_decode(188.0 / 255.0);
     assert!(
         (rho - Rgb::new(0.8 * 0.5, 0.8 * green, 0.0)).max_channel().abs() < 1e-6,
         "{rho:?} {:?}",

@@ -6,17 +6,16 @@
 //! `radiosity bench`.
 
 use std::hint::black_box;
-use std::sync::Arc;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{DVec3, Vec3};
 use radiosity_accel::{Bvh, CandidateTriangles, RayQuery, Segments4};
-use radiosity_core::{Mesh, MeshParams, furnace_box};
+use radiosity_core::{MeshParams, furnace_box};
 use radiosity_solver::form_factor::{
     Rule, for_each_point, point_to_polygon, point_to_polygon_in_front, point_to_polygon_in_front_x4,
     points_to_polygon_in_front_x4,
 };
-use radiosity_solver::{Solver, SolverParams, StepBudget, occluder_triangles};
+use radiosity_solver::{Problem, SolverParams, StepBudget};
 
 fn square(z: f64, size: f64) -> Vec<DVec3> {
     vec![
@@ -106,11 +105,9 @@ fn rays(c: &mut Criterion) {
 
 fn shots(c: &mut Criterion) {
     let scene = furnace_box(0.7, 1.0);
-    let mesh = Arc::new(Mesh::build(&scene, &MeshParams::try_new(0.25, 0.05).unwrap()).unwrap());
-    let accel = Arc::new(Bvh::new(&occluder_triangles(&mesh)));
-    let elements = mesh.elements.len();
-    let mut solver =
-        Solver::new(mesh, accel, SolverParams { unshot_threshold: 1e-12, ..Default::default() }).unwrap();
+    let problem = Problem::new(&scene, &MeshParams::try_new(0.25, 0.05).unwrap()).unwrap();
+    let elements = problem.mesh().elements.len();
+    let mut solver = problem.solver(SolverParams { unshot_threshold: 1e-12, ..Default::default() }).unwrap();
     c.bench_function(&format!("one shot, furnace box, {elements} elements"), |b| {
         b.iter(|| solver.step(StepBudget::Shots(1)))
     });

@@ -4,14 +4,12 @@
 //! loop:
 //!
 //! ```
-//! use std::sync::Arc;
-//! use radiosity_core::{Mesh, furnace_box};
-//! use radiosity_solver::{Solver, SolverParams, StepBudget, occluder_triangles};
+//! use radiosity_core::furnace_box;
+//! use radiosity_solver::{Problem, SolverParams, StepBudget};
 //!
 //! let scene = furnace_box(0.5, 1.0);
-//! let mesh = Arc::new(Mesh::build(&scene, &scene.mesh_params()).unwrap());
-//! let accel = Arc::new(radiosity_accel::Bvh::new(&occluder_triangles(&mesh)));
-//! let mut solver = Solver::new(mesh, accel, SolverParams::default()).unwrap();
+//! let problem = Problem::new(&scene, &scene.mesh_params()).unwrap(); // mesh + ray queries
+//! let mut solver = problem.solver(SolverParams::default()).unwrap();
 //! while solver.stop_reason().is_none() {
 //!     let report = solver.step(StepBudget::Shots(64));
 //!     let _snapshot = solver.solution(); // publish to a viewer, a progress bar, …
@@ -23,12 +21,14 @@
 
 pub mod form_factor;
 mod occluders;
+mod problem;
 mod sampling;
 mod shaft;
 mod solution;
 mod solver;
 
 pub use occluders::occluder_triangles;
+pub use problem::Problem;
 pub use solution::{ObjectRadiosity, Solution};
 pub use solver::{
     Ambient, EnergyBalance, FormFactorMethod, Overshoot, Solver, SolverError, SolverParams, StepBudget,

@@ -2,16 +2,15 @@
 
 use std::sync::Arc;
 
-use radiosity_accel::Bvh;
 use radiosity_core::{
     Mesh, MeshParams, Rgb, Scene, furnace_box, furnace_sphere, two_plates, unit_cube_floor_light,
 };
-use radiosity_solver::{Overshoot, Solver, SolverParams, StepBudget, StopReason, occluder_triangles};
+use radiosity_solver::{
+    Overshoot, Problem, Solver, SolverParams, StepBudget, StopReason, occluder_triangles,
+};
 
 fn solver_for(scene: &Scene, params: SolverParams) -> Solver {
-    let mesh = Arc::new(Mesh::build(scene, &scene.mesh_params()).unwrap());
-    let accel = Arc::new(Bvh::new(&occluder_triangles(&mesh)));
-    Solver::new(mesh, accel, params).unwrap()
+    Problem::new(scene, &scene.mesh_params()).unwrap().solver(params).unwrap()
 }
 
 fn converged(scene: &Scene, threshold: f64) -> Solver {
@@ -199,14 +198,14 @@ fn culled_visibility_matches_brute_force_on_every_triangle() {
         material: 1,
         shape: radiosity_core::Shape::Polygons(vec![lamp]),
     });
-    let mesh = Arc::new(Mesh::build(&scene, &MeshParams::try_new(0.25, 0.0625).unwrap()).unwrap());
+    let fast = Problem::new(&scene, &MeshParams::try_new(0.25, 0.0625).unwrap()).unwrap();
+    let mesh = fast.mesh().clone();
     let params = SolverParams { max_shots: Some(80), ..SolverParams::default() };
-    let fast = Arc::new(Bvh::new(&occluder_triangles(&mesh)));
     let all: Vec<[glam::Vec3; 3]> = mesh.occluders.iter().map(|t| t.map(|p| p.as_vec3())).collect();
     assert!(occluder_triangles(&mesh).len() < all.len());
-    let brute = Arc::new(radiosity_accel::BruteForce::new(&all));
-    let mut a = Solver::new(mesh.clone(), fast, params.clone()).unwrap();
-    let mut b = Solver::new(mesh, brute, params).unwrap();
+    let brute = Problem::with_ray_queries(mesh, Arc::new(radiosity_accel::BruteForce::new(&all)));
+    let mut a = fast.solver(params.clone()).unwrap();
+    let mut b = brute.solver(params).unwrap();
     a.solve();
     b.solve();
     for (x, y) in a.solution().element_radiosity.iter().zip(b.solution().element_radiosity.iter()) {
@@ -274,7 +273,6 @@ fn a_mesh_with_patches_out_of_order_is_refused() {
     let mut mesh = Mesh::build(&scene, &scene.mesh_params()).unwrap();
     assert!(mesh.patches.len() > 1);
     mesh.patches.swap(0, 1);
-    let accel = Arc::new(Bvh::new(&occluder_triangles(&mesh)));
-    let err = Solver::new(Arc::new(mesh), accel, SolverParams::default()).err().unwrap();
+    let err = Problem::from_mesh(Arc::new(mesh)).solver(SolverParams::default()).err().unwrap();
     assert!(matches!(err, radiosity_solver::SolverError::BadMesh { patch: 0 }), "{err}");
 }

@@ -1008,7 +1008,7 @@ mod tests {
     const LONG: Duration = Duration::from_secs(60);
 
     fn harness(scene: &str, shots: Option<u64>, dir: &std::path::Path) -> Harness<'static, ViewerApp> {
-        let mut options = ViewerOptions::new(radiosity_io::resolve_scene(scene).unwrap(), scene);
+        let mut options = ViewerOptions::new(radiosity_io::resolve_scene(scene).unwrap().scene, scene);
         options.samples = 1;
         options.threads = Some(1);
         options.screenshot_dir = dir.to_owned();

@@ -160,20 +160,11 @@ pub fn default_samples() -> u32 {
     }
 }
 
-/// An error and its causes on one line, joined by ": " exactly as the command prints them.
-pub fn one_line(e: &(dyn std::error::Error + 'static)) -> String {
-    let mut parts = vec![e.to_string()];
-    let mut source = e.source();
-    while let Some(s) = source {
-        parts.push(s.to_string());
-        source = s.source();
-    }
-    parts.join(": ")
-}
-
-/// Loads a scene file or built-in name, the error on one line as the command prints it.
+/// Loads a scene file or built-in name, the error on one line as the command prints it
+/// ([`radiosity_core::one_line`]). The loader's warnings are dropped: the window has no place
+/// for them yet.
 fn load_scene(arg: &str) -> Result<Scene, String> {
-    radiosity_io::resolve_scene(arg).map_err(|e| one_line(&e))
+    radiosity_io::resolve_scene(arg).map(|loaded| loaded.scene).map_err(|e| radiosity_core::one_line(&e))
 }
 
 #[cfg(test)]

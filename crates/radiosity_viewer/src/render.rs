@@ -801,11 +801,11 @@ mod tests {
     /// blocks aside.
     #[test]
     fn auto_exposure_agrees_with_the_cpu_renderer() {
-        use radiosity_solver::{Solver, SolverParams, StepBudget, occluder_triangles};
-        let scene = radiosity_io::resolve_scene("cornell").unwrap();
-        let mesh = Arc::new(Mesh::build(&scene, &scene.mesh_params()).unwrap());
-        let accel = Arc::new(radiosity_accel::Bvh::new(&occluder_triangles(&mesh)));
-        let mut solver = Solver::new(mesh.clone(), accel, SolverParams::preview()).unwrap();
+        use radiosity_solver::{Problem, SolverParams, StepBudget};
+        let scene = radiosity_core::cornell_box();
+        let problem = Problem::new(&scene, &scene.mesh_params()).unwrap();
+        let mesh = problem.mesh();
+        let mut solver = problem.solver(SolverParams::preview()).unwrap();
         solver.step(StepBudget::Shots(200));
         let solution = solver.solution();
         let camera = scene.camera.unwrap();
@@ -817,7 +817,7 @@ mod tests {
         let fly = crate::FlyCamera::from_scene_camera(&camera, &crate::SceneExtent::new(lo, hi));
         let aspect = f64::from(params.width) / f64::from(params.height);
         let gpu = auto_exposure_ev(
-            &mesh,
+            mesh,
             &solution,
             fly.clip_from_view(aspect) * fly.view_from_world(),
             fly.position,

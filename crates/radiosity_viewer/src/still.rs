@@ -102,7 +102,7 @@ mod tests {
     use super::*;
     use radiosity_core::glam::DVec3;
     use radiosity_core::{MeshParams, furnace_box};
-    use radiosity_solver::{Solver, SolverParams, StepBudget, occluder_triangles};
+    use radiosity_solver::{Problem, SolverParams, StepBudget};
 
     #[test]
     fn still_size_keeps_the_aspect_and_caps_the_side() {
@@ -116,9 +116,9 @@ mod tests {
     #[test]
     fn a_still_of_the_furnace_arrives_with_its_radiance() {
         let scene = furnace_box(0.5, 1.0);
-        let mesh = Arc::new(Mesh::build(&scene, &MeshParams::try_new(0.5, 0.25).unwrap()).unwrap());
-        let rays = Arc::new(radiosity_accel::Bvh::new(&occluder_triangles(&mesh)));
-        let mut solver = Solver::new(mesh.clone(), rays, SolverParams::default()).unwrap();
+        let problem = Problem::new(&scene, &MeshParams::try_new(0.5, 0.25).unwrap()).unwrap();
+        let mesh = problem.mesh().clone();
+        let mut solver = problem.solver(SolverParams::default()).unwrap();
         solver.step(StepBudget::Shots(u64::MAX));
         let camera = Camera::try_new(DVec3::splat(0.5), DVec3::new(1.0, 0.7, 1.0), DVec3::Y, 90.0).unwrap();
         let job = StillJob::spawn(mesh, solver.solution(), camera, [32, 24], Gather::Direct, || {});

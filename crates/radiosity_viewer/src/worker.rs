@@ -13,9 +13,8 @@ use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use radiosity_accel::Bvh;
 use radiosity_core::{Mesh, MeshParams, Scene};
-use radiosity_solver::{Solution, Solver, SolverParams, StepBudget, StopReason, occluder_triangles};
+use radiosity_solver::{Problem, Solution, Solver, SolverParams, StepBudget, StopReason};
 
 /// How long the worker shoots between two publications: 20 updates a second, well above the
 /// 10 the viewer promises, while a publication (a copy of the solution) stays a small cost.
@@ -292,8 +291,7 @@ impl Drop for SolveWorker {
 /// A job that meshed, with its solver.
 struct Run {
     job: SolveJob,
-    mesh: Arc<Mesh>,
-    accel: Arc<Bvh>,
+    problem: Problem,
     solver: Solver,
 }
 
@@ -419,15 +417,15 @@ impl Worker {
 
     fn start(&mut self, job: SolveJob) {
         self.set_state(WorkerState::Meshing);
-        let reuse =
-            self.run.as_ref().filter(|r| r.job.same_mesh(&job)).map(|r| (r.mesh.clone(), r.accel.clone()));
+        let reuse = self.run.as_ref().filter(|r| r.job.same_mesh(&job)).map(|r| r.problem.clone());
         let built = match reuse {
-            Some(m) => Ok(m),
-            None => self.in_pool(|| build_mesh(&job)),
+            Some(p) => Ok(p),
+            None => self.in_pool(|| build_problem(&job)),
         };
-        let started = built.and_then(|(mesh, accel)| {
-            Solver::new(mesh.clone(), accel.clone(), job.solver_params.clone())
-                .map(|solver| Run { job, mesh, accel, solver })
+        let started = built.and_then(|problem| {
+            problem
+                .solver(job.solver_params.clone())
+                .map(|solver| Run { job, problem, solver })
                 .map_err(|e| format!("cannot start the solver: {e}"))
         });
         match started {
@@ -494,8 +492,8 @@ impl Worker {
         match &self.run {
             None => Progress::default(),
             Some(r) => Progress {
-                patches: r.mesh.patches.len(),
-                elements: r.mesh.elements.len(),
+                patches: r.problem.mesh().patches.len(),
+                elements: r.problem.mesh().elements.len(),
                 shots: r.solver.shots(),
                 unshot_fraction: r.solver.unshot_fraction(),
                 unshot_threshold: r.job.solver_params.unshot_threshold,
@@ -527,7 +525,7 @@ impl Worker {
         let snapshot = match (&self.run, stale) {
             (Some(r), true) => Some(Arc::new(Snapshot {
                 generation: self.generation,
-                mesh: r.mesh.clone(),
+                mesh: r.problem.mesh().clone(),
                 job: r.job.clone(),
                 solution: r.solver.solution(),
                 progress: status.progress.clone(),
@@ -549,12 +547,10 @@ impl Worker {
 }
 
 /// Meshes the job's scene (light scale applied) and builds its ray-query structure.
-fn build_mesh(job: &SolveJob) -> Result<(Arc<Mesh>, Arc<Bvh>), String> {
+fn build_problem(job: &SolveJob) -> Result<Problem, String> {
     let mut scene = (*job.scene).clone();
     scene.scale_emission(job.light_scale);
-    let mesh = Mesh::build(&scene, &job.mesh_params).map_err(|e| format!("cannot mesh the scene: {e}"))?;
-    let accel = Bvh::new(&occluder_triangles(&mesh));
-    Ok((Arc::new(mesh), Arc::new(accel)))
+    Problem::new(&scene, &job.mesh_params).map_err(|e| format!("cannot mesh the scene: {e}"))
 }
 
 #[cfg(test)]

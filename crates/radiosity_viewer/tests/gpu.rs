@@ -3,13 +3,11 @@
 //! work without one either.
 
 use std::path::PathBuf;
-use std::sync::Arc;
 
 use eframe::wgpu;
-use glam::DVec3;
-use radiosity_core::{Camera, Material, Mesh, MeshParams, Object, Polygon, Rgb, Scene, Shape};
-use radiosity_image::{ToneOperator, ToneParams, srgb_encode, tone_map};
-use radiosity_solver::{Solver, SolverParams, StepBudget, occluder_triangles};
+use radiosity_core::{MeshParams, Rgb, cornell_box, srgb_encode};
+use radiosity_image::{ToneOperator, ToneParams, tone_map};
+use radiosity_solver::{Problem, SolverParams, StepBudget};
 use radiosity_viewer::render::{false_colour, shader_operator};
 use radiosity_viewer::{
     COLOR_FORMAT, DisplayMode, FlyCamera, FrameParams, RenderTarget, SceneExtent, SceneRenderer,
@@ -100,7 +98,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     bytemuck::cast_slice(&data).to_vec()
 }
 
-/// The shader's tone map is the CPU's (radiosity_image::tone_map + srgb_encode, what
+/// The shader's tone map is the CPU's (radiosity_image::tone_map + radiosity_core::srgb_encode, what
 /// `render` writes to PNG): every operator, exposures from −8 to +8 EV, radiance from black
 /// through mid-tones to far over white, greys and saturated colours. Tolerance 2e-4 on [0, 1]
 /// display values: f32 against f64 arithmetic and the GPU's pow/exp approximations, well under
@@ -168,59 +166,6 @@ fn gpu_tone_map_agrees_with_the_cpu_on_a_table_of_values() {
     eprintln!("{} cases, largest difference {worst:.2e}", table.len());
 }
 
-/// The Cornell box's walls, light and no blocks, in millimetres as in scenes/cornell.toml.
-fn cornell_walls() -> Scene {
-    let m = |name: &str, r: [f64; 3], e: [f64; 3]| {
-        Material::try_new(name, Rgb::from_array(r), Rgb::from_array(e)).unwrap()
-    };
-    let materials = vec![
-        m("white", [0.738, 0.736, 0.738], [0.0; 3]),
-        m("green", [0.069, 0.398, 0.087], [0.0; 3]),
-        m("red", [0.494, 0.049, 0.051], [0.0; 3]),
-        m("light", [0.0; 3], [65.3, 34.1, 8.7]),
-    ];
-    let quad = |name: &str, material: usize, v: [[f64; 3]; 4]| Object {
-        name: name.into(),
-        material,
-        shape: Shape::Polygons(vec![
-            Polygon::try_new(v.iter().map(|p| DVec3::from_array(*p)).collect()).unwrap(),
-        ]),
-    };
-    let objects = vec![
-        quad("floor", 0, [[552.8, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 559.2], [549.6, 0.0, 559.2]]),
-        quad(
-            "ceiling",
-            0,
-            [[556.0, 548.8, 0.0], [556.0, 548.8, 559.2], [0.0, 548.8, 559.2], [0.0, 548.8, 0.0]],
-        ),
-        quad("back", 0, [[549.6, 0.0, 559.2], [0.0, 0.0, 559.2], [0.0, 548.8, 559.2], [556.0, 548.8, 559.2]]),
-        quad("green", 1, [[0.0, 0.0, 559.2], [0.0, 0.0, 0.0], [0.0, 548.8, 0.0], [0.0, 548.8, 559.2]]),
-        // Slightly twisted in the measured data, so two triangles.
-        Object {
-            name: "red".into(),
-            material: 2,
-            shape: Shape::Polygons(
-                [
-                    [[552.8, 0.0, 0.0], [549.6, 0.0, 559.2], [556.0, 548.8, 559.2]],
-                    [[552.8, 0.0, 0.0], [556.0, 548.8, 559.2], [556.0, 548.8, 0.0]],
-                ]
-                .iter()
-                .map(|t| Polygon::try_new(t.iter().map(|p| DVec3::from_array(*p)).collect()).unwrap())
-                .collect(),
-            ),
-        },
-        quad(
-            "light",
-            3,
-            [[343.0, 548.7, 227.0], [343.0, 548.7, 332.0], [213.0, 548.7, 332.0], [213.0, 548.7, 227.0]],
-        ),
-    ];
-    let camera =
-        Camera::try_new(DVec3::new(278.0, 273.0, -800.0), DVec3::new(278.0, 273.0, 0.0), DVec3::Y, 39.3076)
-            .unwrap();
-    Scene::try_new("Cornell walls", Some(camera), materials, objects).unwrap()
-}
-
 /// Mean sRGB colour of the pixels in the column range `[x0, x1)` of the middle rows.
 fn mean_rgb(img: &image::RgbaImage, x0: f64, x1: f64) -> [f64; 3] {
     let (w, h) = img.dimensions();
@@ -243,10 +188,10 @@ fn mean_rgb(img: &image::RgbaImage, x0: f64, x1: f64) -> [f64; 3] {
 #[test]
 fn offscreen_cornell_shows_red_left_and_green_right() {
     let (device, queue) = gpu();
-    let scene = cornell_walls();
-    let mesh = Arc::new(Mesh::build(&scene, &MeshParams::try_new(120.0, 40.0).unwrap()).unwrap());
-    let accel = Arc::new(radiosity_accel::Bvh::new(&occluder_triangles(&mesh)));
-    let mut solver = Solver::new(mesh.clone(), accel, SolverParams::preview()).unwrap();
+    let scene = cornell_box();
+    let problem = Problem::new(&scene, &MeshParams::try_new(120.0, 40.0).unwrap()).unwrap();
+    let mesh = problem.mesh();
+    let mut solver = problem.solver(SolverParams::preview()).unwrap();
     solver.step(StepBudget::Shots(300));
     let solution = solver.solution();
 
@@ -263,7 +208,7 @@ fn offscreen_cornell_shows_red_left_and_green_right() {
     ] {
         let mut renderer = SceneRenderer::new(&device, COLOR_FORMAT, 1);
         let target = RenderTarget::new(&device, [w, h], COLOR_FORMAT, 1);
-        renderer.set_mesh(&device, &mesh);
+        renderer.set_mesh(&device, mesh);
         renderer.set_solution(&queue, &solution, mode);
         let frame = FrameParams {
             clip_from_world: camera.clip_from_view(aspect) * camera.view_from_world(),
@@ -299,10 +244,10 @@ fn offscreen_cornell_shows_red_left_and_green_right() {
 #[test]
 fn any_target_format_gives_the_same_picture() {
     let (device, queue) = gpu();
-    let scene = cornell_walls();
-    let mesh = Arc::new(Mesh::build(&scene, &MeshParams::try_new(120.0, 40.0).unwrap()).unwrap());
-    let accel = Arc::new(radiosity_accel::Bvh::new(&occluder_triangles(&mesh)));
-    let mut solver = Solver::new(mesh.clone(), accel, SolverParams::preview()).unwrap();
+    let scene = cornell_box();
+    let problem = Problem::new(&scene, &MeshParams::try_new(120.0, 40.0).unwrap()).unwrap();
+    let mesh = problem.mesh();
+    let mut solver = problem.solver(SolverParams::preview()).unwrap();
     solver.step(StepBudget::Shots(100));
     let solution = solver.solution();
     let (w, h) = (160u32, 120u32);
@@ -319,7 +264,7 @@ fn any_target_format_gives_the_same_picture() {
     };
     let picture = |format, samples| {
         let mut renderer = SceneRenderer::new(&device, format, samples);
-        renderer.set_mesh(&device, &mesh);
+        renderer.set_mesh(&device, mesh);
         renderer.set_solution(&queue, &solution, DisplayMode::Smooth);
         let target = RenderTarget::new(&device, [w, h], format, samples);
         renderer.draw(&device, &queue, &target, &frame);

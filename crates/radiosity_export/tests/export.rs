@@ -4,23 +4,22 @@
 
 use std::sync::Arc;
 
-use radiosity_core::{Mesh, Rgb};
-use radiosity_image::{ToneOperator, ToneParams};
-use radiosity_io::{
-    LIGHTMAP_CELL_TEXELS, VertexColours, glb_bytes, gltf_text, lightmaps, ply_bytes, resolve_scene,
-    vertex_colours, write_lightmaps,
+use radiosity_core::{Mesh, Rgb, cornell_box};
+use radiosity_export::{
+    LIGHTMAP_CELL_TEXELS, VertexColours, glb_bytes, gltf_text, lightmaps, ply_bytes, vertex_colours,
+    write_lightmaps,
 };
-use radiosity_solver::{Solution, Solver, SolverParams, occluder_triangles};
+use radiosity_image::{ToneOperator, ToneParams};
+use radiosity_solver::{Problem, Solution, SolverParams};
 
 /// The Cornell box after 150 shots: enough light everywhere for the values to be distinct.
 fn solved() -> (Arc<Mesh>, Solution) {
-    let scene = resolve_scene("cornell").unwrap();
-    let mesh = Arc::new(Mesh::build(&scene, &scene.mesh_params()).unwrap());
-    let accel = Arc::new(radiosity_accel::Bvh::new(&occluder_triangles(&mesh)));
+    let scene = cornell_box();
+    let problem = Problem::new(&scene, &scene.mesh_params()).unwrap();
     let params = SolverParams { max_shots: Some(150), ..SolverParams::default() };
-    let mut solver = Solver::new(mesh.clone(), accel, params).unwrap();
+    let mut solver = problem.solver(params).unwrap();
     solver.solve();
-    (mesh, solver.solution())
+    (problem.mesh().clone(), solver.solution())
 }
 
 /// What a reloaded file holds, all primitives in node order.
@@ -137,7 +136,7 @@ fn ply_holds_display_colours_and_radiosity() {
         let at = end + v * vertex_size;
         let f = |o: usize| f32::from_le_bytes(bytes[at + o..at + o + 4].try_into().unwrap());
         assert_eq!([f(0), f(4), f(8)], mesh.positions[v].as_vec3().to_array());
-        assert_eq!(&bytes[at + 12..at + 15], &radiosity_image::encode_srgb(shown[v]));
+        assert_eq!(&bytes[at + 12..at + 15], &radiosity_core::encode_srgb(shown[v]));
         assert!(close([f(15), f(19), f(23)], solution.vertex_radiosity[v], 1e-6));
     }
 }

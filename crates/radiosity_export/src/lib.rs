@@ -13,12 +13,17 @@
 //!   display colour, what PLY viewers show) and `float radiosity_r radiosity_g radiosity_b`
 //!   (linear B); faces are the elements (triangles and quads) as `list uchar uint`.
 //! * Lightmaps: see [`write_lightmaps`].
+//!
+//! Scene files come in through `radiosity_io`; lit meshes go out here, so the scene loader
+//! needs neither the solver nor the picture-file formats.
+#![warn(missing_docs)]
+#![forbid(unsafe_code)]
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use radiosity_core::{Mesh, Rgb};
-use radiosity_image::{HdrImage, ToneOperator, ToneParams, encode_srgb, tone_map};
+use radiosity_core::{Mesh, Rgb, encode_srgb, unique_names};
+use radiosity_image::{HdrImage, ToneOperator, ToneParams, tone_map};
 use radiosity_solver::Solution;
 use serde_json::{Value, json};
 
@@ -369,7 +374,7 @@ pub fn write_lightmaps(dir: &Path, mesh: &Mesh, solution: &Solution) -> Result<V
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: cannot create the folder: {e}", dir.display()))?;
     let maps = lightmaps(mesh, solution);
     let mut stems: Vec<String> = maps.iter().map(|m| file_stem_for(&mesh.object_names[m.object])).collect();
-    crate::model::unique_names(&mut stems);
+    unique_names(&mut stems);
     let mut written = Vec::new();
     let mut obj = String::from(
         "# radiosity lightmaps: one material and one EXR (linear radiosity) per object\nmtllib lightmapped.mtl\n",

@@ -1,0 +1,63 @@
+//! Errors as the user reads them: one line, whatever the error and whatever a file held.
+//!
+//! Every place that shows an error (the command line's `error: …`, the viewer's status line,
+//! the scene loader's messages) goes through these two functions, so a message reads the same
+//! wherever it appears and a script can take one line per error.
+
+/// An error and its causes on one line, joined by ": " (outermost first), with control
+/// characters escaped.
+///
+/// ```
+/// let e = std::io::Error::other("disk full");
+/// assert_eq!(radiosity_core::one_line(&e), "disk full");
+/// ```
+pub fn one_line(e: &(dyn std::error::Error + 'static)) -> String {
+    let mut parts = vec![escape_controls(&e.to_string())];
+    let mut source = e.source();
+    while let Some(s) = source {
+        parts.push(escape_controls(&s.to_string()));
+        source = s.source();
+    }
+    parts.join(": ")
+}
+
+/// `s` with control characters (a newline in a material name, say) escaped as Rust escapes
+/// them (`\n`, `\t`, `\u{1b}`), so that a message stays one line whatever a file holds.
+pub fn escape_controls(s: &str) -> String {
+    if !s.chars().any(char::is_control) {
+        return s.to_owned();
+    }
+    s.chars().map(|c| if c.is_control() { c.escape_default().to_string() } else { c.to_string() }).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[derive(Debug)]
+    struct Outer(std::io::Error);
+
+    impl std::fmt::Display for Outer {
+        fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+            f.write_str("cannot load\nthe scene")
+        }
+    }
+
+    impl std::error::Error for Outer {
+        fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+            Some(&self.0)
+        }
+    }
+
+    #[test]
+    fn causes_are_joined_and_control_characters_escaped() {
+        let e = Outer(std::io::Error::other("no such file"));
+        assert_eq!(one_line(&e), "cannot load\\nthe scene: no such file");
+    }
+
+    #[test]
+    fn plain_text_is_kept() {
+        assert_eq!(escape_controls("a\nb\tc"), "a\\nb\\tc");
+        assert_eq!(escape_controls("plain"), "plain");
+    }
+}
