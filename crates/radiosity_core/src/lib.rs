@@ -17,8 +17,8 @@ pub use canonical::{furnace_box, furnace_sphere, two_plates, unit_cube_floor_lig
 pub use color::Rgb;
 pub use mesh::{Element, MAX_ELEMENTS, Mesh, MeshError, MeshParams, Patch, Surface};
 pub use scene::{
-    Camera, Facing, Material, Object, Polygon, PolygonMesh, Scene, SceneError, Shape, SolverSettings, Sphere,
-    box_faces,
+    Camera, Facing, MAX_POLYGON_VERTICES, MAX_TIME_LIMIT_SECONDS, Material, Object, Polygon, PolygonMesh,
+    Scene, SceneError, Shape, SolverSettings, Sphere, box_faces,
 };
 
 /// Re-export of the vector maths used in the public API.
