@@ -45,11 +45,22 @@ impl Locator<'_> {
     }
 }
 
+/// Longest part of an error message kept whole, in characters; a longer one (a 1 MB key
+/// echoed by the TOML parser) is cut, saying how long it was.
+const MAX_PART_CHARS: usize = 300;
+
 /// `s` with control characters (a newline in a material name, say) escaped, so that an error
-/// stays one line whatever the file holds.
+/// stays one line whatever the file holds, and cut to [`MAX_PART_CHARS`].
 pub(crate) fn one_line(s: &str) -> String {
+    let count = s.chars().count();
+    let s: String = if count > MAX_PART_CHARS {
+        let head: String = s.chars().take(MAX_PART_CHARS - 60).collect();
+        format!("{head}… ({count} characters)")
+    } else {
+        s.to_owned()
+    };
     if !s.chars().any(char::is_control) {
-        return s.to_owned();
+        return s;
     }
     s.chars().map(|c| if c.is_control() { c.escape_default().to_string() } else { c.to_string() }).collect()
 }
