@@ -47,7 +47,7 @@ impl Locator<'_> {
 
 /// Longest part of an error message kept whole, in characters; a longer one (a 1 MB key
 /// echoed by the TOML parser) is cut, saying how long it was.
-const MAX_PART_CHARS: usize = 300;
+const MAX_PART_CHARS: usize = 1000;
 
 /// `s` with control characters (a newline in a material name, say) escaped, so that an error
 /// stays one line whatever the file holds, and cut to [`MAX_PART_CHARS`].
