@@ -118,7 +118,7 @@ impl Targets {
     pub fn folder(&mut self, dir: &Path, marker: &str, option: &str) -> Result<()> {
         match std::fs::metadata(dir) {
             Ok(meta) if !meta.is_dir() => {
-                return Err(input(format!("{option} {}: exists and is not a folder", dir.display())));
+                Err(input(format!("{option} {}: exists and is not a folder", dir.display())))
             }
             Ok(_) => {
                 if dir.join(marker).exists() && !self.force {

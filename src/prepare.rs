@@ -279,7 +279,8 @@ pub fn prepare(scene_arg: &str, o: &SolveOpts) -> Result<Prepared> {
 fn check_light_scale(scene: &Scene, light_scale: f64) -> Result<()> {
     for m in &scene.materials {
         let scaled = m.emission.max_channel() * light_scale;
-        if !(scaled <= MAX_EMISSION) {
+        // NaN fails this test too.
+        if scaled.is_nan() || scaled > MAX_EMISSION {
             return Err(input(format!(
                 "--light-scale {light_scale}: material '{}' would emit {scaled:e} W/m², more than {MAX_EMISSION:e}",
                 m.name

@@ -55,15 +55,11 @@ pub(crate) fn check_mtl(text: &str, origin: &str) -> Result<String, LoadError> {
                     continue;
                 }
             }
-            "Ns" | "Ni" | "d" => {
-                if values.first().and_then(|w| number(w)).is_none() {
-                    return Err(err(format!("{key}: expected a finite number")));
-                }
+            "Ns" | "Ni" | "d" if values.first().and_then(|w| number(w)).is_none() => {
+                return Err(err(format!("{key}: expected a finite number")));
             }
-            "illum" => {
-                if values.first().and_then(|w| w.parse::<u8>().ok()).is_none() {
-                    return Err(err("illum: expected an illumination model number 0 to 10".into()));
-                }
+            "illum" if values.first().and_then(|w| w.parse::<u8>().ok()).is_none() => {
+                return Err(err("illum: expected an illumination model number 0 to 10".into()));
             }
             "newmtl" if values.is_empty() => return Err(err("newmtl: the material needs a name".into())),
             k if (k.starts_with("map_") || k == "bump") && values.is_empty() => {
