@@ -15,7 +15,7 @@ use std::io::Write;
 use std::sync::Arc;
 use std::time::Instant;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use glam::{DVec3, Vec3};
 use radiosity_accel::{Bvh, RayQuery};
@@ -26,7 +26,7 @@ use rayon::prelude::*;
 use serde_json::json;
 
 use crate::alloc;
-use crate::prepare::{check_writable, write_output};
+use crate::output::{self, Targets};
 
 /// Arguments of `radiosity bench`.
 #[derive(Args)]
@@ -132,10 +132,7 @@ fn random_segments(tris: &[[DVec3; 3]], count: usize, lift: f64) -> Vec<(Vec3, V
 /// Writes the ray case for `scripts/embree_bench.py`: little-endian u32 triangle count,
 /// u32 segment count, then 9 f32 per triangle and 6 f32 per segment.
 fn dump_rays(path: &str, tris: &[[Vec3; 3]], segments: &[(Vec3, Vec3)], force: bool) -> Result<()> {
-    check_writable(std::path::Path::new(path), force)?;
-    let mut out = std::io::BufWriter::new(
-        std::fs::File::create(path).with_context(|| format!("{path}: cannot create"))?,
-    );
+    let mut out = Vec::with_capacity(8 + tris.len() * 36 + segments.len() * 24);
     out.write_all(&(tris.len() as u32).to_le_bytes())?;
     out.write_all(&(segments.len() as u32).to_le_bytes())?;
     for v in tris.iter().flatten() {
@@ -148,8 +145,7 @@ fn dump_rays(path: &str, tris: &[[Vec3; 3]], segments: &[(Vec3, Vec3)], force: b
             out.write_all(&c.to_le_bytes())?;
         }
     }
-    out.flush().with_context(|| format!("{path}: cannot write"))?;
-    Ok(())
+    output::write_file(std::path::Path::new(path), force, &out)
 }
 
 /// Case (a): occlusion rays per second on one thread and on all.
@@ -175,15 +171,15 @@ fn occlusion_case(cornell: &Scene, dump: Option<&str>, force: bool) -> Result<se
     let (one, blocked) = time_rays(false);
     let (all, _) = time_rays(true);
     let threads = rayon::current_num_threads();
-    println!(
-        "(a) occlusion rays, {} triangles (BVH build {build:.2} s): 1 thread {:.2} M rays/s, {threads} threads {:.2} M rays/s ({:.2}×); {:.1} % of {} segments blocked",
+    output::stdout(&format!(
+        "(a) occlusion rays, {} triangles (BVH build {build:.2} s): 1 thread {:.2} M rays/s, {threads} threads {:.2} M rays/s ({:.2}×); {:.1} % of {} segments blocked\n",
         tris.len(),
         one / 1e6,
         all / 1e6,
         all / one,
         100.0 * blocked as f64 / segments.len() as f64,
         segments.len()
-    );
+    ))?;
     Ok(json!({"case": "occlusion_rays", "triangles": tris.len(), "segments": segments.len(),
         "blocked": blocked, "bvh_build_seconds": build, "rays_per_s_1_thread": one,
         "rays_per_s_all_threads": all, "threads": threads}))
@@ -205,15 +201,15 @@ fn solve_case(
     let r = solver.solve();
     let peak = alloc::peak().saturating_sub(before);
     let secs = r.elapsed.as_secs_f64();
-    println!(
-        "{name:<40} {patches:>6} patches {elements:>7} elements {:>5} shots {secs:>8.3} s {:>6.2} M rays/s  unshot {:.2e} ({})  peak heap {:.1} MB ({:.0} B/element)",
+    output::stdout(&format!(
+        "{name:<40} {patches:>6} patches {elements:>7} elements {:>5} shots {secs:>8.3} s {:>6.2} M rays/s  unshot {:.2e} ({})  peak heap {:.1} MB ({:.0} B/element)\n",
         r.total_shots,
         r.rays as f64 / secs.max(1e-9) / 1e6,
         r.unshot_fraction,
         r.stop_reason.map_or("running", |s| s.as_str()),
         peak as f64 / 1e6,
         peak as f64 / elements as f64,
-    );
+    ))?;
     Ok(json!({"case": id, "patches": patches, "elements": elements, "shots": r.total_shots,
         "seconds": secs, "rays": r.rays, "unshot_fraction": r.unshot_fraction,
         "peak_heap_bytes": peak, "bytes_per_element": peak as f64 / elements as f64}))
@@ -227,11 +223,15 @@ fn cornell_mesh(cornell: &Scene, element_size: f64) -> Result<Mesh> {
 
 /// Runs `bench`.
 pub fn run(a: BenchArgs) -> Result<()> {
+    let mut targets = Targets::new(a.force);
     if let Some(path) = a.json.as_deref().filter(|p| *p != "-") {
-        check_writable(std::path::Path::new(path), a.force)?;
+        targets.file(std::path::Path::new(path), "--json")?;
+    }
+    if let Some(path) = a.dump_rays.as_deref() {
+        targets.file(std::path::Path::new(path), "--dump-rays")?;
     }
     let threads = rayon::current_num_threads();
-    println!("radiosity bench ({threads} threads)");
+    output::stdout(&format!("radiosity bench ({threads} threads)\n"))?;
     let cornell = radiosity_core::cornell_box();
     let mut cases = vec![occlusion_case(&cornell, a.dump_rays.as_deref(), a.force)?];
 
@@ -250,7 +250,7 @@ pub fn run(a: BenchArgs) -> Result<()> {
     let mut v =
         solve_case("source_document", "(b) source document (≥100 facets, 1000 shots)", || Ok(seed_mesh), p)?;
     let secs = v["seconds"].as_f64().unwrap_or(f64::NAN);
-    println!("    vs the document's ~60 s: {:.0}× faster", 60.0 / secs);
+    output::stdout(&format!("    vs the document's ~60 s: {:.0}× faster\n", 60.0 / secs))?;
     v["speedup_vs_document"] = json!(60.0 / secs);
     cases.push(v);
 
@@ -269,7 +269,7 @@ pub fn run(a: BenchArgs) -> Result<()> {
     )?;
     let ratio =
         reference["seconds"].as_f64().unwrap_or(f64::NAN) / fast["seconds"].as_f64().unwrap_or(f64::NAN);
-    println!("    fast path {ratio:.2}× faster than the reference path");
+    output::stdout(&format!("    fast path {ratio:.2}× faster than the reference path\n"))?;
     cases.push(json!({"case": "cornell_10k_fast_vs_reference", "fast": fast, "reference": reference,
         "speedup": ratio}));
     // The single-core target: ~15 k elements on one thread.
@@ -292,11 +292,12 @@ pub fn run(a: BenchArgs) -> Result<()> {
     }
 
     if let Some(path) = &a.json {
-        write_output(
-            path,
-            &serde_json::to_string_pretty(&json!({"threads": threads, "cases": cases}))?,
-            a.force,
-        )?;
+        let text = serde_json::to_string_pretty(&json!({"threads": threads, "cases": cases}))? + "\n";
+        if path == "-" {
+            output::stdout(&text)?;
+        } else {
+            output::write_file(std::path::Path::new(path), a.force, text.as_bytes())?;
+        }
     }
     Ok(())
 }

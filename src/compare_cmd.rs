@@ -6,10 +6,11 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::Args;
 use radiosity_core::Rgb;
-use radiosity_image::{HdrImage, SrgbImage, read_hdr, write_png};
+use radiosity_image::{HdrImage, SrgbImage, encode_png, read_hdr};
 use serde_json::json;
 
-use crate::prepare::{InputError, check_writable, write_output};
+use crate::output::{self, Targets, write_report};
+use crate::prepare::InputError;
 
 /// Arguments of `radiosity compare`.
 #[derive(Args)]
@@ -110,13 +111,14 @@ pub fn run(a: CompareArgs) -> Result<()> {
     if !(a.range.is_finite() && a.range > 0.0) {
         return Err(input(format!("--range must be a number > 0, got {}", a.range)));
     }
+    let mut targets = Targets::new(a.force);
     if let Some(path) = &a.output {
-        check_writable(path, a.force)?;
+        targets.file(path, "-o")?;
     }
     if let Some(path) = &a.json
         && path != "-"
     {
-        check_writable(std::path::Path::new(path), a.force)?;
+        targets.file(std::path::Path::new(path), "--json")?;
     }
     let pa = read_hdr(&a.picture).map_err(|e| input(e.to_string()))?;
     let pb = read_hdr(&a.reference).map_err(|e| input(e.to_string()))?;
@@ -161,16 +163,17 @@ pub fn run(a: CompareArgs) -> Result<()> {
         );
     }
     if a.json.as_deref() != Some("-") {
-        print!("{text}");
+        output::stdout(&text)?;
     }
     if let Some(path) = &a.output {
-        write_png(path, &difference_picture(&pa, &pb, a.range))
-            .context("cannot write the difference picture")?;
-        eprintln!(
+        let png = encode_png(&difference_picture(&pa, &pb, a.range), path)
+            .context("cannot encode the difference picture")?;
+        output::write_file(path, a.force, &png)?;
+        output::note(format_args!(
             "wrote {} (relative luminance difference, ±{:.0} % at full colour)",
             path.display(),
             a.range * 100.0
-        );
+        ))?;
     }
     if let Some(path) = &a.json {
         let doc = json!({
@@ -187,7 +190,7 @@ pub fn run(a: CompareArgs) -> Result<()> {
                 "pixels": f.pixels,
             })).collect::<Vec<_>>(),
         });
-        write_output(path, &serde_json::to_string_pretty(&doc)?, a.force)?;
+        write_report(path, a.force, &serde_json::to_string_pretty(&doc)?)?;
     }
     Ok(())
 }

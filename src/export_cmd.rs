@@ -3,12 +3,13 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use radiosity_export::{ExportFormat, VertexColours};
 use radiosity_image::{HdrImage, ToneOperator, ToneParams};
 
-use crate::prepare::{InputError, SolveOpts, check_writable, prepare, run_solver};
+use crate::output::{self, Targets, note};
+use crate::prepare::{InputError, SolveOpts, prepare, run_solver};
 use crate::render_cmd::ToneOpts;
 
 /// Arguments of `radiosity export`.
@@ -46,16 +47,10 @@ pub fn run(a: ExportArgs) -> Result<()> {
         InputError(format!("{}: unknown output format; expected .glb, .gltf or .ply", a.output.display()))
     })?;
     // Refuse before solving, so a long solve is not lost to an existing file.
-    check_writable(&a.output, a.force)?;
-    if let Some(dir) = &a.lightmap
-        && dir.join("lightmapped.obj").exists()
-        && !a.force
-    {
-        return Err(InputError(format!(
-            "{} already holds lightmaps; pass --force to overwrite them",
-            dir.display()
-        ))
-        .into());
+    let mut targets = Targets::new(a.force);
+    targets.file(&a.output, "-o")?;
+    if let Some(dir) = &a.lightmap {
+        targets.folder(dir, "lightmapped.obj", "--lightmap")?;
     }
     let prepared = prepare(&a.scene, &a.solve)?;
     let (solver, report) = run_solver(&prepared)?;
@@ -78,15 +73,15 @@ pub fn run(a: ExportArgs) -> Result<()> {
         ExportFormat::Gltf => radiosity_export::gltf_text(mesh, &solution, mode).into_bytes(),
         ExportFormat::Ply => radiosity_export::ply_bytes(mesh, &solution, tone),
     };
-    std::fs::write(&a.output, bytes).with_context(|| format!("cannot write {}", a.output.display()))?;
-    eprintln!(
+    output::write_file(&a.output, a.force, &bytes)?;
+    note(format_args!(
         "{}: {} patches, {} elements, {} shots, unshot {:.4} %",
         prepared.scene.name,
         mesh.patches.len(),
         mesh.elements.len(),
         report.total_shots,
         report.unshot_fraction * 100.0
-    );
+    ))?;
     let colours = match (format, a.tonemapped) {
         (ExportFormat::Ply, _) => format!(
             "display colours ({}, {ev:+.2} EV) and linear radiosity",
@@ -95,10 +90,12 @@ pub fn run(a: ExportArgs) -> Result<()> {
         (_, true) => format!("display colours ({}, {ev:+.2} EV)", ToneOperator::from(a.tone.tonemap)),
         (_, false) => format!("linear colours ({ev:+.2} EV) and radiosity"),
     };
-    eprintln!("wrote {} ({} vertices, {colours})", a.output.display(), mesh.positions.len());
+    note(format_args!("wrote {} ({} vertices, {colours})", a.output.display(), mesh.positions.len()))?;
     if let Some(dir) = &a.lightmap {
-        let written = radiosity_export::write_lightmaps(dir, mesh, &solution).map_err(anyhow::Error::msg)?;
-        eprintln!("wrote {} lightmap files into {}", written.len(), dir.display());
+        let count = output::write_folder(dir, a.force, |staging| {
+            radiosity_export::write_lightmaps(staging, mesh, &solution)
+        })?;
+        note(format_args!("wrote {count} lightmap files into {}", dir.display()))?;
     }
     Ok(())
 }

@@ -1,5 +1,7 @@
 //! `radiosity info`: what a scene holds, before solving it.
 
+use std::fmt::Write;
+
 use anyhow::Result;
 use clap::Args;
 use radiosity_core::Rgb;
@@ -19,19 +21,21 @@ pub struct InfoArgs {
 pub fn run(a: InfoArgs) -> Result<()> {
     let p = prepare(&a.scene, &a.solve)?;
     let (scene, mesh) = (&p.scene, p.problem.mesh());
+    // One text, one write: a closed pipe or a full disk is one error, not a panic.
+    let mut out = String::new();
     let (lo, hi) = mesh.bounds();
-    println!("scene      {}", scene.name);
-    println!("bounds     {:?} .. {:?}", lo.to_array(), hi.to_array());
-    println!("materials  {}", scene.materials.len());
-    println!("objects    {}", scene.objects.len());
-    println!("surfaces   {}", mesh.surfaces.len());
-    println!("patches    {}", mesh.patches.len());
-    println!("elements   {}", mesh.elements.len());
-    println!("occluders  {} triangles", mesh.occluders.len());
-    println!("area       {:.6e}", mesh.total_area());
+    let _ = writeln!(out, "scene      {}", scene.name);
+    let _ = writeln!(out, "bounds     {:?} .. {:?}", lo.to_array(), hi.to_array());
+    let _ = writeln!(out, "materials  {}", scene.materials.len());
+    let _ = writeln!(out, "objects    {}", scene.objects.len());
+    let _ = writeln!(out, "surfaces   {}", mesh.surfaces.len());
+    let _ = writeln!(out, "patches    {}", mesh.patches.len());
+    let _ = writeln!(out, "elements   {}", mesh.elements.len());
+    let _ = writeln!(out, "occluders  {} triangles", mesh.occluders.len());
+    let _ = writeln!(out, "area       {:.6e}", mesh.total_area());
     let emitted: Rgb =
         (0..mesh.elements.len()).map(|e| mesh.element_material(e).emission * mesh.elements[e].area).sum();
-    println!("emitted    [{:.6e}, {:.6e}, {:.6e}] W", emitted.r, emitted.g, emitted.b);
+    let _ = writeln!(out, "emitted    [{:.6e}, {:.6e}, {:.6e}] W", emitted.r, emitted.g, emitted.b);
     let mut warnings = Vec::new();
     for m in &scene.materials {
         if m.reflectance.max_channel() > 0.95 {
@@ -53,7 +57,7 @@ pub fn run(a: InfoArgs) -> Result<()> {
         warnings.push("no [camera]: views frame the whole scene".into());
     }
     for w in &warnings {
-        println!("warning    {w}");
+        let _ = writeln!(out, "warning    {w}");
     }
-    Ok(())
+    crate::output::stdout(&out)
 }

@@ -5,6 +5,7 @@ mod bench_cmd;
 mod compare_cmd;
 mod export_cmd;
 mod info_cmd;
+mod output;
 mod prepare;
 mod render_cmd;
 mod solve_cmd;
@@ -64,8 +65,11 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        // A reader that stopped reading (`| head`) is not an error to report.
+        Err(e) if output::is_broken_pipe(&e) => ExitCode::from(output::BROKEN_PIPE_EXIT),
         Err(e) => {
-            eprintln!("error: {}", radiosity_core::one_line(e.as_ref()));
+            // Nowhere left to report a failure to write the report; the exit code still says it.
+            let _ = output::note(format_args!("error: {}", radiosity_core::one_line(e.as_ref())));
             ExitCode::from(prepare::exit_code(&e))
         }
     }

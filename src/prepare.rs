@@ -2,10 +2,9 @@
 //! and running the solver with a progress bar.
 
 use std::io::IsTerminal;
-use std::path::Path;
 use std::time::{Duration, Instant};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 use radiosity_core::{MeshParams, Scene};
@@ -26,9 +25,23 @@ pub fn exit_code(e: &anyhow::Error) -> u8 {
             || c.is::<radiosity_core::SceneError>()
             || c.is::<radiosity_core::MeshError>()
             || c.is::<radiosity_solver::SolverError>()
+            || c.is::<radiosity_image::RenderError>()
     });
     if input { 2 } else { 1 }
 }
+
+/// Most visibility, penumbra or dim rays per receiver: 1024 is 64× the `accurate()` preset's
+/// count, far past where more rays change an answer, and keeps a shot's ray count (rays ×
+/// receivers) within what a run can finish.
+pub const MAX_RAYS: u32 = 1024;
+
+/// Most worker threads: beyond what any machine this runs on has, low enough that asking
+/// for them is a mistake to report rather than thousands of threads to spawn.
+pub const MAX_THREADS: usize = 1024;
+
+/// Largest emission × light scale, W/m²: far above any physical light (the sun's surface
+/// gives 6.3e7), low enough that radiosity sums over many bounces and elements stay finite.
+pub const MAX_EMISSION: f64 = 1e30;
 
 /// Form factor choice on the command line.
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -43,56 +56,75 @@ pub enum FormFactorArg {
 #[derive(Args, Clone, Debug)]
 pub struct SolveOpts {
     /// Longest patch edge, scene units (overrides the scene's [mesh]).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub patch_size: Option<f64>,
     /// Longest element edge, scene units (overrides the scene's [mesh]).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub element_size: Option<f64>,
-    /// Stop when unshot power / emitted power falls to this (default 1e-3).
-    #[arg(long)]
+    /// Stop when unshot power / emitted power falls to this, in (0, 1) [default: the scene's
+    /// [solver], else the solver's default, 1e-3].
+    #[arg(long, allow_negative_numbers = true)]
     pub unshot_threshold: Option<f64>,
     /// Stop after this many shots.
     #[arg(long)]
     pub max_shots: Option<u64>,
-    /// Stop after this many seconds of solving.
-    #[arg(long)]
+    /// Stop after this many seconds of solving, in (0, 1e9].
+    #[arg(long, allow_negative_numbers = true)]
     pub time_limit: Option<f64>,
     /// Multiply every emission by this (the light intensity).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 1.0)]
     pub light_scale: f64,
-    /// Worker threads (default: all cores).
+    /// Worker threads, 1 to 1024 (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
     /// Seed of the visibility sampling.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = SolverParams::default().seed)]
     pub seed: u64,
     /// Form factor method.
-    #[arg(long, value_enum, default_value_t = FormFactorArg::Exact)]
+    #[arg(long, value_enum, default_value_t = FormFactorArg::from(SolverParams::default().form_factor))]
     pub form_factor: FormFactorArg,
-    /// Visibility rays per receiver from a bright shooter (see --bright-share).
-    #[arg(long, default_value_t = 8)]
+    /// Visibility rays per receiver from a bright shooter (see --bright-share), 1 to 1024.
+    #[arg(long, default_value_t = SolverParams::default().visibility_rays)]
     pub visibility_rays: u32,
     /// More rays from a bright shooter for a receiver whose neighbours' first visibility rays
-    /// saw a penumbra; 0: none.
-    #[arg(long, default_value_t = 12)]
+    /// saw a penumbra; 0: none; at most 1024.
+    #[arg(long, default_value_t = SolverParams::default().penumbra_rays)]
     pub penumbra_rays: u32,
-    /// Visibility rays per receiver from a dim shooter.
-    #[arg(long, default_value_t = 1)]
+    /// Visibility rays per receiver from a dim shooter, 1 to 1024.
+    #[arg(long, default_value_t = SolverParams::default().dim_rays)]
     pub dim_rays: u32,
     /// A shooter is bright when its first shot carries at least this share of the first
     /// (largest) shot's power; 0: every shooter is.
-    #[arg(long, default_value_t = 0.01, value_name = "SHARE")]
+    #[arg(long, allow_negative_numbers = true, default_value_t = SolverParams::default().bright_share, value_name = "SHARE")]
     pub bright_share: f64,
     /// Memory for keeping each shooter's form factors for its next shots, in MiB (0: keep
     /// none; the answer is the same, only slower).
-    #[arg(long, default_value_t = 256, value_name = "MIB")]
+    #[arg(long, default_value_t = SolverParams::default().row_cache_bytes >> 20, value_name = "MIB")]
     pub row_cache_mib: usize,
     /// Over-relaxation factor ω in [1, 2) (1: plain shooting).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = overshoot_factor(SolverParams::default().overshoot))]
     pub overshoot: f64,
-    /// Add the ambient term (Cohen 1988) to the reported solution.
+    /// Add the ambient term (Cohen 1988) to the reported solution (the solver's default is
+    /// off).
     #[arg(long)]
     pub ambient: bool,
+}
+
+impl From<FormFactorMethod> for FormFactorArg {
+    fn from(m: FormFactorMethod) -> Self {
+        match m {
+            FormFactorMethod::Exact => FormFactorArg::Exact,
+            FormFactorMethod::PointToPoint => FormFactorArg::Point,
+        }
+    }
+}
+
+/// The over-relaxation factor ω of an [`Overshoot`] (1 when off).
+fn overshoot_factor(o: Overshoot) -> f64 {
+    match o {
+        Overshoot::Off => 1.0,
+        Overshoot::Relaxation(w) => w,
+    }
 }
 
 /// A scene ready to solve.
@@ -127,18 +159,30 @@ pub struct Settings {
 /// # Errors
 /// Bad scene files and out-of-range options (exit code 2).
 pub fn settings(scene_arg: &str, o: &SolveOpts) -> Result<Settings> {
-    if o.threads == Some(0) {
-        return Err(input("--threads must be at least 1".into()));
+    if let Some(t) = o.threads
+        && !(1..=MAX_THREADS).contains(&t)
+    {
+        return Err(input(format!("--threads must be 1 to {MAX_THREADS}, got {t}")));
+    }
+    for (option, value, least) in [
+        ("--visibility-rays", o.visibility_rays, 1),
+        ("--penumbra-rays", o.penumbra_rays, 0),
+        ("--dim-rays", o.dim_rays, 1),
+    ] {
+        if !(least..=MAX_RAYS).contains(&value) {
+            return Err(input(format!("{option} must be {least} to {MAX_RAYS}, got {value}")));
+        }
     }
     // A model file given where a scene is expected loads as a scene of its parts; what the
     // loader dropped or defaulted (degenerate faces, a missing MTL) is said once, here.
     let radiosity_io::LoadedScene { scene, warnings } = radiosity_io::resolve_scene(scene_arg)?;
     for w in &warnings {
-        eprintln!("warning: {w}");
+        crate::output::note(format_args!("warning: {w}"))?;
     }
     if !(o.light_scale.is_finite() && o.light_scale > 0.0) {
         return Err(input(format!("--light-scale must be a finite number > 0, got {}", o.light_scale)));
     }
+    check_light_scale(&scene, o.light_scale)?;
     let base = scene.mesh_params();
     let patch = o.patch_size.unwrap_or(base.patch_size);
     let element = o.element_size.unwrap_or(if o.patch_size.is_some() {
@@ -147,11 +191,32 @@ pub fn settings(scene_arg: &str, o: &SolveOpts) -> Result<Settings> {
         base.element_size
     });
     let mesh_params = MeshParams::try_new(patch, element).map_err(|e| input(format!("mesh options: {e}")))?;
+    // The scene file's limit is checked (with its line) by the loader; this is the option's.
     let time_limit = match o.time_limit.or(scene.solver.time_limit) {
-        Some(t) if t.is_finite() && t >= 0.0 => Some(Duration::from_secs_f64(t)),
-        Some(t) => return Err(input(format!("--time-limit must be a number of seconds ≥ 0, got {t}"))),
+        Some(t) if t > 0.0 && t <= radiosity_core::MAX_TIME_LIMIT_SECONDS => Some(Duration::from_secs_f64(t)),
+        Some(t) => {
+            return Err(input(format!(
+                "--time-limit must be a number of seconds in (0, {:e}], got {t}",
+                radiosity_core::MAX_TIME_LIMIT_SECONDS
+            )));
+        }
         None => None,
     };
+    if let Some(t) = o.unshot_threshold
+        && !(t > 0.0 && t < 1.0)
+    {
+        return Err(input(format!("--unshot-threshold must be a fraction in (0, 1), got {t}")));
+    }
+    if o.max_shots == Some(0) {
+        return Err(input("--max-shots must be at least 1".into()));
+    }
+    if !(0.0..=1.0).contains(&o.bright_share) {
+        return Err(input(format!("--bright-share must be a share in [0, 1], got {}", o.bright_share)));
+    }
+    if !(1.0..2.0).contains(&o.overshoot) {
+        return Err(input(format!("--overshoot must be ω in [1, 2), got {}", o.overshoot)));
+    }
+    let defaults = SolverParams::default();
     let solver_params = SolverParams {
         form_factor: match o.form_factor {
             FormFactorArg::Exact => FormFactorMethod::Exact,
@@ -161,14 +226,17 @@ pub fn settings(scene_arg: &str, o: &SolveOpts) -> Result<Settings> {
         penumbra_rays: o.penumbra_rays,
         dim_rays: o.dim_rays,
         bright_share: o.bright_share,
-        unshot_threshold: o.unshot_threshold.or(scene.solver.unshot_threshold).unwrap_or(1e-3),
+        unshot_threshold: o
+            .unshot_threshold
+            .or(scene.solver.unshot_threshold)
+            .unwrap_or(defaults.unshot_threshold),
         max_shots: o.max_shots.or(scene.solver.max_shots),
         time_limit,
         seed: o.seed,
         ambient: if o.ambient { Ambient::On } else { Ambient::Off },
         overshoot: if o.overshoot == 1.0 { Overshoot::Off } else { Overshoot::Relaxation(o.overshoot) },
         row_cache_bytes: o.row_cache_mib.saturating_mul(1 << 20),
-        ..SolverParams::default()
+        ..defaults
     };
     Ok(Settings { scene, mesh_params, solver_params })
 }
@@ -181,21 +249,55 @@ pub fn settings(scene_arg: &str, o: &SolveOpts) -> Result<Settings> {
 pub fn prepare(scene_arg: &str, o: &SolveOpts) -> Result<Prepared> {
     let Settings { mut scene, mesh_params, solver_params } = settings(scene_arg, o)?;
     if let Some(t) = o.threads {
-        // The global pool can be set once per process; a second call is a harmless no-op.
-        let _ = rayon::ThreadPoolBuilder::new().num_threads(t).build_global();
+        // One call per process: an error is the system refusing the threads.
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(t)
+            .build_global()
+            .with_context(|| format!("cannot start {t} worker threads (--threads)"))?;
     }
     scene.scale_emission(o.light_scale);
     let problem = Problem::new(&scene, &mesh_params)?;
     Ok(Prepared { scene, problem, params: solver_params })
 }
 
-/// Runs the solver to a stop criterion, with a progress bar on stderr when it is a terminal.
+/// Refuses a light scale whose product with an emission passes [`MAX_EMISSION`], or whose
+/// emitted power is not finite: the solve would overflow to infinities and report `null`
+/// radiosities.
 ///
 /// # Errors
-/// Solver parameter errors (exit code 2).
+/// The material and the product (exit code 2).
+fn check_light_scale(scene: &Scene, light_scale: f64) -> Result<()> {
+    for m in &scene.materials {
+        let scaled = m.emission.max_channel() * light_scale;
+        // NaN fails this test too.
+        if scaled.is_nan() || scaled > MAX_EMISSION {
+            return Err(input(format!(
+                "--light-scale {light_scale}: material '{}' would emit {scaled:e} W/m², more than {MAX_EMISSION:e}",
+                m.name
+            )));
+        }
+    }
+    let power = scene.emitted_power().max_channel() * light_scale;
+    if !power.is_finite() {
+        return Err(input(format!(
+            "--light-scale {light_scale}: the scene's emitted power would be {power}; lower the scale or the emissions"
+        )));
+    }
+    Ok(())
+}
+
+/// Seconds between progress lines when stderr is not a terminal (a log file, a CI job).
+pub const LOG_INTERVAL: Duration = Duration::from_secs(5);
+
+/// Runs the solver to a stop criterion, with a progress bar on stderr when it is a terminal
+/// and a progress line every [`LOG_INTERVAL`] when it is not (a bar there would be noise).
+///
+/// # Errors
+/// Solver parameter errors (exit code 2); stderr that cannot be written.
 pub fn run_solver(p: &Prepared) -> Result<(Solver, StepReport)> {
     let mut solver = p.problem.solver(p.params.clone())?;
-    let bar = if std::io::stderr().is_terminal() {
+    let terminal = std::io::stderr().is_terminal();
+    let bar = if terminal {
         let bar = ProgressBar::new(1000);
         bar.set_style(
             ProgressStyle::with_template("{spinner} solving [{bar:30}] {msg}")
@@ -208,6 +310,7 @@ pub fn run_solver(p: &Prepared) -> Result<(Solver, StepReport)> {
     };
     let threshold = p.params.unshot_threshold;
     let start = Instant::now();
+    let mut last_log = start;
     let report = loop {
         let r = solver.step(StepBudget::Time(Duration::from_millis(100)));
         // Progress on a log scale: from 1 (nothing shot) down to the threshold.
@@ -215,41 +318,22 @@ pub fn run_solver(p: &Prepared) -> Result<(Solver, StepReport)> {
         bar.set_position((done * 1000.0) as u64);
         let secs = start.elapsed().as_secs_f64();
         let eta = if done > 0.0 { secs * (1.0 - done) / done } else { f64::NAN };
-        bar.set_message(format!(
+        let message = format!(
             "{} shots, unshot {:.3} %, {:.2} M rays/s, ETA {:.1} s",
             r.total_shots,
             r.unshot_fraction * 100.0,
             r.rays as f64 / secs.max(1e-9) / 1e6,
             eta
-        ));
+        );
         if r.stop_reason.is_some() {
             break r;
         }
+        if !terminal && last_log.elapsed() >= LOG_INTERVAL {
+            last_log = Instant::now();
+            crate::output::note(format_args!("[{secs:.0} s] solving: {message}"))?;
+        }
+        bar.set_message(message);
     };
     bar.finish_and_clear();
     Ok((solver, report))
-}
-
-/// Refuses to overwrite an existing file unless `force` is set.
-///
-/// # Errors
-/// The file exists and `force` is false (exit code 2).
-pub fn check_writable(path: &Path, force: bool) -> Result<()> {
-    if path.exists() && !force {
-        bail!(InputError(format!("{} exists; pass --force to overwrite it", path.display())));
-    }
-    Ok(())
-}
-
-/// Writes `text` to `path`, or to stdout when `path` is `-`.
-///
-/// # Errors
-/// The file exists without `force`, or cannot be written.
-pub fn write_output(path: &str, text: &str, force: bool) -> Result<()> {
-    if path == "-" {
-        println!("{text}");
-        return Ok(());
-    }
-    check_writable(Path::new(path), force)?;
-    std::fs::write(path, text).with_context(|| format!("cannot write {path}"))
 }

@@ -3,19 +3,21 @@
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 use std::time::Instant;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::{Args, ValueEnum};
 use glam::DVec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use radiosity_core::Camera;
 use radiosity_image::{
-    Exposure, Gather, HdrImage, RenderParams, Renderer, Shading, ToneOperator, ToneParams, read_hdr,
-    tone_map_image, write_exr, write_pfm, write_png,
+    Exposure, Gather, HdrImage, RenderParams, Renderer, Shading, ToneOperator, ToneParams, encode_exr,
+    encode_pfm, encode_png, read_hdr, tone_map_image,
 };
 
-use crate::prepare::{InputError, SolveOpts, check_writable, prepare, run_solver};
+use crate::output::{self, Targets, note};
+use crate::prepare::{InputError, SolveOpts, prepare, run_solver};
 
 /// Tone-mapping operator on the command line.
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -122,8 +124,8 @@ pub struct RenderArgs {
     /// Point looked at, `x,y,z`.
     #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
     pub look_at: Option<DVec3>,
-    /// Vertical field of view, degrees.
-    #[arg(long)]
+    /// Vertical field of view, degrees, in (0, 180).
+    #[arg(long, allow_negative_numbers = true)]
     pub fov: Option<f64>,
     #[command(flatten)]
     pub tone: ToneOpts,
@@ -170,22 +172,51 @@ fn input(msg: String) -> anyhow::Error {
     InputError(msg).into()
 }
 
-/// A progress bar on stderr when it is a terminal, hidden otherwise.
-fn bar(len: u64, what: &str) -> ProgressBar {
-    if !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
+/// Progress of a per-row job on stderr: a bar on a terminal, otherwise a line every
+/// [`LOG_INTERVAL`](crate::prepare::LOG_INTERVAL).
+struct RowProgress {
+    bar: ProgressBar,
+    what: &'static str,
+    /// Rows done and the last log line's time, when stderr is not a terminal.
+    log: Option<Mutex<(u64, Instant)>>,
+}
+
+impl RowProgress {
+    fn new(len: u64, what: &'static str) -> Self {
+        if !std::io::stderr().is_terminal() {
+            let bar = ProgressBar::hidden();
+            bar.set_length(len);
+            return Self { bar, what, log: Some(Mutex::new((0, Instant::now()))) };
+        }
+        let bar = ProgressBar::new(len);
+        let template = format!("{{spinner}} {what} [{{bar:30}}] {{pos}}/{{len}} rows, ETA {{eta}}");
+        bar.set_style(ProgressStyle::with_template(&template).expect("valid template").progress_chars("=> "));
+        Self { bar, what, log: None }
     }
-    let bar = ProgressBar::new(len);
-    let template = format!("{{spinner}} {what} [{{bar:30}}] {{pos}}/{{len}} rows, ETA {{eta}}");
-    bar.set_style(ProgressStyle::with_template(&template).expect("valid template").progress_chars("=> "));
-    bar
+
+    /// One more row done (called from the render's worker threads).
+    fn inc(&self) {
+        self.bar.inc(1);
+        if let Some(log) = &self.log
+            && let Ok(mut state) = log.lock()
+        {
+            state.0 += 1;
+            if state.1.elapsed() >= crate::prepare::LOG_INTERVAL {
+                state.1 = Instant::now();
+                // Best effort from a worker thread: a stderr that cannot be written is
+                // reported by the summary line that follows the render.
+                let len = self.bar.length().unwrap_or(0);
+                let _ = note(format_args!("{}: {}/{len} rows", self.what, state.0));
+            }
+        }
+    }
 }
 
 /// Tone maps `radiance` with `tone` and writes it as PNG; returns the exposure used (EV).
-fn write_tonemapped(path: &Path, radiance: &HdrImage, tone: &ToneOpts) -> Result<f64> {
+fn write_tonemapped(path: &Path, force: bool, radiance: &HdrImage, tone: &ToneOpts) -> Result<f64> {
     let ev = tone.exposure.ev_for(radiance);
     let png = tone_map_image(radiance, &ToneParams::new(ev, tone.tonemap.into()));
-    write_png(path, &png).with_context(|| "cannot write the PNG")?;
+    output::write_file(path, force, &encode_png(&png, path)?)?;
     Ok(ev)
 }
 
@@ -207,9 +238,13 @@ pub fn run(a: RenderArgs) -> Result<()> {
         shadow_rays: a.shadow_rays,
         gather_rays: a.gather_rays,
     };
-    params.validate().map_err(|e| input(e.to_string()))?;
-    for path in [&a.output, &a.exr, &a.pfm].into_iter().flatten() {
-        check_writable(path, a.force)?;
+    params.validate().map_err(|e| input(format!("--width, --height, --spp: {e}")))?;
+    // Every target checked before the solve: folders, --force, and no file named twice.
+    let mut targets = Targets::new(a.force);
+    for (path, option) in [(&a.output, "-o"), (&a.exr, "--exr"), (&a.pfm, "--pfm")] {
+        if let Some(path) = path {
+            targets.file(path, option)?;
+        }
     }
     let prepared = prepare(&a.scene, &a.solve)?;
     let base = prepared.scene.camera_or_framing();
@@ -219,7 +254,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         base.up,
         a.fov.unwrap_or(base.fov_y_deg),
     )
-    .context("camera options")?;
+    .map_err(|e| input(format!("camera options (--camera-position, --look-at, --fov): {e}")))?;
     if a.reference {
         let radiance = crate::verify_cmd::reference_picture(
             &prepared,
@@ -236,12 +271,12 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let solution = solver.solution();
     let start = Instant::now();
     let renderer = Renderer::new(prepared.problem.mesh().clone());
-    let progress = bar(u64::from(params.height), "rendering");
-    let rendering = renderer.render_with_progress(&solution, &camera, &params, &|| progress.inc(1))?;
-    progress.finish_and_clear();
+    let progress = RowProgress::new(u64::from(params.height), "rendering");
+    let rendering = renderer.render_with_progress(&solution, &camera, &params, &|| progress.inc())?;
+    progress.bar.finish_and_clear();
     let render_secs = start.elapsed().as_secs_f64();
 
-    eprintln!(
+    note(format_args!(
         "{}: {} elements, {} shots, unshot {:.4} % ({}), solved in {:.2} s; rendered {}×{} at {} spp (gather {}) in {:.2} s",
         prepared.scene.name,
         prepared.problem.mesh().elements.len(),
@@ -254,33 +289,40 @@ pub fn run(a: RenderArgs) -> Result<()> {
         params.samples_per_pixel,
         params.gather.as_str(),
         render_secs
-    );
+    ))?;
     write_pictures(&a, &rendering.radiance)
 }
 
 /// Writes the picture to every output asked for.
 fn write_pictures(a: &RenderArgs, radiance: &HdrImage) -> Result<()> {
     if let Some(path) = &a.output {
-        let ev = write_tonemapped(path, radiance, &a.tone)?;
-        eprintln!("wrote {} (exposure {ev:+.2} EV, {})", path.display(), ToneOperator::from(a.tone.tonemap));
+        let ev = write_tonemapped(path, a.force, radiance, &a.tone)?;
+        note(format_args!(
+            "wrote {} (exposure {ev:+.2} EV, {})",
+            path.display(),
+            ToneOperator::from(a.tone.tonemap)
+        ))?;
     }
     if let Some(path) = &a.exr {
-        write_exr(path, radiance).context("cannot write the EXR")?;
-        eprintln!("wrote {} (linear radiance)", path.display());
+        output::write_file(path, a.force, &encode_exr(radiance, path)?)?;
+        note(format_args!("wrote {} (linear radiance)", path.display()))?;
     }
     if let Some(path) = &a.pfm {
-        write_pfm(path, radiance).context("cannot write the PFM")?;
-        eprintln!("wrote {} (linear radiance)", path.display());
+        output::write_file(path, a.force, &encode_pfm(radiance))?;
+        note(format_args!("wrote {} (linear radiance)", path.display()))?;
     }
     Ok(())
 }
 
 /// Runs `tonemap`.
 pub fn run_tonemap(a: TonemapArgs) -> Result<()> {
-    check_writable(&a.output, a.force)?;
+    Targets::new(a.force).file(&a.output, "-o")?;
     // A missing or malformed input is the user's to fix: exit code 2.
     let radiance = read_hdr(&a.input).map_err(|e| input(e.to_string()))?;
-    let ev = write_tonemapped(&a.output, &radiance, &a.tone)?;
-    eprintln!("wrote {} (exposure {ev:+.2} EV, {})", a.output.display(), ToneOperator::from(a.tone.tonemap));
-    Ok(())
+    let ev = write_tonemapped(&a.output, a.force, &radiance, &a.tone)?;
+    note(format_args!(
+        "wrote {} (exposure {ev:+.2} EV, {})",
+        a.output.display(),
+        ToneOperator::from(a.tone.tonemap)
+    ))
 }

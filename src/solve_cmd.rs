@@ -4,7 +4,8 @@ use anyhow::Result;
 use clap::Args;
 use serde_json::json;
 
-use crate::prepare::{Prepared, SolveOpts, prepare, run_solver, write_output};
+use crate::output::{self, Targets};
+use crate::prepare::{Prepared, SolveOpts, prepare, run_solver};
 
 /// Arguments of `radiosity solve`.
 #[derive(Args)]
@@ -23,12 +24,13 @@ pub struct SolveArgs {
 
 /// Runs `solve`.
 pub fn run(a: SolveArgs) -> Result<()> {
-    let prepared = prepare(&a.scene, &a.solve)?;
+    // The report's target is checked before the solve, so no solve is lost to it.
     if let Some(path) = &a.json
         && path != "-"
     {
-        crate::prepare::check_writable(std::path::Path::new(path), a.force)?;
+        Targets::new(a.force).file(std::path::Path::new(path), "--json")?;
     }
+    let prepared = prepare(&a.scene, &a.solve)?;
     let (solver, report) = run_solver(&prepared)?;
     let Prepared { scene, problem, .. } = &prepared;
     let mesh = problem.mesh();
@@ -37,7 +39,7 @@ pub fn run(a: SolveArgs) -> Result<()> {
     let secs = report.elapsed.as_secs_f64();
     let stop = report.stop_reason.map_or("running", |s| s.as_str());
     // The source document's figures (S13): facets, iterations, time.
-    eprintln!(
+    output::note(format_args!(
         "{}: {} patches, {} elements, {} shots, {:.3} s, {} rays ({:.2} M rays/s), unshot {:.4} %, {}",
         scene.name,
         mesh.patches.len(),
@@ -48,10 +50,8 @@ pub fn run(a: SolveArgs) -> Result<()> {
         report.rays as f64 / secs.max(1e-9) / 1e6,
         report.unshot_fraction * 100.0,
         stop
-    );
+    ))?;
     if a.json.as_deref() != Some("-") {
-        // Written, not printed: `radiosity solve … | head` closes the pipe early, and a
-        // reader that has seen enough is not an error (println! would panic).
         let mut table = format!(
             "{:<24} {:>12} {:>36} {:>36}\n",
             "object", "area", "emitted power [r g b]", "mean radiosity [r g b]"
@@ -66,13 +66,7 @@ pub fn run(a: SolveArgs) -> Result<()> {
                 f(o.radiosity)
             );
         }
-        let mut out = std::io::stdout().lock();
-        match std::io::Write::write_all(&mut out, table.as_bytes())
-            .and_then(|()| std::io::Write::flush(&mut out))
-        {
-            Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => return Err(e.into()),
-            _ => {}
-        }
+        output::stdout(&table)?;
     }
     if let Some(path) = &a.json {
         let doc = json!({
@@ -91,7 +85,12 @@ pub fn run(a: SolveArgs) -> Result<()> {
                 "radiosity": o.radiosity.to_array(),
             })).collect::<Vec<_>>(),
         });
-        write_output(path, &serde_json::to_string_pretty(&doc)?, a.force)?;
+        let text = serde_json::to_string_pretty(&doc)? + "\n";
+        if path == "-" {
+            output::stdout(&text)?;
+        } else {
+            output::write_file(std::path::Path::new(path), a.force, text.as_bytes())?;
+        }
     }
     Ok(())
 }

@@ -17,7 +17,8 @@ use radiosity_reference::{Estimate, EstimateParams, PathBudget, PictureParams, P
 use radiosity_solver::Problem;
 use serde_json::{Value, json};
 
-use crate::prepare::{InputError, Prepared, SolveOpts, check_writable, prepare, run_solver, write_output};
+use crate::output::{Targets, write_report};
+use crate::prepare::{InputError, Prepared, SolveOpts, prepare, run_solver};
 
 /// Arguments of `radiosity verify`.
 #[derive(Args)]
@@ -187,7 +188,7 @@ pub fn run(a: VerifyArgs) -> Result<()> {
     if let Some(path) = &a.json
         && path != "-"
     {
-        check_writable(std::path::Path::new(path), a.force)?;
+        Targets::new(a.force).file(std::path::Path::new(path), "--json")?;
     }
     let mut prepared = prepare(&a.scene, &a.solve)?;
     if let Some(k) = a.solve_reflectance_scale {
@@ -204,7 +205,7 @@ pub fn run(a: VerifyArgs) -> Result<()> {
     let solved = solution.object_radiosity(mesh);
     let solve_secs = report.elapsed.as_secs_f64();
     let stop = report.stop_reason.map_or("running", |s| s.as_str());
-    eprintln!(
+    crate::output::note(format_args!(
         "{}: solved {} patches, {} elements, {} shots, {:.3} s, unshot {:.4} %, {}",
         scene.name,
         mesh.patches.len(),
@@ -213,7 +214,7 @@ pub fn run(a: VerifyArgs) -> Result<()> {
         solve_secs,
         report.unshot_fraction * 100.0,
         stop
-    );
+    ))?;
 
     let reference = Reference::new(scene);
     let budget = match a.paths {
@@ -227,13 +228,13 @@ pub fn run(a: VerifyArgs) -> Result<()> {
     let estimates = reference.estimate_objects(&params, &|p| report_progress(&bar, p));
     bar.finish_and_clear();
     let ref_secs = estimates.elapsed.as_secs_f64();
-    eprintln!(
+    crate::output::note(format_args!(
         "reference: {:.1} M paths in {:.1} s ({:.2} M paths/s){}",
         estimates.paths as f64 / 1e6,
         ref_secs,
         estimates.paths as f64 / ref_secs.max(1e-9) / 1e6,
         if estimates.timed_out { ", stopped by the time limit" } else { "" }
-    );
+    ))?;
 
     let rows: Vec<Comparison> = solved
         .iter()
@@ -375,7 +376,7 @@ pub fn run(a: VerifyArgs) -> Result<()> {
         if let Some(part) = element_part {
             doc["element_sample"] = part.json;
         }
-        write_output(path, &serde_json::to_string_pretty(&doc)?, a.force)?;
+        write_report(path, a.force, &serde_json::to_string_pretty(&doc)?)?;
     }
     Ok(())
 }
@@ -528,7 +529,7 @@ pub fn reference_picture(
             count += 1;
         }
     }
-    eprintln!(
+    crate::output::note(format_args!(
         "{}: reference picture {}×{} at {} paths per pixel in {:.1} s; mean relative standard error per pixel {}",
         prepared.scene.name,
         width,
@@ -536,6 +537,6 @@ pub fn reference_picture(
         samples_per_pixel,
         start.elapsed().as_secs_f64(),
         if count > 0 { format!("{:.2} %", sum / count as f64 * 100.0) } else { "—".into() }
-    );
+    ))?;
     Ok(HdrImage::from_pixels(width, height, picture.radiance))
 }

@@ -7,7 +7,8 @@ use clap::{Args, ValueEnum};
 use radiosity_image::Exposure;
 use radiosity_viewer::{DisplayMode, Wireframe};
 
-use crate::prepare::{InputError, Settings, SolveOpts, check_writable, settings};
+use crate::output::Targets;
+use crate::prepare::{InputError, Settings, SolveOpts, settings};
 use crate::render_cmd::ToneOpts;
 
 /// What the surfaces show, on the command line.
@@ -84,7 +85,7 @@ pub fn run(a: ViewArgs) -> Result<()> {
     // meshes on its worker so the window opens at once.
     let Settings { scene, mesh_params, solver_params } = settings(&a.scene, o)?;
     if let Some(path) = &a.screenshot {
-        check_writable(path, a.force)?;
+        Targets::new(a.force).file(path, "--screenshot")?;
     }
     if !(a.width >= 200.0 && a.height >= 150.0) {
         return Err(input(format!("the window must be at least 200×150, got {}×{}", a.width, a.height)));

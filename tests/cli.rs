@@ -164,7 +164,8 @@ fn render_furnace_pfm_holds_linear_radiance() {
 }
 
 /// A reader that closes the pipe early (`radiosity solve … | head -1`) is not an error: no
-/// panic, exit 0.
+/// panic, no message, the shell's status for SIGPIPE (141) — or 0 when the table fitted the
+/// pipe before it closed.
 #[test]
 fn a_closed_stdout_pipe_is_not_a_crash() {
     let mut child = Command::new(env!("CARGO_BIN_EXE_radiosity"))
@@ -177,8 +178,8 @@ fn a_closed_stdout_pipe_is_not_a_crash() {
     drop(child.stdout.take());
     let out = child.wait_with_output().expect("wait");
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "exit {:?}: {stderr}", out.status);
-    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(matches!(out.status.code(), Some(0 | 141)), "exit {:?}: {stderr}", out.status);
+    assert!(!stderr.contains("panicked") && !stderr.contains("error"), "{stderr}");
 }
 
 /// `radiosity bench` runs its fixed cases and writes their figures as JSON (values are not

@@ -18,10 +18,10 @@ mod srgb;
 pub use canonical::{cornell_box, furnace_box, furnace_sphere, two_plates, unit_cube_floor_light};
 pub use color::Rgb;
 pub use mesh::{Element, MAX_ELEMENTS, Mesh, MeshError, MeshParams, Patch, Surface};
-pub use one_line::{escape_controls, one_line};
+pub use one_line::{MAX_PART_CHARS, escape_controls, one_line};
 pub use scene::{
-    Camera, Facing, Material, Object, Polygon, PolygonMesh, Scene, SceneError, Shape, SolverSettings, Sphere,
-    box_faces, unique_names,
+    Camera, Facing, MAX_POLYGON_VERTICES, MAX_TIME_LIMIT_SECONDS, Material, Object, Polygon, PolygonMesh,
+    Scene, SceneError, Shape, SolverSettings, Sphere, box_faces, unique_names,
 };
 pub use srgb::{encode_srgb, srgb_decode, srgb_encode};
 

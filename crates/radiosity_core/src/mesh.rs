@@ -69,9 +69,13 @@ impl MeshParams {
 pub enum MeshError {
     /// The subdivision would create more elements than the limit.
     #[error(
-        "the mesh would have more than {limit} elements (patch_size {patch_size}, element_size {element_size}); use a larger element_size"
+        "the mesh would have more than {limit} elements by object '{object}' (patch_size {}, element_size {}); use a larger element_size ([mesh] in the scene, or --element-size)",
+        short_number(*.patch_size),
+        short_number(*.element_size)
     )]
     TooManyElements {
+        /// The object at which the running count passed the limit.
+        object: String,
         /// The limit.
         limit: usize,
         /// Patch size asked for.
@@ -79,6 +83,12 @@ pub enum MeshError {
         /// Element size asked for.
         element_size: f64,
     },
+}
+
+/// A number as a person reads it: plain in the usual range, in exponent form otherwise (a
+/// `1e300` is not printed as 301 digits).
+fn short_number(v: f64) -> String {
+    if v == 0.0 || (1e-4..1e9).contains(&v.abs()) { format!("{v}") } else { format!("{v:e}") }
 }
 
 /// Most elements a mesh may have; beyond this memory and time explode, so it is an error
@@ -534,8 +544,10 @@ fn mesh_triangle_group(b: &mut SurfaceBuilder, m: &PolygonMesh, group: &[u32], p
 
 fn estimate_polygon_elements(poly: &Polygon, params: &MeshParams) -> usize {
     let v = poly.vertices();
-    let diameter = v.iter().flat_map(|a| v.iter().map(move |b| a.distance(*b))).fold(0.0, f64::max);
-    let per_edge = divisions(diameter, params.element_size) as f64;
+    // The bounding box's diagonal bounds the diameter (within √3) in linear time: the
+    // pairwise maximum was quadratic in the corners (39 s for a 10⁵-gon).
+    let (lo, hi) = v.iter().fold((v[0], v[0]), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+    let per_edge = divisions(lo.distance(hi), params.element_size) as f64;
     // A fan of k-2 triangles with n² elements each bounds every case.
     (per_edge * per_edge * (v.len() - 2) as f64).min(usize::MAX as f64) as usize
 }
@@ -546,7 +558,8 @@ impl Mesh {
     /// # Errors
     /// [`MeshError::TooManyElements`] when the subdivision would exceed [`MAX_ELEMENTS`].
     pub fn build(scene: &Scene, params: &MeshParams) -> Result<Mesh, MeshError> {
-        let too_many = || MeshError::TooManyElements {
+        let too_many = |object: &str| MeshError::TooManyElements {
+            object: object.chars().take(80).collect(),
             limit: MAX_ELEMENTS,
             patch_size: params.patch_size,
             element_size: params.element_size,
@@ -562,7 +575,7 @@ impl Mesh {
                 Shape::Mesh(m) => m.polygons().iter().map(|p| estimate_polygon_elements(p, params)).sum(),
             });
             if estimate > MAX_ELEMENTS {
-                return Err(too_many());
+                return Err(too_many(&o.name));
             }
         }
         let mut mesh = Mesh {

@@ -22,13 +22,25 @@ pub fn one_line(e: &(dyn std::error::Error + 'static)) -> String {
 }
 
 /// `s` with control characters (a newline in a material name, say) escaped as Rust escapes
-/// them (`\n`, `\t`, `\u{1b}`), so that a message stays one line whatever a file holds.
+/// them (`\n`, `\t`, `\u{1b}`), so that a message stays one line whatever a file holds, and
+/// cut to [`MAX_PART_CHARS`].
 pub fn escape_controls(s: &str) -> String {
+    let count = s.chars().count();
+    let s: String = if count > MAX_PART_CHARS {
+        let head: String = s.chars().take(MAX_PART_CHARS - 60).collect();
+        format!("{head}… ({count} characters)")
+    } else {
+        s.to_owned()
+    };
     if !s.chars().any(char::is_control) {
-        return s.to_owned();
+        return s;
     }
     s.chars().map(|c| if c.is_control() { c.escape_default().to_string() } else { c.to_string() }).collect()
 }
+
+/// Longest part of an error message kept whole, in characters; a longer one (a 1 MB key
+/// echoed by the TOML parser) is cut, saying how long it was.
+pub const MAX_PART_CHARS: usize = 1000;
 
 #[cfg(test)]
 mod tests {

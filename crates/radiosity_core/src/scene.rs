@@ -42,6 +42,14 @@ pub enum SceneError {
         /// Number of vertices given.
         count: usize,
     },
+    /// A polygon has more vertices than [`MAX_POLYGON_VERTICES`].
+    #[error("polygon has {count} vertices, more than the {limit} accepted; split it into smaller faces")]
+    TooManyVertices {
+        /// Number of vertices given.
+        count: usize,
+        /// [`MAX_POLYGON_VERTICES`].
+        limit: usize,
+    },
     /// A polygon's area is zero (collinear or repeated vertices).
     #[error("polygon is degenerate: its area is {area:e}, its vertices are collinear or repeated")]
     DegeneratePolygon {
@@ -188,14 +196,20 @@ pub struct Polygon {
 impl Polygon {
     /// A validated polygon.
     ///
-    /// Planarity tolerance is 1e-4 of the polygon's diameter; that keeps measured data such as
+    /// Planarity tolerance is 1e-4 of the bounding box diagonal; that keeps measured data such as
     /// the Cornell box (whose non-planar red wall is given as two triangles) exact.
     ///
+    /// Linear in the vertex count.
+    ///
     /// # Errors
-    /// Too few vertices, non-finite coordinates, zero area, non-planar or non-convex.
+    /// Too few or too many vertices, non-finite coordinates, zero area, non-planar or
+    /// non-convex.
     pub fn try_new(vertices: Vec<DVec3>) -> Result<Self, SceneError> {
         if vertices.len() < 3 {
             return Err(SceneError::TooFewVertices { count: vertices.len() });
+        }
+        if vertices.len() > MAX_POLYGON_VERTICES {
+            return Err(SceneError::TooManyVertices { count: vertices.len(), limit: MAX_POLYGON_VERTICES });
         }
         for &v in &vertices {
             check_finite(v)?;
@@ -207,8 +221,12 @@ impl Polygon {
             n += a.cross(b);
         }
         let area = 0.5 * n.length();
-        let diameter =
-            vertices.iter().flat_map(|a| vertices.iter().map(move |b| a.distance(*b))).fold(0.0, f64::max);
+        // The bounding box's diagonal stands for the diameter in the tolerances below: it is
+        // within a factor √3 of it and linear to compute (the pairwise maximum took 80 s at
+        // 10⁵ corners).
+        let (lo, hi) =
+            vertices.iter().fold((vertices[0], vertices[0]), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
+        let diameter = lo.distance(hi);
         // NaN-safe: a NaN area must also be rejected, hence the explicit `is_nan`.
         if area.is_nan() || area <= 1e-12 * diameter * diameter || diameter == 0.0 {
             return Err(SceneError::DegeneratePolygon { area });
@@ -465,6 +483,15 @@ impl Camera {
     }
 }
 
+/// Most vertices of one polygon (or one mesh face): 2²⁰. Validation and meshing are linear in
+/// the corners (a fan of triangles), so this is a bound on the fan's elements, not on time;
+/// a face with more corners is a tessellated curve better given as a mesh of triangles.
+pub const MAX_POLYGON_VERTICES: usize = 1 << 20;
+
+/// Longest solve time limit accepted, in seconds (about 31.7 years): any longer limit is no
+/// limit, and a larger number does not fit a `Duration`'s arithmetic in every caller.
+pub const MAX_TIME_LIMIT_SECONDS: f64 = 1e9;
+
 /// Stop settings a scene file may carry for the solver (all optional; the solver has defaults).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SolverSettings {
@@ -472,7 +499,7 @@ pub struct SolverSettings {
     pub unshot_threshold: Option<f64>,
     /// Stop after this many shots.
     pub max_shots: Option<u64>,
-    /// Stop after this many seconds.
+    /// Stop after this many seconds, in (0, [`MAX_TIME_LIMIT_SECONDS`]].
     pub time_limit: Option<f64>,
 }
 
@@ -620,6 +647,26 @@ pub fn unique_names(names: &mut [String]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A 10⁵-gon (a disc) is validated in linear time (the pairwise diameter took 80 s), and
+    /// one corner past [`MAX_POLYGON_VERTICES`] is refused before any other work.
+    #[test]
+    fn many_cornered_polygons_are_linear_or_refused() {
+        let n = 100_000;
+        let disc: Vec<DVec3> = (0..n)
+            .map(|k| {
+                let a = std::f64::consts::TAU * k as f64 / n as f64;
+                DVec3::new(a.cos(), a.sin(), 0.0)
+            })
+            .collect();
+        let p = Polygon::try_new(disc).unwrap();
+        assert!((p.area() - std::f64::consts::PI).abs() < 1e-6, "{}", p.area());
+        let e = Polygon::try_new(vec![DVec3::ZERO; MAX_POLYGON_VERTICES + 1]).unwrap_err();
+        assert_eq!(
+            e,
+            SceneError::TooManyVertices { count: MAX_POLYGON_VERTICES + 1, limit: MAX_POLYGON_VERTICES }
+        );
+    }
 
     #[test]
     fn polygon_normal_follows_counter_clockwise_order() {

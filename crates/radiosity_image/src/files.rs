@@ -5,11 +5,17 @@
 //! `PF\n<width> <height>\n<scale>\n`, then `width × height` RGB triples of 32-bit floats, rows
 //! from the **bottom** of the picture to the top; a negative scale means little-endian.
 //!
+//! Every writer here encodes into memory first and then writes the bytes to a temporary file
+//! beside the target, synced, and renamed into place ([`write_file_atomic`]): a crash or a
+//! full disk leaves any older file whole, and a failed write never removes the target.
+//! Every reader takes regular files only (a FIFO would block, a device never ends) and checks
+//! the sizes a header declares against [`MAX_PICTURE_PIXELS`] before it allocates.
+//!
 //! These live here rather than in `radiosity_io` (a deviation from `DESIGN.md`) so that the
 //! scene loader and the picture writers could be built side by side.
 
 use std::fs;
-use std::io::{BufWriter, Write};
+use std::io::{Cursor, Read, Write};
 use std::path::{Path, PathBuf};
 
 use radiosity_core::Rgb;
@@ -60,6 +66,35 @@ pub enum ImageFileError {
         /// The extensions accepted.
         expected: &'static str,
     },
+    /// A header declares more pixels than [`MAX_PICTURE_PIXELS`].
+    #[error(
+        "{path}: a {width}×{height} picture is larger than this program reads (at most {} pixels)",
+        MAX_PICTURE_PIXELS
+    )]
+    TooLarge {
+        /// The file.
+        path: PathBuf,
+        /// Declared width.
+        width: u64,
+        /// Declared height.
+        height: u64,
+    },
+    /// The path is a folder, a FIFO or a device, not a regular file.
+    #[error("{path}: not a regular file")]
+    NotAFile {
+        /// The path.
+        path: PathBuf,
+    },
+    /// The file is larger than any picture read.
+    #[error("{path}: {bytes} bytes is larger than any picture read (at most {limit})")]
+    FileTooLarge {
+        /// The file.
+        path: PathBuf,
+        /// Its size.
+        bytes: u64,
+        /// The limit.
+        limit: u64,
+    },
     /// A picture with no pixels cannot be saved.
     #[error("{path}: the picture is empty ({width}×{height})")]
     Empty {
@@ -70,6 +105,60 @@ pub enum ImageFileError {
         /// Height.
         height: u32,
     },
+}
+
+/// Most pixels in a picture read or rendered: 2²⁶ (8192 × 8192). As linear RGB in `f64` that
+/// is 1.5 GiB, and the renderer and encoders need about as much again; a larger header is
+/// more likely a broken or hostile file than a picture this machine can hold.
+pub const MAX_PICTURE_PIXELS: u64 = 1 << 26;
+
+/// Bytes of the largest picture file read: the largest PFM (12 bytes per pixel) and a header.
+const MAX_PICTURE_FILE_BYTES: u64 = MAX_PICTURE_PIXELS * 12 + 4096;
+
+fn check_size(path: &Path, width: u64, height: u64) -> Result<(), ImageFileError> {
+    if width.saturating_mul(height) > MAX_PICTURE_PIXELS {
+        return Err(ImageFileError::TooLarge { path: path.to_owned(), width, height });
+    }
+    Ok(())
+}
+
+/// Reads a whole regular file of at most `limit` bytes; anything else (a FIFO, a device, a
+/// folder, a larger file) is refused before a byte is read.
+fn read_regular(path: &Path, limit: u64) -> Result<Vec<u8>, ImageFileError> {
+    let meta = fs::metadata(path).map_err(io_err(path))?;
+    if !meta.is_file() {
+        return Err(ImageFileError::NotAFile { path: path.to_owned() });
+    }
+    if meta.len() > limit {
+        return Err(ImageFileError::FileTooLarge { path: path.to_owned(), bytes: meta.len(), limit });
+    }
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    // `take`: the file may have grown since it was measured.
+    fs::File::open(path).and_then(|f| f.take(limit + 1).read_to_end(&mut bytes)).map_err(io_err(path))?;
+    if bytes.len() as u64 > limit {
+        return Err(ImageFileError::FileTooLarge { path: path.to_owned(), bytes: bytes.len() as u64, limit });
+    }
+    Ok(bytes)
+}
+
+/// Writes `bytes` to `path` through a temporary file in the same folder: written, flushed,
+/// synced, then renamed over `path`. A failure at any step leaves `path` as it was.
+///
+/// # Errors
+/// [`ImageFileError::Io`] naming `path`.
+pub fn write_file_atomic(path: &Path, bytes: &[u8]) -> Result<(), ImageFileError> {
+    let folder = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let mut prefix = std::ffi::OsString::from(".");
+    prefix.push(path.file_name().unwrap_or_default());
+    prefix.push(".");
+    let mut tmp =
+        tempfile::Builder::new().prefix(&prefix).suffix(".tmp").tempfile_in(folder).map_err(io_err(path))?;
+    tmp.write_all(bytes).and_then(|()| tmp.as_file().sync_all()).map_err(io_err(path))?;
+    tmp.persist(path).map_err(|e| ImageFileError::Io { path: path.to_owned(), source: e.error })?;
+    Ok(())
 }
 
 fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> ImageFileError + '_ {
@@ -89,16 +178,27 @@ fn check_not_empty(path: &Path, width: u32, height: u32) -> Result<(), ImageFile
 /// [`ImageFileError::Png`] / [`ImageFileError::Io`] when the file cannot be written,
 /// [`ImageFileError::Empty`] for a picture without pixels.
 pub fn write_png(path: &Path, image: &SrgbImage) -> Result<(), ImageFileError> {
+    write_file_atomic(path, &encode_png(image, path)?)
+}
+
+/// Encodes an 8-bit sRGB picture as PNG bytes. `path` only names the file in errors.
+///
+/// # Errors
+/// [`ImageFileError::Png`] from the encoder, [`ImageFileError::Empty`] for a picture without
+/// pixels.
+pub fn encode_png(image: &SrgbImage, path: &Path) -> Result<Vec<u8>, ImageFileError> {
     check_not_empty(path, image.width, image.height)?;
-    image::save_buffer_with_format(
-        path,
+    let mut out = Cursor::new(Vec::new());
+    image::write_buffer_with_format(
+        &mut out,
         &image.as_bytes(),
         image.width,
         image.height,
         image::ExtendedColorType::Rgb8,
         image::ImageFormat::Png,
     )
-    .map_err(|source| ImageFileError::Png { path: path.to_owned(), source })
+    .map_err(|source| ImageFileError::Png { path: path.to_owned(), source })?;
+    Ok(out.into_inner())
 }
 
 /// Reads a PNG as an 8-bit sRGB picture (grey or alpha channels are converted to RGB).
@@ -106,8 +206,12 @@ pub fn write_png(path: &Path, image: &SrgbImage) -> Result<(), ImageFileError> {
 /// # Errors
 /// [`ImageFileError::Png`] when the file is missing or not a PNG.
 pub fn read_png(path: &Path) -> Result<SrgbImage, ImageFileError> {
-    let img =
-        image::open(path).map_err(|source| ImageFileError::Png { path: path.to_owned(), source })?.to_rgb8();
+    let bytes = read_regular(path, MAX_PICTURE_FILE_BYTES)?;
+    let png = |source| ImageFileError::Png { path: path.to_owned(), source };
+    let decoder = image::ImageReader::with_format(Cursor::new(&bytes), image::ImageFormat::Png);
+    let (w, h) = decoder.into_dimensions().map_err(png)?;
+    check_size(path, u64::from(w), u64::from(h))?;
+    let img = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png).map_err(png)?.to_rgb8();
     Ok(SrgbImage { width: img.width(), height: img.height(), pixels: img.pixels().map(|p| p.0).collect() })
 }
 
@@ -117,13 +221,30 @@ pub fn read_png(path: &Path) -> Result<SrgbImage, ImageFileError> {
 /// [`ImageFileError::Exr`] when the file cannot be written, [`ImageFileError::Empty`] for a
 /// picture without pixels.
 pub fn write_exr(path: &Path, image: &HdrImage) -> Result<(), ImageFileError> {
+    write_file_atomic(path, &encode_exr(image, path)?)
+}
+
+/// Encodes linear radiance as 32-bit float RGB OpenEXR bytes. `path` only names the file in
+/// errors.
+///
+/// # Errors
+/// [`ImageFileError::Exr`] from the encoder, [`ImageFileError::Empty`] for a picture without
+/// pixels.
+pub fn encode_exr(image: &HdrImage, path: &Path) -> Result<Vec<u8>, ImageFileError> {
+    use exr::prelude::WritableImage;
     check_not_empty(path, image.width(), image.height())?;
     let w = image.width() as usize;
-    exr::prelude::write_rgb_file(path, w, image.height() as usize, |x, y| {
-        let p = image.pixels()[y * w + x];
+    let channels = exr::prelude::SpecificChannels::rgb(|pos: exr::prelude::Vec2<usize>| {
+        let p = image.pixels()[pos.y() * w + pos.x()];
         (p.r as f32, p.g as f32, p.b as f32)
-    })
-    .map_err(|source| ImageFileError::Exr { path: path.to_owned(), source })
+    });
+    let picture = exr::prelude::Image::from_channels((w, image.height() as usize), channels);
+    let mut out = Cursor::new(Vec::new());
+    picture
+        .write()
+        .to_buffered(&mut out)
+        .map_err(|source| ImageFileError::Exr { path: path.to_owned(), source })?;
+    Ok(out.into_inner())
 }
 
 /// Reads the first RGB(A) layer of an OpenEXR file as linear radiance (alpha is dropped).
@@ -131,14 +252,32 @@ pub fn write_exr(path: &Path, image: &HdrImage) -> Result<(), ImageFileError> {
 /// # Errors
 /// [`ImageFileError::Exr`] when the file is missing, malformed or has no RGB layer.
 pub fn read_exr(path: &Path) -> Result<HdrImage, ImageFileError> {
-    let img = exr::prelude::read_first_rgba_layer_from_file(
-        path,
-        |size, _| HdrImage::new(size.width() as u32, size.height() as u32),
-        |img: &mut HdrImage, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-            img.set_pixel(pos.x() as u32, pos.y() as u32, Rgb::new(f64::from(r), f64::from(g), f64::from(b)));
-        },
-    )
-    .map_err(|source| ImageFileError::Exr { path: path.to_owned(), source })?;
+    use exr::prelude::{ReadChannels, ReadLayers};
+    let bytes = read_regular(path, MAX_PICTURE_FILE_BYTES)?;
+    let exr_err = |source| ImageFileError::Exr { path: path.to_owned(), source };
+    // The header first: every layer's declared size is checked before a pixel is allocated.
+    let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(&bytes), false).map_err(exr_err)?;
+    for header in &meta.headers {
+        let size = header.layer_size;
+        check_size(path, size.width() as u64, size.height() as u64)?;
+    }
+    let img = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .rgba_channels(
+            |size, _| HdrImage::new(size.width() as u32, size.height() as u32),
+            |img: &mut HdrImage, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+                img.set_pixel(
+                    pos.x() as u32,
+                    pos.y() as u32,
+                    Rgb::new(f64::from(r), f64::from(g), f64::from(b)),
+                );
+            },
+        )
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(Cursor::new(&bytes))
+        .map_err(exr_err)?;
     Ok(img.layer_data.channel_data.pixels)
 }
 
@@ -194,9 +333,11 @@ pub fn decode_pfm(bytes: &[u8], path: &Path) -> Result<HdrImage, ImageFileError>
         return Err(bad("the scale must be a finite non-zero number"));
     }
     let little_endian = scale < 0.0;
+    check_size(path, u64::from(width), u64::from(height))?;
     let data = bytes.get(pos + 1..).ok_or_else(|| bad("no pixel data"))?;
-    let count = width as usize * height as usize * channels;
-    if data.len() < count * 4 {
+    // In u64, and after the size check: 2³¹ × 2³¹ must not wrap around to a small count.
+    let count = u64::from(width) * u64::from(height) * channels as u64;
+    if (data.len() as u64) < count * 4 {
         return Err(bad(&format!(
             "{width}×{height} needs {} bytes of pixel data, found {}",
             count * 4,
@@ -222,10 +363,7 @@ pub fn decode_pfm(bytes: &[u8], path: &Path) -> Result<HdrImage, ImageFileError>
 /// picture without pixels.
 pub fn write_pfm(path: &Path, image: &HdrImage) -> Result<(), ImageFileError> {
     check_not_empty(path, image.width(), image.height())?;
-    let file = fs::File::create(path).map_err(io_err(path))?;
-    let mut out = BufWriter::new(file);
-    out.write_all(&encode_pfm(image)).map_err(io_err(path))?;
-    out.flush().map_err(io_err(path))
+    write_file_atomic(path, &encode_pfm(image))
 }
 
 /// Reads a PFM file as linear radiance.
@@ -233,7 +371,7 @@ pub fn write_pfm(path: &Path, image: &HdrImage) -> Result<(), ImageFileError> {
 /// # Errors
 /// [`ImageFileError::Io`] when it cannot be read, [`ImageFileError::BadPfm`] when malformed.
 pub fn read_pfm(path: &Path) -> Result<HdrImage, ImageFileError> {
-    decode_pfm(&fs::read(path).map_err(io_err(path))?, path)
+    decode_pfm(&read_regular(path, MAX_PICTURE_FILE_BYTES)?, path)
 }
 
 /// Which linear picture format a file name asks for, from its extension.

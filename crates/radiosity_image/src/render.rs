@@ -60,7 +60,8 @@ impl Shading {
 pub struct RenderParams {
     /// Picture width in pixels, in 1..=16384. Default 640.
     pub width: u32,
-    /// Picture height in pixels, in 1..=16384. Default 480.
+    /// Picture height in pixels, in 1..=16384; width × height at most
+    /// [`MAX_PICTURE_PIXELS`](crate::MAX_PICTURE_PIXELS). Default 480.
     pub height: u32,
     /// Jittered samples per pixel, in 1..=4096. Default 16 (4 × 4 strata: clean edges).
     pub samples_per_pixel: u32,
@@ -128,6 +129,19 @@ impl RenderParams {
         };
         check("width", self.width, Self::MAX_SIDE)?;
         check("height", self.height, Self::MAX_SIDE)?;
+        // The memory estimate: each pixel's linear radiance (24 bytes), the tone-mapped and
+        // encoded copies (~16 bytes) — about 40 bytes a pixel, 2.5 GiB at the limit.
+        let pixels = u64::from(self.width) * u64::from(self.height);
+        if pixels > crate::MAX_PICTURE_PIXELS {
+            return Err(RenderError::BadParameter {
+                name: "width × height",
+                value: pixels,
+                expected: format!(
+                    "at most {} pixels (e.g. 8192 × 8192; about 40 bytes of memory a pixel)",
+                    crate::MAX_PICTURE_PIXELS
+                ),
+            });
+        }
         check("samples_per_pixel", self.samples_per_pixel, Self::MAX_SAMPLES)?;
         check("shadow_rays", self.shadow_rays, Self::MAX_GATHER_RAYS)?;
         check("gather_rays", self.gather_rays, Self::MAX_GATHER_RAYS)

@@ -123,3 +123,73 @@ fn unknown_extensions_and_empty_pictures_are_refused() {
     let missing = read_exr(&scratch("does/not/exist.exr")).unwrap_err();
     assert!(missing.to_string().contains("exist.exr"), "{missing}");
 }
+
+/// Declared sizes are checked before anything is allocated: a PFM header of 2³¹ × 2³¹ (whose
+/// byte count once wrapped around and then indexed past the data), and an EXR whose header
+/// claims 100 000 × 100 000 (240 GB as linear RGB).
+#[test]
+fn huge_declared_sizes_are_refused_before_allocating() {
+    for header in
+        ["PF\n2147483648 2147483648\n-1.0\n", "Pf\n4294967295 4294967295\n1.0\n", "PF\n100000 100000\n-1\n"]
+    {
+        let mut bytes = header.as_bytes().to_vec();
+        bytes.extend_from_slice(&[0; 64]);
+        let e = decode_pfm(&bytes, &PathBuf::from("h.pfm")).unwrap_err();
+        assert!(matches!(e, ImageFileError::TooLarge { .. }), "{header:?}: {e}");
+    }
+    // A real EXR whose data and display windows are patched to 100 000².
+    let path = scratch("huge.exr");
+    write_exr(&path, &test_picture()).unwrap();
+    let mut bytes = std::fs::read(&path).unwrap();
+    for name in [&b"dataWindow\0box2i\0"[..], &b"displayWindow\0box2i\0"[..]] {
+        let at = bytes.windows(name.len()).position(|w| w == name).unwrap() + name.len() + 4;
+        for (k, v) in [0i32, 0, 99_999, 99_999].into_iter().enumerate() {
+            bytes[at + 4 * k..at + 4 * k + 4].copy_from_slice(&v.to_le_bytes());
+        }
+    }
+    std::fs::write(&path, &bytes).unwrap();
+    let e = read_exr(&path).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            ImageFileError::TooLarge { width: 100_000, height: 100_000, .. } | ImageFileError::Exr { .. }
+        ),
+        "{e}"
+    );
+}
+
+/// Only regular files are read: a folder or a device is refused at once, not read forever.
+#[cfg(unix)]
+#[test]
+fn only_regular_files_are_read() {
+    for path in ["/dev/zero", "/dev/null", "/tmp"] {
+        let e = read_pfm(&PathBuf::from(path)).unwrap_err();
+        assert!(matches!(e, ImageFileError::NotAFile { .. }), "{path}: {e}");
+        let e = read_exr(&PathBuf::from(path)).unwrap_err();
+        assert!(matches!(e, ImageFileError::NotAFile { .. }), "{path}: {e}");
+    }
+}
+
+/// Writers go through a temporary file and a rename: a failed write leaves the target as it
+/// was (the EXR writer used to delete it), and a successful one leaves no temporary file.
+#[test]
+fn writes_are_atomic() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("p.exr");
+    write_exr(&path, &test_picture()).unwrap();
+    write_pfm(&dir.path().join("p.pfm"), &test_picture()).unwrap();
+    write_png(&dir.path().join("p.png"), &SrgbImage { width: 1, height: 1, pixels: vec![[1, 2, 3]] })
+        .unwrap();
+    let mut names: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["p.exr", "p.pfm", "p.png"]);
+    // An empty picture cannot be written: the old file stays.
+    let before = std::fs::read(&path).unwrap();
+    assert!(write_exr(&path, &HdrImage::new(0, 0)).is_err());
+    assert_eq!(std::fs::read(&path).unwrap(), before);
+    // A folder that does not exist: an error, nothing made.
+    assert!(write_pfm(&dir.path().join("no/p.pfm"), &test_picture()).is_err());
+}

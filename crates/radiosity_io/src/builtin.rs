@@ -37,7 +37,10 @@ pub fn builtin_scene(name: &str) -> Option<Scene> {
 /// other name.
 pub fn resolve_scene(arg: &str) -> Result<LoadedScene, LoadError> {
     let path = Path::new(arg);
-    if path.is_file() || arg.ends_with(".toml") || ModelFormat::from_path(path).is_some() {
+    // Anything there but a folder is read as a file, so a FIFO or a device is refused by
+    // the loader rather than taken for an unknown built-in name.
+    let present = std::fs::metadata(path).is_ok_and(|m| !m.is_dir());
+    if present || arg.ends_with(".toml") || ModelFormat::from_path(path).is_some() {
         return load_scene(path);
     }
     builtin_scene(arg)

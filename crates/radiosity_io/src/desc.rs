@@ -4,7 +4,8 @@
 //! rather than a silently ignored setting. Values that the second stage validates are
 //! wrapped in [`Spanned`], so that stage can say on which line the bad value sits.
 
-use serde::Deserialize;
+use serde::de::Error as _;
+use serde::{Deserialize, Deserializer};
 use toml::Spanned;
 
 /// A point `[x, y, z]` and where it was written.
@@ -12,6 +13,52 @@ pub(crate) type Point = Spanned<[f64; 3]>;
 
 /// A polygon's vertex list and where it was written.
 pub(crate) type Face = Spanned<Vec<Point>>;
+
+/// Exactly three numbers: serde reads a `[f64; 3]` from the first three values of a longer
+/// array and drops the rest, so `[x, y, z, w]` would pass silently.
+pub(crate) struct Exactly3(pub(crate) [f64; 3]);
+
+impl<'de> Deserialize<'de> for Exactly3 {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let values = Vec::<f64>::deserialize(d)?;
+        <[f64; 3]>::try_from(values.as_slice()).map(Exactly3).map_err(|_| {
+            D::Error::custom(format!("invalid length {}, expected 3 numbers [x, y, z]", values.len()))
+        })
+    }
+}
+
+fn point_of(p: Spanned<Exactly3>) -> Point {
+    let span = p.span();
+    Spanned::new(span, p.into_inner().0)
+}
+
+fn face_of(f: Spanned<Vec<Spanned<Exactly3>>>) -> Face {
+    let span = f.span();
+    Spanned::new(span, f.into_inner().into_iter().map(point_of).collect())
+}
+
+/// A [`Point`] of exactly three numbers.
+fn point<'de, D: Deserializer<'de>>(d: D) -> Result<Point, D::Error> {
+    Spanned::<Exactly3>::deserialize(d).map(point_of)
+}
+
+/// An optional [`Point`] of exactly three numbers.
+fn point_opt<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Point>, D::Error> {
+    Ok(Option::<Spanned<Exactly3>>::deserialize(d)?.map(point_of))
+}
+
+/// An optional [`Face`] whose points are exactly three numbers.
+fn face_opt<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Face>, D::Error> {
+    Ok(Option::<Spanned<Vec<Spanned<Exactly3>>>>::deserialize(d)?.map(face_of))
+}
+
+/// Optional faces whose points are exactly three numbers.
+fn faces_opt<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Spanned<Vec<Face>>>, D::Error> {
+    Ok(Option::<Spanned<Vec<Spanned<Vec<Spanned<Exactly3>>>>>>::deserialize(d)?.map(|f| {
+        let span = f.span();
+        Spanned::new(span, f.into_inner().into_iter().map(face_of).collect())
+    }))
+}
 
 /// The whole file.
 #[derive(Deserialize)]
@@ -38,10 +85,13 @@ pub(crate) struct SceneDesc {
 #[serde(deny_unknown_fields)]
 pub(crate) struct CameraDesc {
     /// Eye position.
+    #[serde(deserialize_with = "point")]
     pub(crate) position: Point,
     /// Point looked at.
+    #[serde(deserialize_with = "point")]
     pub(crate) look_at: Point,
     /// Up direction; default `[0, 1, 0]`.
+    #[serde(default, deserialize_with = "point_opt")]
     pub(crate) up: Option<Point>,
     /// Vertical field of view in degrees, in (0, 180); default 45.
     pub(crate) fov_y_deg: Option<Spanned<f64>>,
@@ -54,8 +104,10 @@ pub(crate) struct MaterialDesc {
     /// Unique name, referenced by objects.
     pub(crate) name: Spanned<String>,
     /// ρ per channel, each in [0, 1).
+    #[serde(deserialize_with = "point")]
     pub(crate) reflectance: Spanned<[f64; 3]>,
     /// Emitted radiosity W/m² per channel, each ≥ 0; default 0.
+    #[serde(default, deserialize_with = "point_opt")]
     pub(crate) emission: Option<Spanned<[f64; 3]>>,
 }
 
@@ -74,18 +126,23 @@ pub(crate) struct ObjectDesc {
     /// materials.
     pub(crate) material: Option<Spanned<String>>,
     /// `polygon`: the vertices, counter-clockwise seen from the lit side.
+    #[serde(default, deserialize_with = "face_opt")]
     pub(crate) vertices: Option<Face>,
     /// `polygons`: several vertex lists.
+    #[serde(default, deserialize_with = "faces_opt")]
     pub(crate) faces: Option<Spanned<Vec<Face>>>,
     /// `box`: minimum corner.
+    #[serde(default, deserialize_with = "point_opt")]
     pub(crate) min: Option<Point>,
     /// `box`: maximum corner.
+    #[serde(default, deserialize_with = "point_opt")]
     pub(crate) max: Option<Point>,
     /// `box`, `sphere`: `"inward"` or `"outward"` (default).
     pub(crate) normals: Option<Spanned<String>>,
     /// `box`: rotation about the vertical axis through its centre, degrees; default 0.
     pub(crate) rotate_y_deg: Option<Spanned<f64>>,
     /// `sphere`: centre.
+    #[serde(default, deserialize_with = "point_opt")]
     pub(crate) center: Option<Point>,
     /// `sphere`: radius > 0.
     pub(crate) radius: Option<Spanned<f64>>,
@@ -100,6 +157,7 @@ pub(crate) struct ObjectDesc {
 #[serde(deny_unknown_fields)]
 pub(crate) struct TransformDesc {
     /// Offset, scene units; default 0.
+    #[serde(default, deserialize_with = "point_opt")]
     pub(crate) translate: Option<Spanned<[f64; 3]>>,
     /// One number or one per axis, each finite and ≠ 0; default 1.
     pub(crate) scale: Option<Spanned<Scale>>,
@@ -118,7 +176,7 @@ pub(crate) enum Scale {
     /// The same factor on every axis.
     Uniform(f64),
     /// One factor per axis.
-    PerAxis([f64; 3]),
+    PerAxis(Exactly3),
 }
 
 /// `[mesh]`.

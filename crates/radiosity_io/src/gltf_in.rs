@@ -172,6 +172,32 @@ pub(crate) fn parse_gltf(
 ) -> Result<Model, LoadError> {
     let err = |message: String| model_error(origin, None, message);
     let (document, blob) = read_document(bytes).map_err(|m| err(format!("glTF: {m}")))?;
+    // The crate reads external buffers itself, unbounded: a FIFO or `/dev/zero` named as a
+    // buffer would block or exhaust memory, so each is checked first.
+    for buffer in document.buffers() {
+        if let (gltf::buffer::Source::Uri(uri), Some(base)) = (buffer.source(), base)
+            && !uri.starts_with("data:")
+            && !uri.contains('%')
+        {
+            let path = base.join(uri);
+            if let Ok(meta) = std::fs::metadata(&path) {
+                if !meta.is_file() {
+                    return Err(err(format!(
+                        "glTF buffer {}: '{uri}' is not a regular file",
+                        buffer.index()
+                    )));
+                }
+                if meta.len() > crate::model::MAX_MODEL_BYTES {
+                    return Err(err(format!(
+                        "glTF buffer {}: '{uri}' is {} bytes, more than the {} read",
+                        buffer.index(),
+                        meta.len(),
+                        crate::model::MAX_MODEL_BYTES
+                    )));
+                }
+            }
+        }
+    }
     let buffers =
         gltf::import_buffers(&document, base, blob).map_err(|e| err(format!("glTF buffers: {e}")))?;
     let mut warnings = Vec::new();

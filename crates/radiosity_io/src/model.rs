@@ -114,6 +114,37 @@ impl ModelFormat {
     }
 }
 
+/// Largest model file read (OBJ, glTF, GLB, and each external glTF buffer): 1 GiB.
+pub(crate) const MAX_MODEL_BYTES: u64 = 1 << 30;
+
+/// Largest scene or MTL text read: 64 MiB, far past any hand-written file.
+pub(crate) const MAX_TEXT_BYTES: u64 = 64 << 20;
+
+/// Reads a whole input file: only a regular file (a FIFO would block, `/dev/zero` never
+/// ends), of at most `limit` bytes, both checked before reading.
+///
+/// # Errors
+/// A one-line reason, without the path (callers name the file).
+pub(crate) fn read_input_file(path: &Path, limit: u64) -> Result<Vec<u8>, String> {
+    use std::io::Read;
+    let meta = std::fs::metadata(path).map_err(|e| e.to_string())?;
+    if !meta.is_file() {
+        return Err("not a regular file".into());
+    }
+    if meta.len() > limit {
+        return Err(format!("{} bytes is more than the {limit} read", meta.len()));
+    }
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    // `take`: the file may have grown since it was measured.
+    std::fs::File::open(path)
+        .and_then(|f| f.take(limit + 1).read_to_end(&mut bytes))
+        .map_err(|e| e.to_string())?;
+    if bytes.len() as u64 > limit {
+        return Err(format!("more than the {limit} bytes read"));
+    }
+    Ok(bytes)
+}
+
 /// Reads the model at `path` with `transform` applied.
 ///
 /// # Errors
@@ -122,7 +153,7 @@ impl ModelFormat {
 /// outside [0, 1), negative emission, or no face left after dropping degenerate ones.
 pub fn load_model(path: &Path, transform: &Transform) -> Result<Model, LoadError> {
     let origin = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| LoadError::Model {
+    let bytes = read_input_file(path, MAX_MODEL_BYTES).map_err(|e| LoadError::Model {
         origin: origin.clone(),
         line: None,
         message: format!("cannot read the model file: {e}"),

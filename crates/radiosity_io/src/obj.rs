@@ -2,6 +2,9 @@
 //! wrong but not *where*, and a user with a 100k-line file needs the line. The scan checks
 //! what `tobj` would reject or accept badly (vertex lines that are not finite numbers, face
 //! indices out of range, faces of fewer than 3 vertices) and records each face's line.
+//!
+//! Each MTL library is checked line by line before `tobj` sees it ([`check_mtl`]): `tobj`
+//! panics on a colour of fewer than three numbers, and its other MTL errors name no line.
 
 use std::cell::RefCell;
 use std::collections::HashMap;
@@ -12,17 +15,70 @@ use radiosity_core::glam::DVec3;
 use radiosity_core::unique_names;
 
 use crate::LoadError;
-use crate::model::{DEFAULT_GREY, Model, ModelPart, PartBuilder, Transform, model_error, model_material};
+use crate::model::{
+    DEFAULT_GREY, MAX_TEXT_BYTES, Model, ModelPart, PartBuilder, Transform, model_error, model_material,
+    read_input_file,
+};
 
-/// What the line scan learns: the line of every face, in file order.
+/// What the line scan learns: the line of every face, in file order, and every `usemtl`.
 struct Scan {
     face_lines: Vec<usize>,
+    /// Material name and line of each `usemtl`, to warn about names no library defines.
+    usemtl: Vec<(String, usize)>,
+}
+
+/// Checks an MTL text line by line and returns it as `tobj` can read it without panicking:
+/// a colour given as one number (the MTL spec's grey, `Kd 0.5`) is written out as three.
+///
+/// # Errors
+/// The first malformed line, named by file and line: a colour (`Ka`, `Kd`, `Ks`, `Ke`)
+/// that is not one or three finite numbers, a number key (`Ns`, `Ni`, `d`, `illum`) that is
+/// not a number, a `newmtl` without a name, a texture key without a file.
+pub(crate) fn check_mtl(text: &str, origin: &str) -> Result<String, LoadError> {
+    let mut out = String::with_capacity(text.len() + 64);
+    for (l, raw) in text.lines().enumerate() {
+        let err = |m: String| model_error(origin, Some(l + 1), m);
+        let line = raw.trim();
+        let mut words = line.split_whitespace();
+        let key = words.next().unwrap_or("");
+        let values: Vec<&str> = words.collect();
+        let number = |w: &str| w.parse::<f64>().ok().filter(|v| v.is_finite());
+        match key {
+            "Ka" | "Kd" | "Ks" | "Ke" => {
+                if values.iter().any(|w| number(w).is_none()) || !(values.len() == 1 || values.len() == 3) {
+                    let shown: String = values.join(" ").chars().take(60).collect();
+                    return Err(err(format!(
+                        "{key}: expected three finite numbers r g b (or one, a grey), got '{shown}'"
+                    )));
+                }
+                if values.len() == 1 {
+                    out.push_str(&format!("{key} {0} {0} {0}\n", values[0]));
+                    continue;
+                }
+            }
+            "Ns" | "Ni" | "d" if values.first().and_then(|w| number(w)).is_none() => {
+                return Err(err(format!("{key}: expected a finite number")));
+            }
+            "illum" if values.first().and_then(|w| w.parse::<u8>().ok()).is_none() => {
+                return Err(err("illum: expected an illumination model number 0 to 10".into()));
+            }
+            "newmtl" if values.is_empty() => return Err(err("newmtl: the material needs a name".into())),
+            k if (k.starts_with("map_") || k == "bump") && values.is_empty() => {
+                return Err(err(format!("{k}: expected a texture file name")));
+            }
+            _ => {}
+        }
+        out.push_str(raw);
+        out.push('\n');
+    }
+    Ok(out)
 }
 
 /// Checks `v` and `f` lines; the first problem is an error naming its line and element.
 fn scan(text: &str, origin: &str) -> Result<Scan, LoadError> {
     let mut vertices = 0usize;
     let mut face_lines = Vec::new();
+    let mut usemtl = Vec::new();
     for (l, line) in text.lines().enumerate() {
         let line_no = l + 1;
         let mut words = line.split_whitespace();
@@ -80,10 +136,11 @@ fn scan(text: &str, origin: &str) -> Result<Scan, LoadError> {
                 }
                 face_lines.push(line_no);
             }
+            Some("usemtl") => usemtl.push((words.collect::<Vec<_>>().join(" "), line_no)),
             _ => {}
         }
     }
-    Ok(Scan { face_lines })
+    Ok(Scan { face_lines, usemtl })
 }
 
 /// Line of `key` within material `name` of an MTL text, for errors.
@@ -125,6 +182,8 @@ pub(crate) fn parse_obj(
     // MTL texts read by the loader, kept for error lines; and why a library could not be read.
     let mtl_texts: RefCell<Vec<(String, String)>> = RefCell::new(Vec::new());
     let mtl_problems: RefCell<Vec<String>> = RefCell::new(Vec::new());
+    // A malformed library is an error, not a warning: its materials would all be lost.
+    let mtl_error: RefCell<Option<LoadError>> = RefCell::new(None);
     let options = tobj::LoadOptions {
         triangulate: false,
         single_index: false,
@@ -137,26 +196,53 @@ pub(crate) fn parse_obj(
             return Err(tobj::LoadError::OpenFileFailed);
         };
         let path = base.join(p);
-        match std::fs::read(&path) {
+        let mtl_origin = path.display().to_string();
+        match read_input_file(&path, MAX_TEXT_BYTES) {
             Ok(mtl) => {
-                let result = tobj::load_mtl_buf(&mut Cursor::new(&mtl));
+                let checked = std::str::from_utf8(&mtl)
+                    .map_err(|e| {
+                        model_error(
+                            &mtl_origin,
+                            None,
+                            format!("not a text file (invalid UTF-8 at byte {})", e.valid_up_to()),
+                        )
+                    })
+                    .and_then(|text| check_mtl(text, &mtl_origin));
+                let text = match checked {
+                    Ok(text) => text,
+                    Err(e) => {
+                        mtl_error.borrow_mut().get_or_insert(e);
+                        return Err(tobj::LoadError::MaterialParseError);
+                    }
+                };
+                let result = tobj::load_mtl_buf(&mut Cursor::new(text.as_bytes()));
                 if let Err(e) = &result {
-                    mtl_problems.borrow_mut().push(format!("{}: {e}", path.display()));
+                    mtl_problems.borrow_mut().push(format!("{mtl_origin}: {e}"));
                 }
-                mtl_texts
-                    .borrow_mut()
-                    .push((path.display().to_string(), String::from_utf8_lossy(&mtl).into()));
+                mtl_texts.borrow_mut().push((mtl_origin, text));
                 result
             }
             Err(e) => {
-                mtl_problems.borrow_mut().push(format!("{}: {e}", path.display()));
+                mtl_problems.borrow_mut().push(format!("{mtl_origin}: {e}"));
                 Err(tobj::LoadError::OpenFileFailed)
             }
         }
     });
+    if let Some(e) = mtl_error.into_inner() {
+        return Err(e);
+    }
     let (models, materials) = loaded.map_err(|e| model_error(origin, None, format!("OBJ: {e}")))?;
     let mut warnings = Vec::new();
     let materials = materials.unwrap_or_else(|_| Vec::new());
+    // tobj maps an unknown `usemtl` name to no material at all; say which line did it.
+    for (name, line) in &scan.usemtl {
+        if !materials.iter().any(|m| &m.name == name) {
+            warnings.push(format!(
+                "{origin}:{line}: usemtl '{}': no material library defines it; its faces are default grey ({DEFAULT_GREY})",
+                name.chars().take(60).collect::<String>()
+            ));
+        }
+    }
     for p in mtl_problems.into_inner() {
         warnings.push(format!(
             "{origin}: cannot read material library {p}; its faces are default grey ({DEFAULT_GREY})"
@@ -320,6 +406,30 @@ mod tests {
 
     fn err(text: &str) -> String {
         parse_obj(text.as_bytes(), "m.obj", None, &Transform::default()).unwrap_err().to_string()
+    }
+
+    /// Every colour line `tobj` would panic on or misread is caught with its line; a single
+    /// number is the MTL spec's grey and is written out as three for `tobj`.
+    #[test]
+    fn mtl_lines_are_checked_before_tobj_sees_them() {
+        let ok = check_mtl("newmtl a\n  Kd 0.5\nKe 1 2 3\nNs 10\nillum 2\n# Kd\n", "m.mtl").unwrap();
+        assert_eq!(ok, "newmtl a\nKd 0.5 0.5 0.5\nKe 1 2 3\nNs 10\nillum 2\n# Kd\n");
+        let (materials, _) = tobj::load_mtl_buf(&mut Cursor::new(ok.as_bytes())).unwrap();
+        assert_eq!(materials[0].diffuse, Some([0.5; 3]));
+        for (text, expected) in [
+            ("newmtl a\nKd\n", "m.mtl:2: Kd: expected three finite numbers"),
+            ("newmtl a\nKd 1 2\n", "m.mtl:2: Kd"),
+            ("newmtl a\nKa 1 2 3 4\n", "m.mtl:2: Ka"),
+            ("newmtl a\nKs 1 inf 1\n", "m.mtl:2: Ks"),
+            ("newmtl a\n\nKe xyz 1 1 1\n", "m.mtl:3: Ke"),
+            ("newmtl a\nd\n", "m.mtl:2: d: expected a finite number"),
+            ("newmtl a\nillum -1\n", "m.mtl:2: illum"),
+            ("newmtl\n", "m.mtl:1: newmtl"),
+            ("newmtl a\nmap_Kd   \n", "m.mtl:2: map_Kd"),
+        ] {
+            let e = check_mtl(text, "m.mtl").unwrap_err().to_string();
+            assert!(e.starts_with(expected), "{text:?}: {e}");
+        }
     }
 
     #[test]

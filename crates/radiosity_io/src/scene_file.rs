@@ -61,8 +61,12 @@ pub fn load_scene(path: &Path) -> Result<LoadedScene, LoadError> {
     if ModelFormat::from_path(path).is_some() {
         return scene_from_model(path);
     }
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| LoadError::Unreadable { path: path.to_owned(), reason: e.to_string() })?;
+    let bytes = crate::model::read_input_file(path, crate::model::MAX_TEXT_BYTES)
+        .map_err(|reason| LoadError::Unreadable { path: path.to_owned(), reason })?;
+    let text = String::from_utf8(bytes).map_err(|e| LoadError::Unreadable {
+        path: path.to_owned(),
+        reason: format!("not a text file (invalid UTF-8 at byte {})", e.utf8_error().valid_up_to()),
+    })?;
     parse_scene(&text, &path.display().to_string())
 }
 
@@ -82,7 +86,10 @@ fn scene_from_model(path: &Path) -> Result<LoadedScene, LoadError> {
             }
             _ => "",
         };
-        model_error(&origin, None, format!("{e}{hint}"))
+        // What the loader noticed (a missing MTL, an unknown material) often explains the
+        // error, and would otherwise be lost with the scene.
+        let notes: String = model.warnings.iter().map(|w| format!(" (warning: {w})")).collect();
+        model_error(&origin, None, format!("{e}{hint}{notes}"))
     })?;
     Ok(LoadedScene { scene, warnings: model.warnings })
 }
@@ -441,7 +448,7 @@ fn transform(loc: &Locator, key: &str, t: &Spanned<TransformDesc>) -> Result<Tra
     if let Some(sc) = &d.scale {
         let scale = match sc.get_ref() {
             Scale::Uniform(s) => [*s; 3],
-            Scale::PerAxis(a) => *a,
+            Scale::PerAxis(a) => a.0,
         };
         if !scale.iter().all(|s| s.is_finite() && *s != 0.0) {
             return Err(loc.at(
@@ -577,11 +584,14 @@ fn solver_settings(loc: &Locator, d: &SolverDesc) -> Result<SolverSettings, Load
     }
     if let Some(t) = &d.time_limit {
         let v = *t.get_ref();
-        if !(v.is_finite() && v > 0.0) {
+        if !(v > 0.0 && v <= radiosity_core::MAX_TIME_LIMIT_SECONDS) {
             return Err(loc.at(
                 t.span(),
                 "solver.time_limit",
-                format!("expected a finite number of seconds > 0, got {v}"),
+                format!(
+                    "expected a finite number of seconds > 0 and ≤ {:e}, got {v}",
+                    radiosity_core::MAX_TIME_LIMIT_SECONDS
+                ),
             ));
         }
         settings.time_limit = Some(v);

@@ -604,3 +604,34 @@ fn errors_from_a_file_name_the_file() {
     std::fs::write(&path, BASE.replacen("name = \"test\"\n", "", 1)).unwrap();
     assert_eq!(load_scene(&path).unwrap().scene.name, "radiosity_io_bad_rho");
 }
+
+#[test]
+fn a_fourth_number_in_a_colour_is_an_error() {
+    check(
+        "reflectance = [0.5, 0.5, 0.5]",
+        "reflectance = [0.5, 0.5, 0.5, 0.5]",
+        "material[0].reflectance",
+        "invalid length 4",
+    );
+}
+
+#[test]
+fn a_time_limit_past_a_duration_is_an_error() {
+    check("time_limit = 60", "time_limit = 1e308", "solver.time_limit", "≤ 1e9");
+}
+
+#[test]
+fn a_fourth_coordinate_of_a_vertex_is_an_error() {
+    let text = "[[material]]\nname = \"m\"\nreflectance = [0, 0, 0]\nemission = [1, 1, 1]\n\
+                [[object]]\nname = \"o\"\ntype = \"polygon\"\nmaterial = \"m\"\n\
+                vertices = [[0, 0, 0], [1, 0, 0, 9], [1, 1, 0]]\n";
+    let s = error_at(text, 9, "object[0].vertices");
+    assert!(s.contains("invalid length 4"), "{s}");
+}
+
+#[test]
+fn a_huge_key_is_not_echoed_whole() {
+    let text = format!("{} = 1\n{BASE}", "k".repeat(1_000_000));
+    let e = parse_scene(&text, "bad.toml").unwrap_err().to_string();
+    assert!(e.len() < 3000 && e.contains("characters)"), "{} bytes: {}", e.len(), &e[..200]);
+}

@@ -443,9 +443,10 @@ impl ViewerApp {
         let Some(renderer) = egui_renderer.callback_resources.get::<SceneRenderer>() else { return };
         let target = RenderTarget::new(device, self.view_size, renderer.format(), renderer.samples());
         renderer.draw(device, queue, &target, &frame);
-        let result = target
-            .read_rgba8(device, queue)
-            .and_then(|img| image::DynamicImage::ImageRgba8(img).to_rgb8().save(&path).map_err(Into::into));
+        let result = target.read_rgba8(device, queue).and_then(|img| {
+            let rgb = image::DynamicImage::ImageRgba8(img).to_rgb8();
+            write_rgb_png(&path, rgb.width(), rgb.height(), rgb.into_raw())
+        });
         drop(egui_renderer);
         self.message = Some(match result {
             Ok(()) => format!("wrote {}", path.display()),
@@ -978,12 +979,21 @@ impl egui_wgpu::CallbackTrait for ViewCallback {
 fn save_color_image(img: &egui::ColorImage, path: &std::path::Path) -> anyhow::Result<()> {
     let [w, h] = img.size;
     let rgb: Vec<u8> = img.pixels.iter().flat_map(|c| [c.r(), c.g(), c.b()]).collect();
-    let buf = image::RgbImage::from_raw(w as u32, h as u32, rgb)
-        .ok_or_else(|| anyhow::anyhow!("screenshot has the wrong size"))?;
+    if rgb.len() != w * h * 3 {
+        anyhow::bail!("screenshot has the wrong size");
+    }
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("cannot create {}: {e}", dir.display()))?;
     }
-    buf.save(path).map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))
+    write_rgb_png(path, w as u32, h as u32, rgb)
+}
+
+/// Writes packed RGB bytes as a PNG through a temporary file and a rename, as every picture
+/// the program writes: an interrupted write leaves no half file under the name.
+fn write_rgb_png(path: &std::path::Path, width: u32, height: u32, rgb: Vec<u8>) -> anyhow::Result<()> {
+    let pixels = rgb.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
+    let image = radiosity_image::SrgbImage { width, height, pixels };
+    Ok(radiosity_image::write_png(path, &image)?)
 }
 
 /// `name.png`, or `name-2.png`, … if it exists: a screenshot never overwrites a file.
@@ -998,7 +1008,7 @@ fn unique_path(dir: &std::path::Path, name: &str) -> PathBuf {
 /// The window driven by egui_kittest: real egui frames, real wgpu (lavapipe on CI), input
 /// injected as events. Rendering goes through the P screenshot path (an offscreen target),
 /// since the harness's own pass has no depth buffer for the paint callback.
-#[cfg(test)]
+#[cfg(all(test, feature = "gui-tests"))]
 mod tests {
     use super::*;
     use egui_kittest::Harness;
