@@ -5,12 +5,12 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::Args;
-use radiosity_export::{ExportFormat, VertexColours};
-use radiosity_image::{HdrImage, ToneOperator, ToneParams};
+use radiosity_export::{ExportFormat, Texels, VertexColours};
+use radiosity_image::{Gather, HdrImage, RenderParams, Renderer, ToneOperator, ToneParams};
 
 use crate::output::{self, Targets, note};
 use crate::prepare::{InputError, SolveOpts, prepare, run_solver};
-use crate::render_cmd::ToneOpts;
+use crate::render_cmd::{GatherArg, ToneOpts};
 
 /// Arguments of `radiosity export`.
 #[derive(Args)]
@@ -28,6 +28,11 @@ pub struct ExportArgs {
     /// Also write per-object lightmaps (linear EXR) and an OBJ mapping them into this folder.
     #[arg(long)]
     pub lightmap: Option<PathBuf>,
+    /// Lightmap texels: `none` interpolated from the solution, `direct` with direct light by
+    /// shadow rays per texel (sharp shadows from a coarse solve), `full` also one bounce of
+    /// gathering rays. Needs --lightmap.
+    #[arg(long, value_enum, default_value_t = GatherArg::None)]
+    pub gather: GatherArg,
     #[command(flatten)]
     pub tone: ToneOpts,
     /// Overwrite existing output files.
@@ -51,6 +56,9 @@ pub fn run(a: ExportArgs) -> Result<()> {
     targets.file(&a.output, "-o")?;
     if let Some(dir) = &a.lightmap {
         targets.folder(dir, "lightmapped.obj", "--lightmap")?;
+    }
+    if a.lightmap.is_none() && !matches!(a.gather, GatherArg::None) {
+        return Err(InputError("--gather bakes lightmaps: give --lightmap DIR too".into()).into());
     }
     let prepared = prepare(&a.scene, &a.solve)?;
     let (solver, report) = run_solver(&prepared)?;
@@ -92,8 +100,15 @@ pub fn run(a: ExportArgs) -> Result<()> {
     };
     note(format_args!("wrote {} ({} vertices, {colours})", a.output.display(), mesh.positions.len()))?;
     if let Some(dir) = &a.lightmap {
+        let gather = Gather::from(a.gather);
+        let renderer = (gather != Gather::None).then(|| Renderer::new(mesh.clone()));
+        let params = RenderParams { gather, seed: a.solve.seed, ..RenderParams::default() };
+        let texels = match &renderer {
+            Some(renderer) => Texels::Gathered { renderer, params: &params },
+            None => Texels::Interpolated,
+        };
         let count = output::write_folder(dir, a.force, |staging| {
-            radiosity_export::write_lightmaps(staging, mesh, &solution)
+            radiosity_export::write_lightmaps(staging, mesh, &solution, texels)
         })?;
         note(format_args!("wrote {count} lightmap files into {}", dir.display()))?;
     }

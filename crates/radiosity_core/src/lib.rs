@@ -7,6 +7,7 @@
 #![warn(missing_docs)]
 #![forbid(unsafe_code)]
 
+mod auto_camera;
 mod canonical;
 mod color;
 mod mesh;

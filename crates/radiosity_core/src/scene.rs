@@ -591,12 +591,11 @@ impl Scene {
         (lo, hi)
     }
 
-    /// The scene's camera, or one framing the whole scene.
+    /// The scene's camera or, without one, a view that sees its lit faces: from outside on
+    /// the side that shows the most front faces (the open side of an open box), or from inside
+    /// a closed room (probed with a few dozen rays per candidate view).
     pub fn camera_or_framing(&self) -> Camera {
-        self.camera.unwrap_or_else(|| {
-            let (lo, hi) = self.bounds();
-            Camera::framing(lo, hi)
-        })
+        self.camera.unwrap_or_else(|| crate::auto_camera::choose(self))
     }
 
     /// Mesh parameters of the scene, or [`crate::MeshParams::for_extent`] of its bounds.

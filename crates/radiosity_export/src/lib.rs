@@ -22,9 +22,11 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+use radiosity_core::glam::DVec3;
 use radiosity_core::{Mesh, Rgb, encode_srgb, unique_names};
-use radiosity_image::{HdrImage, ToneOperator, ToneParams, tone_map};
+use radiosity_image::{HdrImage, RenderError, RenderParams, Renderer, ToneOperator, ToneParams, tone_map};
 use radiosity_solver::Solution;
+use rayon::prelude::*;
 use serde_json::{Value, json};
 
 /// What the exported vertex colours (`COLOR_0`) hold. glTF requires colours in [0, 1], so
@@ -291,6 +293,22 @@ pub struct Lightmap {
     pub charts: Vec<(usize, Vec<[f64; 2]>)>,
 }
 
+/// How the texels of a lightmap get their radiosity.
+#[derive(Clone, Copy)]
+pub enum Texels<'a> {
+    /// Interpolated from the element's vertex radiosity, as the vertex colours shade.
+    Interpolated,
+    /// Gathered at the texel's point ([`Renderer::gathered_radiosity`]: direct light by
+    /// shadow rays, so a coarse solve bakes sharp shadows), `params.samples_per_pixel`
+    /// samples per texel.
+    Gathered {
+        /// The renderer over the same mesh.
+        renderer: &'a Renderer,
+        /// Gather mode, samples and rays per texel, seed.
+        params: &'a RenderParams,
+    },
+}
+
 /// Per-object lightmaps: each element of an object gets its own square cell of
 /// [`LIGHTMAP_CELL_TEXELS`]² texels in the object's atlas, cells in rows in element order (the
 /// simplest chart packing: no texel is shared, so no seam bleeds from one element into
@@ -299,6 +317,18 @@ pub struct Lightmap {
 /// radiosity at its centre (bilinear over a quad, barycentric over a triangle), so the map
 /// shades as smoothly as the vertex colours.
 pub fn lightmaps(mesh: &Mesh, solution: &Solution) -> Vec<Lightmap> {
+    lightmaps_with(mesh, solution, Texels::Interpolated).expect("interpolated texels cannot fail")
+}
+
+/// [`lightmaps`] with the texels' radiosity taken as `texels` says.
+///
+/// # Errors
+/// A gather's [`RenderError`] (bad parameters, a solution of another mesh, no direct part).
+pub fn lightmaps_with(
+    mesh: &Mesh,
+    solution: &Solution,
+    texels: Texels<'_>,
+) -> Result<Vec<Lightmap>, RenderError> {
     let k = LIGHTMAP_CELL_TEXELS;
     let mut by_object: Vec<Vec<usize>> = vec![Vec::new(); mesh.object_names.len()];
     for e in 0..mesh.elements.len() {
@@ -313,31 +343,16 @@ pub fn lightmaps(mesh: &Mesh, solution: &Solution) -> Vec<Lightmap> {
         let rows = (elements.len() as u32).div_ceil(columns);
         let (w, h) = (columns * k, rows * k);
         let mut image = HdrImage::new(w, h);
+        // Each element's cell on its own (in parallel: a gather traces rays per texel).
+        let cells: Vec<Vec<Rgb>> = elements
+            .par_iter()
+            .map(|&e| element_cell(mesh, solution, e, texels))
+            .collect::<Result<_, _>>()?;
         let mut charts = Vec::with_capacity(elements.len());
-        for (n, &e) in elements.iter().enumerate() {
+        for (n, (&e, cell)) in elements.iter().zip(cells).enumerate() {
             let (cx, cy) = ((n as u32 % columns) * k, (n as u32 / columns) * k);
-            let el = &mesh.elements[e];
-            let b: Vec<Rgb> =
-                el.vertex_indices().iter().map(|&v| solution.vertex_radiosity[v as usize]).collect();
-            // Cell parameters (s, t) in [0, 1] at texel centres 0 and k−1.
-            let param = |i: u32| i as f64 / (k - 1) as f64;
-            for ty in 0..k {
-                for tx in 0..k {
-                    let (s, t) = (param(tx), param(ty));
-                    let value = if b.len() == 4 {
-                        b[0] * ((1.0 - s) * (1.0 - t))
-                            + b[1] * (s * (1.0 - t))
-                            + b[2] * (s * t)
-                            + b[3] * ((1.0 - s) * t)
-                    } else {
-                        // Outside the triangle (s + t > 1) the texel is never sampled inside the
-                        // chart; it takes the nearest edge value so filtering there is harmless.
-                        let sum = (s + t).max(1.0);
-                        let (s, t) = (s / sum, t / sum);
-                        b[0] * (1.0 - s - t) + b[1] * s + b[2] * t
-                    };
-                    image.set_pixel(cx + tx, cy + ty, value);
-                }
+            for (i, value) in cell.into_iter().enumerate() {
+                image.set_pixel(cx + i as u32 % k, cy + i as u32 / k, value);
             }
             let uv = |s: f64, t: f64| {
                 [
@@ -345,7 +360,7 @@ pub fn lightmaps(mesh: &Mesh, solution: &Solution) -> Vec<Lightmap> {
                     (cy as f64 + 0.5 + t * (k - 1) as f64) / h as f64,
                 ]
             };
-            let corners = if b.len() == 4 {
+            let corners = if mesh.elements[e].vertex_count == 4 {
                 vec![uv(0.0, 0.0), uv(1.0, 0.0), uv(1.0, 1.0), uv(0.0, 1.0)]
             } else {
                 vec![uv(0.0, 0.0), uv(1.0, 0.0), uv(0.0, 1.0)]
@@ -354,7 +369,51 @@ pub fn lightmaps(mesh: &Mesh, solution: &Solution) -> Vec<Lightmap> {
         }
         out.push(Lightmap { object, image, charts });
     }
-    out
+    Ok(out)
+}
+
+/// The [`LIGHTMAP_CELL_TEXELS`]² texels of element `e`'s cell, row by row.
+fn element_cell(
+    mesh: &Mesh,
+    solution: &Solution,
+    e: usize,
+    texels: Texels<'_>,
+) -> Result<Vec<Rgb>, RenderError> {
+    let k = LIGHTMAP_CELL_TEXELS;
+    let idx = mesh.elements[e].vertex_indices();
+    // Cell parameters (s, t) in [0, 1] at texel centres 0 and k−1.
+    let param = |i: u32| i as f64 / (k - 1) as f64;
+    let mut cell = Vec::with_capacity((k * k) as usize);
+    for ty in 0..k {
+        for tx in 0..k {
+            let (s, t) = (param(tx), param(ty));
+            let weights: Vec<f64> = if idx.len() == 4 {
+                vec![(1.0 - s) * (1.0 - t), s * (1.0 - t), s * t, (1.0 - s) * t]
+            } else {
+                // Outside the triangle (s + t > 1) the texel is never sampled inside the
+                // chart; it takes the nearest edge value so filtering there is harmless.
+                let sum = (s + t).max(1.0);
+                let (s, t) = (s / sum, t / sum);
+                vec![1.0 - s - t, s, t]
+            };
+            let value = match texels {
+                Texels::Interpolated => {
+                    idx.iter().zip(&weights).map(|(&v, &w)| solution.vertex_radiosity[v as usize] * w).sum()
+                }
+                Texels::Gathered { renderer, params } => {
+                    let p: DVec3 =
+                        idx.iter().zip(&weights).map(|(&v, &w)| mesh.positions[v as usize] * w).sum();
+                    // Corner texels sit on the element's edge, which may be a room's edge where
+                    // rays graze the next wall: gather a thousandth of the way in instead.
+                    let p = p + (mesh.elements[e].centre - p) * 1e-3;
+                    let key = (e as u64) << 12 | u64::from(ty * k + tx);
+                    renderer.gathered_radiosity(solution, e, p, params, key)?
+                }
+            };
+            cell.push(value);
+        }
+    }
+    Ok(cell)
 }
 
 /// A file-name-safe version of an object name (`/` and other separators become `_`).
@@ -364,15 +423,20 @@ pub fn file_stem_for(name: &str) -> String {
     if s.is_empty() { "object".into() } else { s }
 }
 
-/// Writes [`lightmaps`] into `dir` as `<object>.exr` (linear radiosity), with `lightmapped.obj`
+/// Writes lightmaps ([`lightmaps_with`] `texels`) into `dir` as `<object>.exr` (linear radiosity), with `lightmapped.obj`
 /// and `lightmapped.mtl` mapping them (`map_Kd`, texture coordinates per element corner) so a
 /// modelling tool shows the baked light. Returns the paths written.
 ///
 /// # Errors
 /// The folder or a file cannot be written.
-pub fn write_lightmaps(dir: &Path, mesh: &Mesh, solution: &Solution) -> Result<Vec<PathBuf>, String> {
+pub fn write_lightmaps(
+    dir: &Path,
+    mesh: &Mesh,
+    solution: &Solution,
+    texels: Texels<'_>,
+) -> Result<Vec<PathBuf>, String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: cannot create the folder: {e}", dir.display()))?;
-    let maps = lightmaps(mesh, solution);
+    let maps = lightmaps_with(mesh, solution, texels).map_err(|e| e.to_string())?;
     let mut stems: Vec<String> = maps.iter().map(|m| file_stem_for(&mesh.object_names[m.object])).collect();
     unique_names(&mut stems);
     let mut written = Vec::new();

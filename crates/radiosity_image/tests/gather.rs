@@ -59,7 +59,7 @@ fn direct_gather_needs_the_direct_part() {
 /// ~50 %.
 #[test]
 fn gathered_cornell_box_agrees_with_the_mesh_per_object() {
-    let scene = common::cornell_box();
+    let scene = radiosity_core::cornell_box();
     let (mesh, solution) = common::solve(&scene, SolverParams::default());
     let camera = scene.camera_or_framing();
     let renderer = Renderer::new(mesh.clone());

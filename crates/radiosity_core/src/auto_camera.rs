@@ -1,0 +1,177 @@
+//! A camera for a scene that gives none: one that sees lit (front) faces.
+//!
+//! Framing the scene from a fixed side shows a closed room, or a model that opens towards
+//! another side, from behind its walls: a black picture. Instead a few candidate views are
+//! probed with a coarse grid of rays against the scene's own polygons and spheres, and the
+//! view whose rays meet the most front faces wins: from outside on each side (the open side
+//! of an open box), or from the middle looking along each horizontal axis (inside a closed
+//! room). `render` and `view` both take their default camera from here, so they agree.
+
+use glam::DVec3;
+
+use crate::scene::{Camera, Facing, Shape};
+use crate::{Polygon, Scene};
+
+/// Probe rays per candidate view, across and down.
+const PROBE: (usize, usize) = (8, 6);
+
+/// Field of view of a camera placed inside the scene, degrees: wide, as a room is seen.
+const INSIDE_FOV_DEG: f64 = 75.0;
+
+/// The camera [`Scene::camera_or_framing`] gives a scene without one.
+pub(crate) fn choose(scene: &Scene) -> Camera {
+    let (lo, hi) = scene.bounds();
+    let framing = Camera::framing(lo, hi);
+    let centre = (lo + hi) * 0.5;
+    let mut candidates = vec![framing];
+    for d in [DVec3::Z, -DVec3::Z, DVec3::X, -DVec3::X, -DVec3::Y, DVec3::Y] {
+        if d == DVec3::Z {
+            continue; // the framing view already looks along +z
+        }
+        let distance = (framing.look_at - framing.position).length();
+        let up = if d.y.abs() > 0.5 { DVec3::Z } else { DVec3::Y };
+        if let Ok(c) = Camera::try_new(centre - d * distance, centre, up, framing.fov_y_deg) {
+            candidates.push(c);
+        }
+    }
+    // From outside first: an open scene (a box without a front wall, a model on a plane) is
+    // shown as a whole from its open side whenever some side shows enough lit faces.
+    let best_outside = best_of(scene, candidates);
+    if best_outside.1 >= PROBE.0 * PROBE.1 / 4 {
+        return best_outside.0;
+    }
+    // A closed room shows only the backs of its walls from outside: look from its middle.
+    let inside = [DVec3::Z, -DVec3::Z, DVec3::X, -DVec3::X]
+        .into_iter()
+        .filter_map(|d| Camera::try_new(centre, centre + d, DVec3::Y, INSIDE_FOV_DEG).ok());
+    let best_inside = best_of(scene, inside.collect());
+    if best_inside.1 > best_outside.1 { best_inside.0 } else { best_outside.0 }
+}
+
+/// The candidate that sees the most front faces and how many; ties keep the earlier one (the
+/// classic framing first). `candidates` must not be empty.
+fn best_of(scene: &Scene, candidates: Vec<Camera>) -> (Camera, usize) {
+    let mut best = (candidates[0], 0usize);
+    for camera in candidates {
+        let score = front_faces_seen(scene, &camera);
+        if score > best.1 {
+            best = (camera, score);
+        }
+    }
+    best
+}
+
+/// How many of the probe rays through `camera` first meet a front (lit) face.
+pub(crate) fn front_faces_seen(scene: &Scene, camera: &Camera) -> usize {
+    let forward = (camera.look_at - camera.position).normalize();
+    let right = forward.cross(camera.up).normalize();
+    let up = right.cross(forward);
+    let half = (camera.fov_y_deg.to_radians() * 0.5).tan();
+    let mut seen = 0;
+    for j in 0..PROBE.1 {
+        for i in 0..PROBE.0 {
+            let sx = ((i as f64 + 0.5) / PROBE.0 as f64 * 2.0 - 1.0) * half * 4.0 / 3.0;
+            let sy = ((j as f64 + 0.5) / PROBE.1 as f64 * 2.0 - 1.0) * half;
+            let dir = (forward + right * sx + up * sy).normalize();
+            if let Some((_, front)) = first_hit(scene, camera.position, dir) {
+                seen += usize::from(front);
+            }
+        }
+    }
+    seen
+}
+
+/// The nearest surface along `origin + t·dir` (t > 0): its distance and whether the ray meets
+/// its lit side.
+fn first_hit(scene: &Scene, origin: DVec3, dir: DVec3) -> Option<(f64, bool)> {
+    let mut best: Option<(f64, bool)> = None;
+    let mut take = |t: f64, front: bool| {
+        if best.is_none_or(|(b, _)| t < b) {
+            best = Some((t, front));
+        }
+    };
+    for object in &scene.objects {
+        match &object.shape {
+            Shape::Polygons(ps) => {
+                ps.iter().filter_map(|p| hit_polygon(p, origin, dir)).for_each(|h| take(h.0, h.1))
+            }
+            Shape::Mesh(m) => {
+                m.polygons().iter().filter_map(|p| hit_polygon(p, origin, dir)).for_each(|h| take(h.0, h.1))
+            }
+            Shape::Sphere(s) => {
+                // |o + t d − c|² = r², d unit: t² + 2 b t + c = 0.
+                let oc = origin - s.center;
+                let b = oc.dot(dir);
+                let c = oc.length_squared() - s.radius * s.radius;
+                let disc = b * b - c;
+                if disc < 0.0 {
+                    continue;
+                }
+                let root = disc.sqrt();
+                let t = if -b - root > 0.0 { -b - root } else { -b + root };
+                if t > 0.0 {
+                    let outward = (origin + dir * t - s.center).dot(dir) < 0.0;
+                    take(t, outward == (s.facing == Facing::Outward));
+                }
+            }
+        }
+    }
+    best
+}
+
+/// Where the ray meets the convex polygon `p` (t > 0), and whether on its lit side.
+fn hit_polygon(p: &Polygon, origin: DVec3, dir: DVec3) -> Option<(f64, bool)> {
+    let n = p.normal();
+    let v = p.vertices();
+    let denom = n.dot(dir);
+    if denom.abs() < 1e-12 {
+        return None;
+    }
+    let t = n.dot(v[0] - origin) / denom;
+    if t <= 0.0 || !t.is_finite() {
+        return None;
+    }
+    let q = origin + dir * t;
+    let k = v.len();
+    let inside = (0..k).all(|i| (v[(i + 1) % k] - v[i]).cross(q - v[i]).dot(n) >= 0.0);
+    inside.then_some((t, denom < 0.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{cornell_box, furnace_box, two_plates};
+
+    /// A closed box lit from inside is seen from inside: every probe ray meets a lit face
+    /// (the framing view from outside would see only the backs of its walls).
+    #[test]
+    fn a_closed_room_is_seen_from_inside() {
+        let scene = furnace_box(0.5, 1.0);
+        let framing = {
+            let (lo, hi) = scene.bounds();
+            Camera::framing(lo, hi)
+        };
+        assert_eq!(front_faces_seen(&scene, &framing), 0, "the old default saw only back faces");
+        let camera = scene.camera_or_framing();
+        assert_eq!(front_faces_seen(&scene, &camera), PROBE.0 * PROBE.1);
+    }
+
+    /// The Cornell box opens towards −z: without its camera, the chosen view looks in
+    /// through the open side (as the scene's own camera does).
+    #[test]
+    fn an_open_box_is_seen_through_its_open_side() {
+        let mut scene = cornell_box();
+        scene.camera = None;
+        let camera = scene.camera_or_framing();
+        assert!(camera.position.z < 0.0 && camera.look_at.z > camera.position.z, "{camera:?}");
+        assert!(front_faces_seen(&scene, &camera) >= PROBE.0 * PROBE.1 / 4);
+    }
+
+    /// Two facing plates show their lit sides.
+    #[test]
+    fn facing_plates_show_a_lit_side() {
+        let scene = two_plates(1.0, 1.0, 0.5, 1.0);
+        let camera = scene.camera_or_framing();
+        assert!(front_faces_seen(&scene, &camera) > 0, "{camera:?}");
+    }
+}
