@@ -10,9 +10,9 @@
 use glam::DVec3;
 
 use crate::scene::{Camera, Facing, Shape};
-use crate::{Polygon, Scene};
+use crate::{CameraRays, Polygon, Scene};
 
-/// Probe rays per candidate view, across and down.
+/// Probe rays per candidate view, across and down (a 4:3 picture).
 const PROBE: (usize, usize) = (8, 6);
 
 /// Field of view of a camera placed inside the scene, degrees: wide, as a room is seen.
@@ -63,16 +63,11 @@ fn best_of(scene: &Scene, candidates: Vec<Camera>) -> (Camera, usize) {
 
 /// How many of the probe rays through `camera` first meet a front (lit) face.
 pub(crate) fn front_faces_seen(scene: &Scene, camera: &Camera) -> usize {
-    let forward = (camera.look_at - camera.position).normalize();
-    let right = forward.cross(camera.up).normalize();
-    let up = right.cross(forward);
-    let half = (camera.fov_y_deg.to_radians() * 0.5).tan();
+    let rays = CameraRays::new(camera, PROBE.0 as u32, PROBE.1 as u32);
     let mut seen = 0;
     for j in 0..PROBE.1 {
         for i in 0..PROBE.0 {
-            let sx = ((i as f64 + 0.5) / PROBE.0 as f64 * 2.0 - 1.0) * half * 4.0 / 3.0;
-            let sy = ((j as f64 + 0.5) / PROBE.1 as f64 * 2.0 - 1.0) * half;
-            let dir = (forward + right * sx + up * sy).normalize();
+            let dir = rays.direction(i as f64 + 0.5, j as f64 + 0.5);
             if let Some((_, front)) = first_hit(scene, camera.position, dir) {
                 seen += usize::from(front);
             }

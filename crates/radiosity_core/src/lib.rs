@@ -10,6 +10,7 @@
 mod auto_camera;
 mod canonical;
 mod color;
+mod film;
 mod mesh;
 mod one_line;
 pub mod random;
@@ -18,6 +19,7 @@ mod srgb;
 
 pub use canonical::{cornell_box, furnace_box, furnace_sphere, two_plates, unit_cube_floor_light};
 pub use color::Rgb;
+pub use film::CameraRays;
 pub use mesh::{Element, MAX_ELEMENTS, Mesh, MeshError, MeshParams, Patch, Surface};
 pub use one_line::{MAX_PART_CHARS, escape_controls, one_line};
 pub use scene::{

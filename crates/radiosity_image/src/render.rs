@@ -22,7 +22,7 @@ use std::sync::Arc;
 use glam::{DVec2, DVec3, Vec3};
 use radiosity_accel::{Bvh, RayQuery};
 use radiosity_core::random::Rng;
-use radiosity_core::{Camera, Mesh, Rgb};
+use radiosity_core::{Camera, CameraRays, Mesh, Rgb};
 use radiosity_solver::Solution;
 use rayon::prelude::*;
 use thiserror::Error;
@@ -558,44 +558,6 @@ fn grid(count: u32) -> (u32, u32) {
     let count = count.max(1);
     let columns = (1..=count).find(|&c| c * c >= count && count.is_multiple_of(c)).unwrap_or(count);
     (columns, count / columns)
-}
-
-/// Primary ray directions of a pinhole camera.
-struct CameraRays {
-    forward: DVec3,
-    right: DVec3,
-    up: DVec3,
-    /// tan(fov_y / 2): half the image plane's height at distance 1.
-    half_height: f64,
-    aspect: f64,
-    width: f64,
-    height: f64,
-}
-
-impl CameraRays {
-    fn new(camera: &Camera, width: u32, height: u32) -> Self {
-        let forward = (camera.look_at - camera.position).normalize();
-        // Right-handed: right = forward × up, so a camera looking down +z with +y up sees +x on
-        // its left (the Cornell box's red wall, at x ≈ 556, is on the left of its picture).
-        let right = forward.cross(camera.up).normalize();
-        let up = right.cross(forward);
-        Self {
-            forward,
-            right,
-            up,
-            half_height: (camera.fov_y_deg.to_radians() * 0.5).tan(),
-            aspect: f64::from(width) / f64::from(height),
-            width: f64::from(width),
-            height: f64::from(height),
-        }
-    }
-
-    /// Unit direction through the film point `(px, py)` in pixels, y down from the top edge.
-    fn direction(&self, px: f64, py: f64) -> DVec3 {
-        let sx = (2.0 * px / self.width - 1.0) * self.aspect * self.half_height;
-        let sy = (1.0 - 2.0 * py / self.height) * self.half_height;
-        (self.forward + self.right * sx + self.up * sy).normalize()
-    }
 }
 
 /// Barycentric weights of `p` in the triangle `(0, b, c)`, clamped into the triangle.

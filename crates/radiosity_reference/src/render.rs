@@ -1,9 +1,8 @@
 //! Pictures by path tracing: the radiance the camera sees, B/π of the first surface a ray
 //! meets, with B estimated by a path from that point.
 
-use radiosity_core::glam::DVec3;
 use radiosity_core::random::Rng;
-use radiosity_core::{Camera, Rgb};
+use radiosity_core::{Camera, CameraRays, Rgb};
 use rayon::prelude::*;
 
 use crate::geometry::Geometry;
@@ -11,41 +10,6 @@ use crate::{Picture, PictureParams};
 
 /// Task key of the pixels' streams.
 const PIXEL_TASK: u64 = 0x7069_7800_0000_0000; // "pix"
-
-/// Primary ray directions of a pinhole camera, the same mapping as the radiosity renderer's
-/// (right = forward × up, film y down from the top edge), so pictures compare pixel by pixel.
-struct CameraRays {
-    forward: DVec3,
-    right: DVec3,
-    up: DVec3,
-    half_height: f64,
-    aspect: f64,
-    width: f64,
-    height: f64,
-}
-
-impl CameraRays {
-    fn new(camera: &Camera, width: u32, height: u32) -> Self {
-        let forward = (camera.look_at - camera.position).normalize();
-        let right = forward.cross(camera.up).normalize();
-        let up = right.cross(forward);
-        Self {
-            forward,
-            right,
-            up,
-            half_height: (camera.fov_y_deg.to_radians() * 0.5).tan(),
-            aspect: f64::from(width) / f64::from(height),
-            width: f64::from(width),
-            height: f64::from(height),
-        }
-    }
-
-    fn direction(&self, px: f64, py: f64) -> DVec3 {
-        let sx = (2.0 * px / self.width - 1.0) * self.aspect * self.half_height;
-        let sy = (1.0 - 2.0 * py / self.height) * self.half_height;
-        (self.forward + self.right * sx + self.up * sy).normalize()
-    }
-}
 
 pub(crate) fn render(
     g: &Geometry,

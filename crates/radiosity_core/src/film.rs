@@ -1,0 +1,67 @@
+//! Primary rays of a pinhole camera: the one mapping from a picture's pixels to directions,
+//! shared by the radiosity renderer, the reference path tracer and the default camera's probe,
+//! so their pictures compare pixel by pixel.
+
+use glam::DVec3;
+
+use crate::Camera;
+
+/// Directions through the film of `camera` for a picture of `width × height` pixels.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraRays {
+    forward: DVec3,
+    right: DVec3,
+    up: DVec3,
+    /// tan(fov_y / 2): half the image plane's height at distance 1.
+    half_height: f64,
+    aspect: f64,
+    width: f64,
+    height: f64,
+}
+
+impl CameraRays {
+    /// The film of `camera` for `width × height` pixels (each at least 1).
+    pub fn new(camera: &Camera, width: u32, height: u32) -> Self {
+        let forward = (camera.look_at - camera.position).normalize();
+        // Right-handed: right = forward × up, so a camera looking down +z with +y up sees +x on
+        // its left (the Cornell box's red wall, at x ≈ 556, is on the left of its picture).
+        let right = forward.cross(camera.up).normalize();
+        let up = right.cross(forward);
+        let (width, height) = (f64::from(width.max(1)), f64::from(height.max(1)));
+        Self {
+            forward,
+            right,
+            up,
+            half_height: (camera.fov_y_deg.to_radians() * 0.5).tan(),
+            aspect: width / height,
+            width,
+            height,
+        }
+    }
+
+    /// Unit direction through the film point `(px, py)` in pixels, y down from the top edge
+    /// (`(x + 0.5, y + 0.5)` is the centre of pixel `(x, y)`).
+    pub fn direction(&self, px: f64, py: f64) -> DVec3 {
+        let sx = (2.0 * px / self.width - 1.0) * self.aspect * self.half_height;
+        let sy = (1.0 - 2.0 * py / self.height) * self.half_height;
+        (self.forward + self.right * sx + self.up * sy).normalize()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The centre of the film looks at `look_at`; the top-left corner is up and to the left
+    /// by half the field of view.
+    #[test]
+    fn the_film_maps_centre_and_corners() {
+        let camera = Camera::try_new(DVec3::ZERO, DVec3::Z, DVec3::Y, 90.0).unwrap();
+        let rays = CameraRays::new(&camera, 200, 100);
+        assert!((rays.direction(100.0, 50.0) - DVec3::Z).length() < 1e-12);
+        let corner = rays.direction(0.0, 0.0);
+        // tan 45° = 1 up, aspect 2 to the left (+x: right = z × y = −x).
+        let expected = DVec3::new(2.0, 1.0, 1.0).normalize();
+        assert!((corner - expected).length() < 1e-12, "{corner}");
+    }
+}
