@@ -108,9 +108,11 @@ pub struct RenderArgs {
     /// Radiosity at a hit point: interpolated from vertices, or per element.
     #[arg(long, value_enum, default_value_t = ShadingArg::Smooth)]
     pub shading: ShadingArg,
-    /// Final gather: `none` (the radiosity mesh as the viewer shows it), `direct` (direct light
-    /// by shadow rays per pixel, sharp shadows), `full` (also one bounce of gathering rays).
-    #[arg(long, value_enum, default_value_t = GatherArg::None)]
+    /// Final gather: `direct` (direct light by shadow rays per pixel, sharp shadows; the
+    /// default: on the Cornell box a third less error per pixel than `none` against the
+    /// path-traced reference, in under 2 s), `none` (the radiosity mesh as the viewer shows
+    /// it), `full` (also one bounce of gathering rays).
+    #[arg(long, value_enum, default_value_t = GatherArg::Direct)]
     pub gather: GatherArg,
     /// Shadow rays per sample towards the emitters, with a gather.
     #[arg(long, default_value_t = RenderParams::default().shadow_rays)]

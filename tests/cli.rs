@@ -153,6 +153,8 @@ fn render_furnace_pfm_holds_linear_radiance() {
         "0.9,0.7,1.0",
         "--fov",
         "70",
+        "--gather",
+        "none",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let img = radiosity_image::read_pfm(&pfm).unwrap();

@@ -242,6 +242,12 @@ impl Renderer {
         &self.mesh
     }
 
+    /// Whether `solution` holds the solver's direct part for every element and vertex.
+    fn has_direct_part(&self, solution: &Solution) -> bool {
+        solution.vertex_direct.len() == self.mesh.positions.len()
+            && solution.element_direct.len() == self.mesh.elements.len()
+    }
+
     fn check(&self, solution: &Solution) -> Result<(), RenderError> {
         let m = &self.mesh;
         if solution.element_radiosity.len() != m.elements.len()
@@ -368,7 +374,7 @@ impl Renderer {
     ) -> Result<Rendering, RenderError> {
         params.validate()?;
         self.check(solution)?;
-        if params.gather == Gather::Direct && solution.vertex_direct.len() != self.mesh.positions.len() {
+        if params.gather == Gather::Direct && !self.has_direct_part(solution) {
             return Err(RenderError::NoDirectPart);
         }
         let (w, h) = (params.width as usize, params.height as usize);
@@ -439,7 +445,7 @@ impl Renderer {
         if params.gather == Gather::None {
             return Ok(self.interpolate(solution, e, p));
         }
-        if params.gather == Gather::Direct && solution.vertex_direct.len() != self.mesh.positions.len() {
+        if params.gather == Gather::Direct && !self.has_direct_part(solution) {
             return Err(RenderError::NoDirectPart);
         }
         let mut rng = Rng::for_task(params.seed, TEXEL_TASK, key);
@@ -488,10 +494,16 @@ impl Renderer {
         let indirect = match gather {
             // What the solver's radiosity holds besides emission and direct light, as it is
             // at x; clamped because the direct part and the total are interpolated apart.
-            Gather::Direct => (self.interpolate(solution, e, x)
-                - material.emission
-                - self.interpolate_values(&solution.vertex_direct, e, x))
-            .map(|c| c.max(0.0)),
+            Gather::Direct => {
+                let (total, direct) = match params.shading {
+                    Shading::Flat => (solution.element_radiosity[e], solution.element_direct[e]),
+                    Shading::Smooth => (
+                        self.interpolate(solution, e, x),
+                        self.interpolate_values(&solution.vertex_direct, e, x),
+                    ),
+                };
+                (total - material.emission - direct).map(|c| c.max(0.0))
+            }
             _ => material.reflectance * reflected,
         };
         material.emission + material.reflectance * direct + indirect
