@@ -10,7 +10,7 @@ use radiosity_io::{LoadError, ModelFormat, Transform, load_scene, parse_model, r
 use radiosity_solver::{Problem, SolverParams};
 
 fn scenes() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")
 }
 
 /// Per-object mean radiosity of `scene` meshed with `params`, default solver settings.

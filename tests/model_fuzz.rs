@@ -121,7 +121,7 @@ fn fuzz(name: &str, original: &[u8], format: ModelFormat, base: Option<&Path>, s
 }
 
 fn scenes() -> std::path::PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")
 }
 
 #[test]
