@@ -5,6 +5,7 @@
 use glam::DVec3;
 
 use crate::Camera;
+use crate::random::Rng;
 
 /// Directions through the film of `camera` for a picture of `width × height` pixels.
 #[derive(Clone, Copy, Debug)]
@@ -45,6 +46,20 @@ impl CameraRays {
         let sx = (2.0 * px / self.width - 1.0) * self.aspect * self.half_height;
         let sy = (1.0 - 2.0 * py / self.height) * self.half_height;
         (self.forward + self.right * sx + self.up * sy).normalize()
+    }
+
+    /// Direction of sample `sample` of `samples` in pixel `(x, y)`: jittered in its cell of a
+    /// stratified ⌊√samples⌋² grid over the pixel, the samples beyond the grid anywhere in it
+    /// (two draws from `rng` each, so every picture taken this way jitters alike).
+    pub fn jittered_direction(&self, x: u32, y: u32, sample: u32, samples: u32, rng: &mut Rng) -> DVec3 {
+        let m = f64::from(samples).sqrt().floor() as u32; // strata per side
+        let (jx, jy) = (rng.next_f64(), rng.next_f64());
+        let (sx, sy) = if sample < m * m {
+            ((f64::from(sample % m) + jx) / f64::from(m), (f64::from(sample / m) + jy) / f64::from(m))
+        } else {
+            (jx, jy)
+        };
+        self.direction(f64::from(x) + sx, f64::from(y) + sy)
     }
 }
 

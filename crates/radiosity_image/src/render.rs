@@ -382,20 +382,13 @@ impl Renderer {
         let mut pixels = vec![Rgb::ZERO; w * h];
         let mut object_ids = vec![None; w * h];
         let n = params.samples_per_pixel;
-        let m = f64::from(n).sqrt().floor() as u32; // strata per side
         pixels.par_chunks_mut(w).zip(object_ids.par_chunks_mut(w)).enumerate().for_each(|(y, (row, ids))| {
             for x in 0..w {
                 let index = (y * w + x) as u64;
                 let mut rng = Rng::for_task(params.seed, PIXEL_TASK, index);
                 let mut sum = Rgb::ZERO;
                 for i in 0..n {
-                    let (jx, jy) = (rng.next_f64(), rng.next_f64());
-                    let (sx, sy) = if i < m * m {
-                        ((f64::from(i % m) + jx) / f64::from(m), (f64::from(i / m) + jy) / f64::from(m))
-                    } else {
-                        (jx, jy)
-                    };
-                    let dir = rays.direction(x as f64 + sx, y as f64 + sy);
+                    let dir = rays.jittered_direction(x as u32, y as u32, i, n, &mut rng);
                     if let Some(hit) = self.trace_unchecked(solution, camera.position, dir, params.shading) {
                         sum += match params.gather {
                             Gather::None => hit.radiance,

@@ -20,7 +20,6 @@ pub(crate) fn render(
     let (w, h) = (params.width as usize, params.height as usize);
     let rays = CameraRays::new(camera, params.width, params.height);
     let n = params.samples_per_pixel.max(1);
-    let m = f64::from(n).sqrt().floor() as u32; // strata per side, as the radiosity renderer
     let mut radiance = vec![Rgb::ZERO; w * h];
     let mut stderr = vec![Rgb::ZERO; w * h];
     radiance.par_chunks_mut(w).zip(stderr.par_chunks_mut(w)).enumerate().for_each(|(y, (row, se_row))| {
@@ -28,13 +27,7 @@ pub(crate) fn render(
             let mut rng = Rng::for_task(params.seed, PIXEL_TASK, (y * w + x) as u64);
             let (mut sum, mut sum_sq) = (Rgb::ZERO, Rgb::ZERO);
             for i in 0..n {
-                let (jx, jy) = (rng.next_f64(), rng.next_f64());
-                let (sx, sy) = if i < m * m {
-                    ((f64::from(i % m) + jx) / f64::from(m), (f64::from(i / m) + jy) / f64::from(m))
-                } else {
-                    (jx, jy)
-                };
-                let dir = rays.direction(x as f64 + sx, y as f64 + sy);
+                let dir = rays.jittered_direction(x as u32, y as u32, i, n, &mut rng);
                 let l = match g.intersect(camera.position, dir) {
                     Some(hit) if hit.front => {
                         g.radiosity_at(hit.point, u32::MAX, &mut rng) * std::f64::consts::FRAC_1_PI
