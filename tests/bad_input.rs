@@ -338,54 +338,114 @@ fn closed_and_full_standard_streams_end_cleanly() {
     }
 }
 
+/// Sends `signal` (a name `kill` knows: STOP, KILL) to process `pid`.
+#[cfg(unix)]
+fn signal(pid: u32, signal: &str) {
+    let status = Command::new("kill").arg(format!("-{signal}")).arg(pid.to_string()).status().unwrap();
+    assert!(status.success(), "kill -{signal} {pid}");
+}
+
+/// Whether `dir` holds a temporary file for `name` (the output module's `.NAME.*`).
+fn has_temporary(dir: &Path, name: &str) -> bool {
+    let prefix = format!(".{name}.");
+    std::fs::read_dir(dir).unwrap().flatten().any(|e| e.file_name().to_string_lossy().starts_with(&prefix))
+}
+
 /// `--force` over an existing picture, killed while the new one is being written: the old
-/// file stays whole (the new one goes to a temporary file and is renamed into place), or —
-/// if the kill came after the rename — the new one is there whole.
+/// file stays whole, because the new one goes to a temporary file that is renamed into place
+/// only once complete. The run is stopped (SIGSTOP) as soon as the temporary file appears and
+/// killed only if that file is still there, i.e. the rename has not happened: so the kill
+/// provably lands mid-write. A run whose write slipped between two polls is tried again; none
+/// caught in ten tries fails the test.
 #[cfg(unix)]
 #[test]
 fn a_killed_write_leaves_the_old_file_whole() {
     let dir = tempfile::tempdir().unwrap();
     let pfm = dir.path().join("r.pfm");
     let old = b"PF\n1 1\n-1.0\n\0\0\x80?\0\0\x80?\0\0\x80?".to_vec();
-    std::fs::write(&pfm, &old).unwrap();
-    let mut child = bin()
-        .args([
-            "render",
-            "two-plates",
-            "--max-shots",
-            "1",
-            "--width",
-            "2000",
-            "--height",
-            "2000",
-            "--spp",
-            "1",
-        ])
-        .args(["--force", "--pfm", pfm.to_str().unwrap()])
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    // Kill as soon as the temporary file for r.pfm appears beside it, or when the run ends.
-    let start = Instant::now();
-    loop {
-        let tmp = std::fs::read_dir(dir.path())
-            .unwrap()
-            .flatten()
-            .any(|e| e.file_name().to_string_lossy().starts_with(".r.pfm."));
-        if tmp || child.try_wait().unwrap().is_some() || start.elapsed() > DEADLINE {
-            break;
+    for attempt in 0..10 {
+        std::fs::write(&pfm, &old).unwrap();
+        let mut child = bin()
+            .args(["render", "two-plates", "--max-shots", "1", "--width", "2000", "--height", "2000"])
+            .args(["--spp", "1", "--gather", "none", "--force", "--pfm", pfm.to_str().unwrap()])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        let start = Instant::now();
+        let mut caught = false;
+        while child.try_wait().unwrap().is_none() && start.elapsed() < DEADLINE {
+            if has_temporary(dir.path(), "r.pfm") {
+                signal(child.id(), "STOP");
+                caught = has_temporary(dir.path(), "r.pfm");
+                break;
+            }
+            std::thread::sleep(Duration::from_micros(200));
         }
-        std::thread::sleep(Duration::from_millis(1));
-    }
-    let _ = child.kill();
-    let _ = child.wait();
-    let now = std::fs::read(&pfm).unwrap();
-    if now != old {
-        // Renamed before the kill: then it must be the whole new picture.
+        let _ = child.kill();
+        let _ = child.wait();
+        let now = std::fs::read(&pfm).unwrap();
+        if caught {
+            assert_eq!(now, old, "attempt {attempt}: killed mid-write, the old file must be untouched");
+            return;
+        }
+        // Not caught mid-write: the run finished (or was stopped after its rename), and then
+        // the file is the whole new picture.
         let img = radiosity_image::decode_pfm(&now, &pfm).expect("a whole PFM");
         assert_eq!((img.width(), img.height()), (2000, 2000));
     }
+    panic!("no kill landed during the write in ten runs");
+}
+
+/// A full disk, as the file-size limit (RLIMIT_FSIZE, `ulimit -f`) makes it for one process
+/// without privileges: the write fails with EFBIG as it would with ENOSPC. The run must say
+/// so with exit 1, name the file, keep the old file and leave no temporary file behind.
+#[cfg(unix)]
+#[test]
+fn a_full_disk_is_an_error_and_keeps_the_old_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut cases = vec![];
+    for (flag, name) in [("--pfm", "r.pfm"), ("-o", "r.png"), ("--exr", "r.exr")] {
+        let path = dir.path().join(name);
+        std::fs::write(&path, "old picture").unwrap();
+        cases.push((flag, name, path));
+    }
+    for (flag, name, path) in &cases {
+        let mut cmd = Command::new("sh");
+        // Signal disposition "ignored" survives exec, so the write returns EFBIG instead of the
+        // process dying of SIGXFSZ. 64 blocks (32 or 64 KiB) is far below any of the pictures.
+        cmd.args(["-c", "trap '' XFSZ; ulimit -f 64; exec \"$@\"", "sh"])
+            .arg(env!("CARGO_BIN_EXE_radiosity"))
+            .args(["render", "two-plates", "--max-shots", "1", "--width", "512", "--height", "512"])
+            .args(["--spp", "1", "--gather", "none", "--force", flag, path.to_str().unwrap()]);
+        let o = finish(cmd, name);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(1), "{name}: {err}");
+        assert!(!err.contains("panicked") && !err.contains("wrote"), "{name}: {err}");
+        assert!(err.contains(name), "{name}: the error names the file: {err}");
+        assert_eq!(std::fs::read_to_string(path).unwrap(), "old picture", "{name}");
+        assert!(!has_temporary(dir.path(), name), "{name}: a temporary file was left behind");
+    }
+}
+
+/// A mesh over the element limit is refused before meshing, at the line that asks for it.
+#[test]
+fn a_mesh_over_the_element_limit_names_its_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let fine = write(
+        dir.path(),
+        "fine.toml",
+        &format!("{SCENE}[mesh]\npatch_size = 0.001\nelement_size = 0.0001\n"),
+    );
+    let o = run(&["solve", fine.to_str().unwrap()]);
+    assert_input_error(&o, "fine", &["fine.toml:20:", "mesh.element_size", "20000000", "'lamp'", "line 8)"]);
+    let moon = format!(
+        "{SCENE}[[object]]\nname = \"moon\"\ntype = \"sphere\"\nmaterial = \"grey\"\ncenter = [0, 0, 0]\nradius = 1e5\n\
+         [mesh]\npatch_size = 1\nelement_size = 0.1\n"
+    );
+    let path = write(dir.path(), "moon.toml", &moon);
+    let o = run(&["info", path.to_str().unwrap()]);
+    assert_input_error(&o, "moon", &["moon.toml:26:", "mesh.element_size", "'moon'", "line 18)"]);
 }
 
 #[test]

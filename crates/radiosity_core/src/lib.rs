@@ -20,7 +20,10 @@ mod srgb;
 pub use canonical::{cornell_box, furnace_box, furnace_sphere, two_plates, unit_cube_floor_light};
 pub use color::Rgb;
 pub use film::CameraRays;
-pub use mesh::{Element, MAX_ELEMENTS, Mesh, MeshError, MeshParams, Patch, Surface};
+pub use mesh::{
+    Element, MAX_ELEMENTS, Mesh, MeshError, MeshParams, Patch, Surface, estimate_elements,
+    first_object_over_limit,
+};
 pub use one_line::{MAX_PART_CHARS, escape_controls, one_line};
 pub use scene::{
     Camera, Facing, MAX_POLYGON_VERTICES, MAX_TIME_LIMIT_SECONDS, Material, Object, Polygon, PolygonMesh,

@@ -552,6 +552,33 @@ fn estimate_polygon_elements(poly: &Polygon, params: &MeshParams) -> usize {
     (per_edge * per_edge * (v.len() - 2) as f64).min(usize::MAX as f64) as usize
 }
 
+/// An upper bound on the elements `shape` meshes into with `params`, computed in time linear in
+/// its corners (saturating, never overflowing).
+pub fn estimate_elements(shape: &Shape, params: &MeshParams) -> usize {
+    let polygons = |ps: &[Polygon]| {
+        ps.iter().fold(0usize, |n, p| n.saturating_add(estimate_polygon_elements(p, params)))
+    };
+    match shape {
+        Shape::Polygons(ps) => polygons(ps),
+        Shape::Sphere(s) => {
+            let k = divisions(std::f64::consts::PI * s.radius, params.element_size).max(6) as f64;
+            (k * k * 4.0).min(usize::MAX as f64) as usize
+        }
+        Shape::Mesh(m) => polygons(m.polygons()),
+    }
+}
+
+/// The index of the object with which the running total of [`estimate_elements`] over
+/// `scene`'s objects first passes [`MAX_ELEMENTS`], if any: the object a too-large mesh is
+/// blamed on (scene loaders report it with its line before anything is meshed).
+pub fn first_object_over_limit(scene: &Scene, params: &MeshParams) -> Option<usize> {
+    let mut total = 0usize;
+    scene.objects.iter().position(|o| {
+        total = total.saturating_add(estimate_elements(&o.shape, params));
+        total > MAX_ELEMENTS
+    })
+}
+
 impl Mesh {
     /// Meshes `scene` with `params`.
     ///
@@ -564,19 +591,8 @@ impl Mesh {
             patch_size: params.patch_size,
             element_size: params.element_size,
         };
-        let mut estimate = 0usize;
-        for o in &scene.objects {
-            estimate = estimate.saturating_add(match &o.shape {
-                Shape::Polygons(ps) => ps.iter().map(|p| estimate_polygon_elements(p, params)).sum(),
-                Shape::Sphere(s) => {
-                    let k = divisions(std::f64::consts::PI * s.radius, params.element_size).max(6) as f64;
-                    (k * k * 4.0).min(usize::MAX as f64) as usize
-                }
-                Shape::Mesh(m) => m.polygons().iter().map(|p| estimate_polygon_elements(p, params)).sum(),
-            });
-            if estimate > MAX_ELEMENTS {
-                return Err(too_many(&o.name));
-            }
+        if let Some(i) = first_object_over_limit(scene, params) {
+            return Err(too_many(&scene.objects[i].name));
         }
         let mut mesh = Mesh {
             object_names: scene.objects.iter().map(|o| o.name.clone()).collect(),

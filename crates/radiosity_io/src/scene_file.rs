@@ -116,6 +116,8 @@ pub fn parse_scene(text: &str, origin: &str) -> Result<LoadedScene, LoadError> {
     let mut materials = materials(&loc, &desc.material)?;
     let declared = materials.len();
     let mut objects = Vec::new();
+    // For each object, the `[[object]]` it came from (a `mesh` object gives several).
+    let mut origins = Vec::new();
     let mut warnings = Vec::new();
     for (i, o) in desc.object.iter().enumerate() {
         if o.get_ref().kind.get_ref() == "mesh" {
@@ -124,6 +126,7 @@ pub fn parse_scene(text: &str, origin: &str) -> Result<LoadedScene, LoadError> {
         } else {
             objects.push(object(&loc, i, o, &desc.material, &materials[..declared])?);
         }
+        origins.resize(objects.len(), i);
     }
     let camera = desc.camera.as_ref().map(|c| camera(&loc, c)).transpose()?;
     let mesh = desc.mesh.as_ref().map(|m| mesh_params(&loc, m)).transpose()?;
@@ -163,7 +166,35 @@ pub fn parse_scene(text: &str, origin: &str) -> Result<LoadedScene, LoadError> {
     })?;
     scene.mesh = mesh;
     scene.solver = solver;
+    check_element_count(&loc, &desc, &scene, &origins)?;
     Ok(LoadedScene { scene, warnings })
+}
+
+/// Refuses, with a line, a scene whose mesh would pass [`radiosity_core::MAX_ELEMENTS`]: at
+/// `[mesh] element_size` when the file sets it, else at the object that passes the limit
+/// (a huge sphere, say, against the default sizes).
+fn check_element_count(
+    loc: &Locator,
+    desc: &SceneDesc,
+    scene: &Scene,
+    origins: &[usize],
+) -> Result<(), LoadError> {
+    let params = scene.mesh_params();
+    let Some(i) = radiosity_core::first_object_over_limit(scene, &params) else { return Ok(()) };
+    let object = &desc.object[origins[i]];
+    let e = radiosity_core::MeshError::TooManyElements {
+        object: scene.objects[i].name.chars().take(80).collect(),
+        limit: radiosity_core::MAX_ELEMENTS,
+        patch_size: params.patch_size,
+        element_size: params.element_size,
+    };
+    Err(match &desc.mesh {
+        Some(m) => {
+            let (line, _) = crate::locate::line_col(loc.text, object.span().start);
+            loc.at(m.element_size.span(), "mesh.element_size", format!("{e} (the object at line {line})"))
+        }
+        None => loc.at(object.span(), format!("object[{}]", origins[i]), e.to_string()),
+    })
 }
 
 fn materials(loc: &Locator, descs: &[Spanned<MaterialDesc>]) -> Result<Vec<Material>, LoadError> {
