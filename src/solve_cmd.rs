@@ -65,6 +65,9 @@ pub fn run(a: SolveArgs) -> Result<()> {
                 f(o.emitted_power),
                 f(o.radiosity)
             );
+            if let Some(back) = o.radiosity_back {
+                table += &format!("{:<24} {:>12} {:>36} {:>36}\n", "  (back face)", "", "", f(back));
+            }
         }
         output::stdout(&table)?;
     }
@@ -78,12 +81,18 @@ pub fn run(a: SolveArgs) -> Result<()> {
             "stop_reason": stop,
             "seconds": secs,
             "rays": report.rays,
-            "objects": objects.iter().map(|o| json!({
-                "name": o.name,
-                "area": o.area,
-                "emitted_power": o.emitted_power.to_array(),
-                "radiosity": o.radiosity.to_array(),
-            })).collect::<Vec<_>>(),
+            "objects": objects.iter().map(|o| {
+                let mut entry = json!({
+                    "name": o.name,
+                    "area": o.area,
+                    "emitted_power": o.emitted_power.to_array(),
+                    "radiosity": o.radiosity.to_array(),
+                });
+                if let Some(back) = o.radiosity_back {
+                    entry["radiosity_back"] = json!(back.to_array());
+                }
+                entry
+            }).collect::<Vec<_>>(),
         });
         let text = serde_json::to_string_pretty(&doc)? + "\n";
         if path == "-" {

@@ -21,7 +21,12 @@ pub fn furnace_box(rho: f64, emission: f64) -> Scene {
         "Furnace box",
         None,
         vec![material("furnace", rho, emission)],
-        vec![Object { name: "box".into(), material: 0, shape: Shape::Polygons(faces) }],
+        vec![Object {
+            name: "box".into(),
+            material: 0,
+            shape: Shape::Polygons(faces),
+            sides: crate::Sides::One,
+        }],
     )
     .expect("furnace scene is valid");
     s.mesh = Some(MeshParams::try_new(0.5, 0.125).expect("sizes > 0"));
@@ -39,7 +44,12 @@ pub fn furnace_sphere(rho: f64, emission: f64) -> Scene {
         "Furnace sphere",
         None,
         vec![material("furnace", rho, emission)],
-        vec![Object { name: "dome".into(), material: 0, shape: Shape::Sphere(sphere) }],
+        vec![Object {
+            name: "dome".into(),
+            material: 0,
+            shape: Shape::Sphere(sphere),
+            sides: crate::Sides::One,
+        }],
     )
     .expect("furnace scene is valid");
     s.mesh = Some(MeshParams::try_new(0.4, 0.4).expect("sizes > 0"));
@@ -63,6 +73,7 @@ pub fn unit_cube_floor_light(rho: f64) -> Scene {
             name: n.into(),
             material: usize::from(i != 0),
             shape: Shape::Polygons(vec![f]),
+            sides: crate::Sides::One,
         })
         .collect();
     let mut s = Scene::try_new(
@@ -101,8 +112,18 @@ pub fn two_plates(size: f64, distance: f64, rho: f64, emission: f64) -> Scene {
         None,
         vec![material("light", 0.0, emission), material("grey", rho, 0.0)],
         vec![
-            Object { name: "emitter".into(), material: 0, shape: Shape::Polygons(vec![lower]) },
-            Object { name: "receiver".into(), material: 1, shape: Shape::Polygons(vec![upper]) },
+            Object {
+                name: "emitter".into(),
+                material: 0,
+                shape: Shape::Polygons(vec![lower]),
+                sides: crate::Sides::One,
+            },
+            Object {
+                name: "receiver".into(),
+                material: 1,
+                shape: Shape::Polygons(vec![upper]),
+                sides: crate::Sides::One,
+            },
         ],
     )
     .expect("plates scene is valid");
@@ -136,6 +157,7 @@ pub fn cornell_box() -> Scene {
         name: name.into(),
         material,
         shape: Shape::Polygons(faces.iter().map(|f| polygon(f)).collect()),
+        sides: crate::Sides::One,
     };
     let objects = vec![
         o("floor", white, &[&[[552.8, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 559.2], [549.6, 0.0, 559.2]]]),

@@ -27,7 +27,7 @@ pub use mesh::{
 pub use one_line::{MAX_PART_CHARS, escape_controls, one_line};
 pub use scene::{
     Camera, Facing, MAX_POLYGON_VERTICES, MAX_TIME_LIMIT_SECONDS, Material, Object, Polygon, PolygonMesh,
-    Scene, SceneError, Shape, SolverSettings, Sphere, box_faces, unique_names,
+    Scene, SceneError, Shape, Sides, SolverSettings, Sphere, box_faces, unique_names,
 };
 pub use srgb::{encode_srgb, srgb_decode, srgb_encode};
 

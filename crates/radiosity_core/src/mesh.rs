@@ -24,7 +24,7 @@ use glam::DVec3;
 use thiserror::Error;
 
 use crate::Material;
-use crate::scene::{Facing, Polygon, PolygonMesh, Scene, SceneError, Shape, Sphere};
+use crate::scene::{Facing, Polygon, PolygonMesh, Scene, SceneError, Shape, Sides, Sphere};
 
 /// Subdivision of surfaces (the source document's "discrétisation", S10).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -155,6 +155,12 @@ pub struct Surface {
     pub material: u32,
     /// Its patches, a range into [`Mesh::patches`].
     pub patches: Range<u32>,
+    /// True for the back face of a two-sided object ([`Sides::Two`]): the same geometry as
+    /// its `twin`, wound the other way.
+    pub back: bool,
+    /// The surface on the other face of a two-sided object: same elements in the same order,
+    /// reversed. `None` for one-sided objects.
+    pub twin: Option<u32>,
 }
 
 /// The meshed scene: surfaces → patches → elements, plus the coarse occluder triangles that
@@ -574,7 +580,8 @@ pub fn estimate_elements(shape: &Shape, params: &MeshParams) -> usize {
 pub fn first_object_over_limit(scene: &Scene, params: &MeshParams) -> Option<usize> {
     let mut total = 0usize;
     scene.objects.iter().position(|o| {
-        total = total.saturating_add(estimate_elements(&o.shape, params));
+        let faces = usize::from(o.sides.count());
+        total = total.saturating_add(estimate_elements(&o.shape, params).saturating_mul(faces));
         total > MAX_ELEMENTS
     })
 }
@@ -599,7 +606,11 @@ impl Mesh {
             materials: scene.materials.clone(),
             ..Mesh::default()
         };
+        // The back face of an emitting material that emits from its front only: the same
+        // reflectance, no emission (one per material, made when first needed).
+        let mut dark_back = HashMap::new();
         for (oi, o) in scene.objects.iter().enumerate() {
+            let first_surface = mesh.surfaces.len() as u32;
             match &o.shape {
                 Shape::Polygons(ps) => {
                     for p in ps {
@@ -639,6 +650,21 @@ impl Mesh {
                         let v = p.vertices();
                         mesh.occluders.extend((1..v.len() - 1).map(|i| [v[0], v[i], v[i + 1]]));
                     }
+                }
+            }
+            if let Sides::Two { emits_back } = o.sides {
+                let material = scene.materials[o.material].clone();
+                let back_material = if emits_back || !material.is_emitter() {
+                    o.material as u32
+                } else {
+                    *dark_back.entry(o.material).or_insert_with(|| {
+                        let name = format!("{} (back)", material.name);
+                        mesh.materials.push(Material { name, emission: crate::Rgb::ZERO, ..material });
+                        (mesh.materials.len() - 1) as u32
+                    })
+                };
+                for s in first_surface..mesh.surfaces.len() as u32 {
+                    mesh.push_back_face(s, back_material);
                 }
             }
         }
@@ -693,7 +719,72 @@ impl Mesh {
             object: object as u32,
             material: material as u32,
             patches: first_patch..self.patches.len() as u32,
+            back: false,
+            twin: None,
         });
+    }
+
+    /// Adds the back face of surface `s`: its vertices (normals negated), patches and elements
+    /// in the same order, each wound the other way, with `material`; links the two as twins.
+    fn push_back_face(&mut self, s: u32, material: u32) {
+        let front = self.surfaces[s as usize].clone();
+        let back = self.surfaces.len() as u32;
+        let patches = front.patches.start as usize..front.patches.end as usize;
+        let elements = self.patches[patches.start].elements.start as usize
+            ..self.patches[patches.end - 1].elements.end as usize;
+        // A surface's vertices are its own and contiguous: from its first element's lowest
+        // index to the highest index any of its elements uses.
+        let used = || self.elements[elements.clone()].iter().flat_map(|e| e.vertex_indices().iter().copied());
+        let (vlo, vhi) = used().fold((u32::MAX, 0), |(lo, hi), v| (lo.min(v), hi.max(v)));
+        let vbase = self.positions.len() as u32;
+        self.positions.extend_from_within(vlo as usize..=vhi as usize);
+        for i in vlo..=vhi {
+            self.shading_normals.push(-self.shading_normals[i as usize]);
+        }
+        let first_patch = self.patches.len() as u32;
+        for p in patches {
+            let mut patch = self.patches[p].clone();
+            patch.corners[..patch.corner_count as usize].reverse();
+            patch.normal = -patch.normal;
+            patch.surface = back;
+            let start = self.elements.len() as u32;
+            for e in patch.elements.clone() {
+                let mut el = self.elements[e as usize];
+                el.vertices[..el.vertex_count as usize].reverse();
+                for v in &mut el.vertices[..el.vertex_count as usize] {
+                    *v = *v - vlo + vbase;
+                }
+                el.normal = -el.normal;
+                el.patch = self.patches.len() as u32;
+                self.elements.push(el);
+            }
+            patch.elements = start..self.elements.len() as u32;
+            self.patches.push(patch);
+        }
+        self.surfaces.push(Surface {
+            object: front.object,
+            material,
+            patches: first_patch..self.patches.len() as u32,
+            back: true,
+            twin: Some(s),
+        });
+        self.surfaces[s as usize].twin = Some(back);
+    }
+
+    /// Whether element `e` lies on the back face of a two-sided object.
+    pub fn element_is_back(&self, e: usize) -> bool {
+        let patch = &self.patches[self.elements[e].patch as usize];
+        self.surfaces[patch.surface as usize].back
+    }
+
+    /// The element on the other face of element `e` (the same place, wound the other way),
+    /// when `e` belongs to a two-sided object.
+    pub fn element_twin(&self, e: usize) -> Option<usize> {
+        let patch = &self.patches[self.elements[e].patch as usize];
+        let surface = &self.surfaces[patch.surface as usize];
+        let twin = &self.surfaces[surface.twin? as usize];
+        let first = |s: &Surface| self.patches[s.patches.start as usize].elements.start as usize;
+        Some(e - first(surface) + first(twin))
     }
 
     /// The material of element `e`.
@@ -747,7 +838,13 @@ mod tests {
 
     fn scene_of(shape: Shape) -> Scene {
         let m = Material::try_new("m", Rgb::splat(0.5), Rgb::ONE).unwrap();
-        Scene::try_new("t", None, vec![m], vec![Object { name: "o".into(), material: 0, shape }]).unwrap()
+        Scene::try_new(
+            "t",
+            None,
+            vec![m],
+            vec![Object { name: "o".into(), material: 0, shape, sides: crate::Sides::One }],
+        )
+        .unwrap()
     }
 
     fn check_mesh(mesh: &Mesh, expected_area: f64, params: &MeshParams) {

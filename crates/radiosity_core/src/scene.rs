@@ -425,6 +425,32 @@ pub enum Shape {
     Mesh(PolygonMesh),
 }
 
+/// Which faces of an object take part in the exchange of light.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Sides {
+    /// The face its normals point to only; the back is black and blocks light. Right for
+    /// closed shapes and the walls of a room, and half the work of [`Sides::Two`].
+    #[default]
+    One,
+    /// Both faces receive and reflect, each with its own radiosity (a sheet of paper, a wall
+    /// modelled as one polygon seen from both rooms, a model whose normals are inconsistent).
+    /// Emission leaves the front face only unless `emits_back`.
+    Two {
+        /// The back face emits the material's emission too.
+        emits_back: bool,
+    },
+}
+
+impl Sides {
+    /// `1` or `2`, as written in scene files and reports.
+    pub fn count(self) -> u8 {
+        match self {
+            Sides::One => 1,
+            Sides::Two { .. } => 2,
+        }
+    }
+}
+
 /// A named object with one material.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Object {
@@ -434,6 +460,15 @@ pub struct Object {
     pub material: usize,
     /// Geometry.
     pub shape: Shape,
+    /// Faces that exchange light.
+    pub sides: Sides,
+}
+
+impl Object {
+    /// A one-sided object.
+    pub fn new(name: impl Into<String>, material: usize, shape: Shape) -> Self {
+        Self { name: name.into(), material, shape, sides: Sides::One }
+    }
 }
 
 /// A pinhole camera.

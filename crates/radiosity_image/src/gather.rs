@@ -271,6 +271,7 @@ mod tests {
             name: name.into(),
             material,
             shape: Shape::Polygons(vec![Polygon::try_new(vertices).unwrap()]),
+            sides: radiosity_core::Sides::One,
         };
         let scene = Scene::try_new(
             "lamp over a floor",

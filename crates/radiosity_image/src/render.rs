@@ -237,6 +237,14 @@ impl Renderer {
         Self { mesh, accel, triangle_element, emitters, lift }
     }
 
+    /// The element a ray along `dir` sees at BVH triangle `triangle`: where a two-sided
+    /// object puts two elements back to back in one place, the one that faces the ray
+    /// (which of the two coplanar triangles the BVH reports first is arbitrary).
+    fn facing_element(&self, triangle: u32, dir: DVec3) -> usize {
+        let e = self.triangle_element[triangle as usize] as usize;
+        if self.mesh.elements[e].normal.dot(dir) > 0.0 { self.mesh.element_twin(e).unwrap_or(e) } else { e }
+    }
+
     /// The mesh being drawn.
     pub fn mesh(&self) -> &Arc<Mesh> {
         &self.mesh
@@ -288,7 +296,7 @@ impl Renderer {
         shading: Shading,
     ) -> Option<SurfaceHit> {
         let hit = self.accel.closest_hit(origin.as_vec3(), dir.as_vec3(), f32::MAX)?;
-        let e = self.triangle_element[hit.triangle as usize] as usize;
+        let e = self.facing_element(hit.triangle, dir);
         let el = &self.mesh.elements[e];
         // Recompute the hit in double precision against the element's plane: the BVH works in
         // single precision, and interpolation wants the point on the plane.
@@ -532,7 +540,7 @@ impl Renderer {
             let Some(hit) = self.accel.closest_hit(origin.as_vec3(), dir.as_vec3(), f32::MAX) else {
                 continue;
             };
-            let e = self.triangle_element[hit.triangle as usize] as usize;
+            let e = self.facing_element(hit.triangle, dir);
             let el = &self.mesh.elements[e];
             let denom = el.normal.dot(dir);
             if denom >= 0.0 {

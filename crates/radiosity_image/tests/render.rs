@@ -77,8 +77,18 @@ fn corner_scene(triangle_floor: bool) -> Scene {
         None,
         vec![bright, dark],
         vec![
-            Object { name: "bright_wall".into(), material: 0, shape: Shape::Polygons(vec![wall]) },
-            Object { name: "dark_floor".into(), material: 1, shape: Shape::Polygons(vec![floor]) },
+            Object {
+                name: "bright_wall".into(),
+                material: 0,
+                shape: Shape::Polygons(vec![wall]),
+                sides: radiosity_core::Sides::One,
+            },
+            Object {
+                name: "dark_floor".into(),
+                material: 1,
+                shape: Shape::Polygons(vec![floor]),
+                sides: radiosity_core::Sides::One,
+            },
         ],
     )
     .unwrap();

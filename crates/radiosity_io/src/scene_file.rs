@@ -77,6 +77,7 @@ fn scene_from_model(path: &Path) -> Result<LoadedScene, LoadError> {
         name: p.name,
         material: p.material,
         shape: Shape::Mesh(p.mesh),
+        sides: radiosity_core::Sides::One,
     });
     let name = path.file_stem().map_or_else(|| "model".to_owned(), |s| s.to_string_lossy().into_owned());
     let scene = Scene::try_new(&name, model.camera, model.materials, objects.collect()).map_err(|e| {
@@ -394,7 +395,7 @@ fn object(
         }
         _ => unreachable!("mesh objects go through mesh_object; allowed_fields accepts only these types"),
     };
-    Ok(Object { name, material, shape })
+    Ok(Object { name, material, shape, sides: radiosity_core::Sides::One })
 }
 
 /// A field of another type (a `radius` on a box) is an error, not silently ignored.
@@ -571,6 +572,7 @@ fn mesh_object(
             name: format!("{name}/{}", p.name),
             material: override_material.unwrap_or(first + p.material),
             shape: Shape::Mesh(p.mesh),
+            sides: radiosity_core::Sides::One,
         })
         .collect())
 }

@@ -108,6 +108,7 @@ mod tests {
             name: "block".into(),
             material: 0,
             shape: radiosity_core::Shape::Polygons(block),
+            sides: radiosity_core::Sides::One,
         });
         let mesh = Mesh::build(&scene, &scene.mesh_params()).unwrap();
         let kept = blocking_triangles(&mesh);

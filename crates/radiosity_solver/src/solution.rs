@@ -33,8 +33,11 @@ pub struct ObjectRadiosity {
     pub area: f64,
     /// Emitted power per channel, E·A.
     pub emitted_power: Rgb,
-    /// Area-weighted mean radiosity per channel.
+    /// Area-weighted mean radiosity per channel (of the front face, the one its normals
+    /// point to, for a two-sided object).
     pub radiosity: Rgb,
+    /// Of a two-sided object, the area-weighted mean radiosity of its back face.
+    pub radiosity_back: Option<Rgb>,
 }
 
 impl Solution {
@@ -48,17 +51,30 @@ impl Solution {
                 area: 0.0,
                 emitted_power: Rgb::ZERO,
                 radiosity: Rgb::ZERO,
+                radiosity_back: None,
             })
             .collect();
+        let mut back_area = vec![0.0; out.len()];
         for (e, el) in mesh.elements.iter().enumerate() {
-            let o = &mut out[mesh.element_object(e)];
-            o.area += el.area;
+            let object = mesh.element_object(e);
+            let o = &mut out[object];
             o.emitted_power += mesh.element_material(e).emission * el.area;
-            o.radiosity += self.element_radiosity[e] * el.area;
+            if mesh.element_is_back(e) {
+                back_area[object] += el.area;
+                *o.radiosity_back.get_or_insert(Rgb::ZERO) += self.element_radiosity[e] * el.area;
+            } else {
+                o.area += el.area;
+                o.radiosity += self.element_radiosity[e] * el.area;
+            }
         }
-        for o in &mut out {
+        for (o, back_area) in out.iter_mut().zip(back_area) {
             if o.area > 0.0 {
                 o.radiosity = o.radiosity / o.area;
+            }
+            if let Some(b) = &mut o.radiosity_back
+                && back_area > 0.0
+            {
+                *b = *b / back_area;
             }
         }
         out

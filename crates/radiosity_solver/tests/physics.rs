@@ -145,6 +145,7 @@ fn a_blocker_casts_a_shadow() {
         name: "blocker".into(),
         material: 2,
         shape: radiosity_core::Shape::Polygons(vec![blocker]),
+        sides: radiosity_core::Sides::One,
     });
     scene.mesh = Some(MeshParams::try_new(0.25, 0.0625).unwrap());
     let shaded = converged(&scene, 1e-6);
@@ -192,11 +193,13 @@ fn culled_visibility_matches_brute_force_on_every_triangle() {
         name: "block".into(),
         material: 0,
         shape: radiosity_core::Shape::Polygons(block),
+        sides: radiosity_core::Sides::One,
     });
     scene.objects.push(radiosity_core::Object {
         name: "lamp".into(),
         material: 1,
         shape: radiosity_core::Shape::Polygons(vec![lamp]),
+        sides: radiosity_core::Sides::One,
     });
     let fast = Problem::new(&scene, &MeshParams::try_new(0.25, 0.0625).unwrap()).unwrap();
     let mesh = fast.mesh().clone();
@@ -239,8 +242,18 @@ fn a_lamp_half_behind_a_wall_lights_it_through_the_half_in_front() {
             Material::try_new("grey", Rgb::splat(0.5), Rgb::ZERO).unwrap(),
         ],
         vec![
-            Object { name: "lamp".into(), material: 0, shape: Shape::Polygons(vec![lamp.clone()]) },
-            Object { name: "wall".into(), material: 1, shape: Shape::Polygons(vec![wall]) },
+            Object {
+                name: "lamp".into(),
+                material: 0,
+                shape: Shape::Polygons(vec![lamp.clone()]),
+                sides: radiosity_core::Sides::One,
+            },
+            Object {
+                name: "wall".into(),
+                material: 1,
+                shape: Shape::Polygons(vec![wall]),
+                sides: radiosity_core::Sides::One,
+            },
         ],
     )
     .unwrap();
