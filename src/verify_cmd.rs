@@ -14,7 +14,7 @@ use radiosity_core::random::Rng;
 use radiosity_core::{Camera, Mesh, Rgb};
 use radiosity_image::HdrImage;
 use radiosity_reference::{Estimate, EstimateParams, PathBudget, PictureParams, Progress, Reference, Region};
-use radiosity_solver::Problem;
+use radiosity_solver::{ObjectRadiosity, Problem};
 use serde_json::{Value, json};
 
 use crate::output::{Targets, write_report};
@@ -80,6 +80,24 @@ pub fn scale_solver_reflectance(mesh: &mut Mesh, factor: f64) -> Result<()> {
         m.reflectance *= factor;
     }
     Ok(())
+}
+
+/// `objects`, then the back face of every two-sided one as an object of its own named
+/// `NAME (back)`: the order of [`Reference::objects`].
+fn with_back_faces(objects: Vec<ObjectRadiosity>) -> Vec<ObjectRadiosity> {
+    let backs: Vec<ObjectRadiosity> = objects
+        .iter()
+        .filter_map(|o| {
+            Some(ObjectRadiosity {
+                name: format!("{} (back)", o.name),
+                area: o.area,
+                emitted_power: Rgb::ZERO,
+                radiosity: o.radiosity_back?,
+                radiosity_back: None,
+            })
+        })
+        .collect();
+    objects.into_iter().chain(backs).collect()
 }
 
 /// A progress bar for the reference on stderr when it is a terminal.
@@ -202,7 +220,7 @@ pub fn run(a: VerifyArgs) -> Result<()> {
     let Prepared { scene, problem, .. } = &prepared;
     let mesh = problem.mesh();
     let solution = solver.solution();
-    let solved = solution.object_radiosity(mesh);
+    let solved = with_back_faces(solution.object_radiosity(mesh));
     let solve_secs = report.elapsed.as_secs_f64();
     let stop = report.stop_reason.map_or("running", |s| s.as_str());
     crate::output::note(format_args!(
@@ -410,7 +428,15 @@ fn compare_elements(
     sample.sort_unstable();
     let regions: Vec<Region> = sample
         .iter()
-        .map(|&e| Region { object: mesh.element_object(e), corners: mesh.element_corners(e).collect() })
+        .map(|&e| {
+            let object = mesh.element_object(e);
+            let object = if mesh.element_is_back(e) {
+                reference.back_object(object).unwrap_or(object)
+            } else {
+                object
+            };
+            Region { object, corners: mesh.element_corners(e).collect() }
+        })
         .collect();
     let params = EstimateParams {
         budget: PathBudget::Fixed { paths },

@@ -131,6 +131,45 @@ pub fn two_plates(size: f64, distance: f64, rho: f64, emission: f64) -> Scene {
     s
 }
 
+/// A two-sided unit plate (reflectance `rho`, normal −z, at z = 1) between two unit lamps
+/// one apart on each side, both black: `below` at z = 0 facing +z with emission `e_below`,
+/// `above` at z = 2 facing −z with `e_above`. The plate hides each lamp from the other and
+/// its faces do not see each other, so each face gets its own lamp's light only, reflected
+/// once: B_front = ρ·E_below·F, B_back = ρ·E_above·F with F = 0.199825 (Howell C-11).
+///
+/// # Panics
+/// When `rho` is outside [0, 1) or an emission is negative.
+pub fn two_sided_plate(rho: f64, e_below: f64, e_above: f64) -> Scene {
+    let square = |z: f64, up: bool| {
+        let mut v = vec![
+            DVec3::new(0.0, 0.0, z),
+            DVec3::new(1.0, 0.0, z),
+            DVec3::new(1.0, 1.0, z),
+            DVec3::new(0.0, 1.0, z),
+        ];
+        if !up {
+            v.reverse();
+        }
+        Shape::Polygons(vec![Polygon::try_new(v).expect("square")])
+    };
+    let mut s = Scene::try_new(
+        "Two-sided plate",
+        None,
+        vec![material("below", 0.0, e_below), material("above", 0.0, e_above), material("grey", rho, 0.0)],
+        vec![
+            Object::new("below", 0, square(0.0, true)),
+            Object {
+                sides: crate::Sides::Two { emits_back: false },
+                ..Object::new("plate", 2, square(1.0, false))
+            },
+            Object::new("above", 1, square(2.0, false)),
+        ],
+    )
+    .expect("plate scene is valid");
+    s.mesh = Some(MeshParams::try_new(0.25, 1.0 / 16.0).expect("sizes > 0"));
+    s
+}
+
 fn polygon(points: &[[f64; 3]]) -> Polygon {
     Polygon::try_new(points.iter().map(|p| DVec3::from_array(*p)).collect())
         .expect("Cornell polygon is valid")

@@ -17,7 +17,9 @@ pub mod random;
 mod scene;
 mod srgb;
 
-pub use canonical::{cornell_box, furnace_box, furnace_sphere, two_plates, unit_cube_floor_light};
+pub use canonical::{
+    cornell_box, furnace_box, furnace_sphere, two_plates, two_sided_plate, unit_cube_floor_light,
+};
 pub use color::Rgb;
 pub use film::CameraRays;
 pub use mesh::{

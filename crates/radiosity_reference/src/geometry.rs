@@ -6,7 +6,7 @@
 
 use radiosity_accel::{Bvh, RayQuery};
 use radiosity_core::glam::{DVec3, Vec3};
-use radiosity_core::{Facing, Polygon, Rgb, Scene, Shape};
+use radiosity_core::{Facing, Polygon, Rgb, Scene, Shape, Sides};
 
 /// One piece of an object's surface.
 #[derive(Clone, Debug)]
@@ -37,6 +37,10 @@ pub(crate) struct Piece {
     pub object: u32,
     pub area: f64,
     pub shape: Primitive,
+    /// The piece on the other face of a two-sided object: the same place with the normal
+    /// reversed, in the back face's object. Back pieces are not in the BVH nor in `spheres`:
+    /// a ray that meets a front piece from behind is handed to its twin.
+    pub twin: Option<u32>,
 }
 
 /// A surface point reached by a ray or drawn on an object.
@@ -86,6 +90,8 @@ pub(crate) struct Geometry {
     /// Pieces that are spheres (tested analytically on every ray).
     pub spheres: Vec<u32>,
     pub objects: Vec<ObjectGeometry>,
+    /// Per scene object, the index in `objects` of its back face (two-sided objects).
+    pub back_objects: Vec<Option<u32>>,
     /// Emitting pieces and cumulative emitted power (channel sum) to choose them by.
     pub emitters: Vec<u32>,
     pub emitter_cdf: Vec<f64>,
@@ -115,6 +121,7 @@ impl Geometry {
             bvh: Bvh::new(&[]),
             spheres: Vec::new(),
             objects: Vec::new(),
+            back_objects: vec![None; scene.objects.len()],
             emitters: Vec::new(),
             emitter_cdf: Vec::new(),
             offset: 0.0,
@@ -158,11 +165,43 @@ impl Geometry {
                             radius: s.radius,
                             inward: s.facing == Facing::Inward,
                         },
+                        twin: None,
                     };
                     add(&mut g, piece);
                 }
             }
             g.objects.push(object);
+        }
+        // Back faces of two-sided objects come after every scene object, in scene order, so
+        // object i is still scene object i.
+        for (oi, o) in scene.objects.iter().enumerate() {
+            let Sides::Two { emits_back } = o.sides else { continue };
+            let front = g.objects[oi].clone();
+            let back_index = g.objects.len() as u32;
+            g.back_objects[oi] = Some(back_index);
+            let mut back = ObjectGeometry {
+                name: format!("{} (back)", front.name),
+                emission: if emits_back { front.emission } else { Rgb::ZERO },
+                pieces: Vec::with_capacity(front.pieces.len()),
+                ..front.clone()
+            };
+            for &p in &front.pieces {
+                let mut piece = g.pieces[p as usize].clone();
+                piece.object = back_index;
+                piece.twin = Some(p);
+                piece.shape = match piece.shape {
+                    Primitive::Polygon { normal, first_triangle, triangle_count } => {
+                        Primitive::Polygon { normal: -normal, first_triangle, triangle_count }
+                    }
+                    Primitive::Sphere { center, radius, inward } => {
+                        Primitive::Sphere { center, radius, inward: !inward }
+                    }
+                };
+                g.pieces[p as usize].twin = Some(g.pieces.len() as u32);
+                back.pieces.push(g.pieces.len() as u32);
+                g.pieces.push(piece);
+            }
+            g.objects.push(back);
         }
         let mut power = 0.0;
         for (i, piece) in g.pieces.iter().enumerate() {
@@ -196,6 +235,7 @@ impl Geometry {
             object: object as u32,
             area: p.area(),
             shape: Primitive::Polygon { normal: p.normal(), first_triangle, triangle_count: v.len() - 2 },
+            twin: None,
         }
     }
 
@@ -226,6 +266,17 @@ impl Geometry {
         self.sample_piece(piece, [u[1], u[2], u[3]])
     }
 
+    /// The point `p` on piece `piece` (lit-side normal `n`) as a ray along `dir` sees it: on
+    /// the piece's back face, when it has one and the ray comes from behind.
+    fn facing(&self, piece: u32, p: DVec3, n: DVec3, dir: DVec3) -> SurfacePoint {
+        match self.pieces[piece as usize].twin {
+            Some(twin) if n.dot(dir) > 0.0 => {
+                SurfacePoint { p, n: -n, object: self.pieces[twin as usize].object }
+            }
+            _ => SurfacePoint { p, n, object: self.pieces[piece as usize].object },
+        }
+    }
+
     /// The first surface along `origin + t·dir` (`dir` unit), t > 0.
     pub fn intersect(&self, origin: DVec3, dir: DVec3) -> Option<RayHit> {
         let mut best: Option<(f64, SurfacePoint)> = None;
@@ -239,7 +290,7 @@ impl Geometry {
             let t0 = self.triangles[hit.triangle as usize][0];
             let denom = normal.dot(dir);
             let t = if denom.abs() > 1e-12 { normal.dot(t0 - origin) / denom } else { f64::from(hit.t) };
-            best = Some((t, SurfacePoint { p: origin + dir * t, n: normal, object: piece.object }));
+            best = Some((t, self.facing(piece_index, origin + dir * t, normal, dir)));
         }
         for &s in &self.spheres {
             let piece = &self.pieces[s as usize];
@@ -248,8 +299,7 @@ impl Geometry {
             if let Some(t) = sphere_hit(center, radius, origin, dir, 1e-3 * self.offset, limit) {
                 let p = origin + dir * t;
                 let out = (p - center) / radius;
-                best =
-                    Some((t, SurfacePoint { p, n: if inward { -out } else { out }, object: piece.object }));
+                best = Some((t, self.facing(s, p, if inward { -out } else { out }, dir)));
             }
         }
         best.map(|(_, point)| RayHit { point, front: point.n.dot(dir) < 0.0 })

@@ -209,9 +209,16 @@ impl Reference {
         Self { geometry: Geometry::new(scene) }
     }
 
-    /// Names and areas of the objects, in scene order.
+    /// Names and areas of the objects, in scene order, then the back faces of two-sided
+    /// objects (named `NAME (back)`), in scene order too.
     pub fn objects(&self) -> impl Iterator<Item = (&str, f64)> {
         self.geometry.objects.iter().map(|o| (o.name.as_str(), o.area))
+    }
+
+    /// The index among [`Reference::objects`] of the back face of scene object `object`, when
+    /// it is two-sided: what a [`Region`] on that face names.
+    pub fn back_object(&self, object: usize) -> Option<usize> {
+        self.geometry.back_objects.get(object).copied().flatten().map(|i| i as usize)
     }
 
     /// The mean radiosity of every object, with its standard error.

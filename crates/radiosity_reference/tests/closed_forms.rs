@@ -4,7 +4,9 @@
 //! fails.
 
 use radiosity_core::glam::DVec3;
-use radiosity_core::{Camera, furnace_box, furnace_sphere, two_plates, unit_cube_floor_light};
+use radiosity_core::{
+    Camera, furnace_box, furnace_sphere, two_plates, two_sided_plate, unit_cube_floor_light,
+};
 use radiosity_reference::{Estimate, EstimateParams, PathBudget, PictureParams, Reference, Region};
 
 /// Howell C-11, unit squares one apart.
@@ -68,6 +70,20 @@ fn two_plates_match_howell_c11() {
     // The emitter's radiosity is its emission alone, with no noise at all.
     assert_eq!(all[0].1.mean.r, 1.0);
     assert_eq!(all[0].1.stderr.r, 0.0);
+}
+
+/// A two-sided plate between two black lamps (E = 1 below, 2 above): each face is ρ·E·F
+/// of its own lamp; the back face is an object of its own, after the scene's objects.
+#[test]
+fn each_face_of_a_two_sided_plate_matches_howell_c11() {
+    let r = Reference::new(&two_sided_plate(0.5, 1.0, 2.0));
+    let all = objects(&r, &fixed(40_000));
+    let names: Vec<&str> = all.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(names, ["below", "plate", "above", "plate (back)"]);
+    assert_eq!(r.back_object(1), Some(3));
+    assert_eq!(r.back_object(0), None);
+    assert_within(&all[1].1, 0.5 * F_C11, 3.0, "front face");
+    assert_within(&all[3].1, 0.5 * 2.0 * F_C11, 3.0, "back face");
 }
 
 /// The unit cube lit by its floor (E = 1, ρ = 0.5). With one reflection each face is

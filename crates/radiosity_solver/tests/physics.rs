@@ -3,7 +3,8 @@
 use std::sync::Arc;
 
 use radiosity_core::{
-    Mesh, MeshParams, Rgb, Scene, furnace_box, furnace_sphere, two_plates, unit_cube_floor_light,
+    Mesh, MeshParams, Rgb, Scene, Sides, furnace_box, furnace_sphere, two_plates, two_sided_plate,
+    unit_cube_floor_light,
 };
 use radiosity_solver::{
     Overshoot, Problem, Solver, SolverParams, StepBudget, StopReason, occluder_triangles,
@@ -77,10 +78,46 @@ fn two_plates_receiver_gets_rho_e_f() {
     assert!(rel(o[1].radiosity.r, expected) < 1e-2, "{} vs {expected}", o[1].radiosity.r);
 }
 
+/// A two-sided plate between two lamps: each face gets its own lamp's light, ρ·E·F
+/// (Howell C-11), within the 1 % of the one-sided case above.
+#[test]
+fn each_face_of_a_two_sided_plate_gets_its_own_light() {
+    let s = converged(&two_sided_plate(0.5, 1.0, 2.0), 1e-6);
+    let plate = &s.solution().object_radiosity(s.mesh())[1];
+    let back = plate.radiosity_back.expect("two-sided: a back-face radiosity");
+    for (face, b, expected) in
+        [("front", plate.radiosity.r, 0.5 * 0.199825), ("back", back.r, 0.5 * 2.0 * 0.199825)]
+    {
+        assert!(rel(b, expected) < 1e-2, "{face}: {b} vs {expected}");
+    }
+    // The one-sided lamps report no back face.
+    assert!(s.solution().object_radiosity(s.mesh())[0].radiosity_back.is_none());
+}
+
+/// The furnace with two-sided walls: inside still E/(1 − ρ); the outer faces see nothing
+/// and emit nothing (front-only emission), so they stay exactly black.
+#[test]
+fn a_two_sided_furnace_is_unchanged_inside_and_black_outside() {
+    let mut scene = furnace_box(0.5, 1.0);
+    scene.objects[0].sides = Sides::Two { emits_back: false };
+    let s = converged(&scene, 1e-5);
+    let mesh = s.mesh();
+    let mut backs = 0;
+    for (e, b) in s.solution().element_radiosity.iter().enumerate() {
+        if mesh.element_is_back(e) {
+            backs += 1;
+            assert_eq!(*b, Rgb::ZERO, "outer face element {e}");
+        } else {
+            assert!(rel(b.r, 2.0) < 5e-3, "inner element {e}: {} vs 2", b.r);
+        }
+    }
+    assert_eq!(backs * 2, mesh.elements.len());
+}
+
 /// Energy: emitted = absorbed + unshot + escaped after every shot, to round-off.
 #[test]
 fn energy_is_conserved_after_every_shot() {
-    for scene in [two_plates(1.0, 0.5, 0.7, 2.0), furnace_box(0.8, 1.0)] {
+    for scene in [two_plates(1.0, 0.5, 0.7, 2.0), furnace_box(0.8, 1.0), two_sided_plate(0.7, 1.0, 2.0)] {
         let mut s = solver_for(&scene, SolverParams::default());
         for _ in 0..60 {
             s.step(StepBudget::Shots(1));
