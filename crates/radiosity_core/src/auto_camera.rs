@@ -9,7 +9,7 @@
 
 use glam::DVec3;
 
-use crate::scene::{Camera, Facing, Shape};
+use crate::scene::{Camera, Facing, Shape, Sides};
 use crate::{CameraRays, Polygon, Scene};
 
 /// Probe rays per candidate view, across and down (a 4:3 picture).
@@ -86,6 +86,9 @@ fn first_hit(scene: &Scene, origin: DVec3, dir: DVec3) -> Option<(f64, bool)> {
         }
     };
     for object in &scene.objects {
+        // Both faces of a two-sided object are lit sides.
+        let two_sided = object.sides != Sides::One;
+        let mut take = |t: f64, front: bool| take(t, front || two_sided);
         match &object.shape {
             Shape::Polygons(ps) => {
                 ps.iter().filter_map(|p| hit_polygon(p, origin, dir)).for_each(|h| take(h.0, h.1))
@@ -168,5 +171,19 @@ mod tests {
         let scene = two_plates(1.0, 1.0, 0.5, 1.0);
         let camera = scene.camera_or_framing();
         assert!(front_faces_seen(&scene, &camera) > 0, "{camera:?}");
+    }
+
+    /// A two-sided wall is lit on both sides: the framing view of a closed box, which sees
+    /// no lit face of one-sided walls, sees lit faces of two-sided ones.
+    #[test]
+    fn both_faces_of_a_two_sided_object_count_as_lit() {
+        let mut scene = furnace_box(0.5, 1.0);
+        let framing = {
+            let (lo, hi) = scene.bounds();
+            Camera::framing(lo, hi)
+        };
+        assert_eq!(front_faces_seen(&scene, &framing), 0);
+        scene.objects[0].sides = Sides::Two { emits_back: false };
+        assert!(front_faces_seen(&scene, &framing) > 0);
     }
 }

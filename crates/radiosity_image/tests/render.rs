@@ -215,3 +215,36 @@ fn a_solution_for_another_mesh_is_an_error() {
     let err = renderer.render(&other, &camera, &RenderParams::preview()).unwrap_err();
     assert!(err.to_string().contains("does not fit the mesh"), "{err}");
 }
+
+/// A two-sided plate seen from below and from above: each view shows its own face's
+/// radiosity, B/π (the two faces sit in one place, so which of the two coplanar triangles the
+/// ray query meets first must not matter), and the faces differ by their lamps' ratio, 2.
+#[test]
+fn each_face_of_a_two_sided_plate_shows_its_own_radiosity() {
+    let scene = radiosity_core::two_sided_plate(0.5, 1.0, 2.0);
+    let (mesh, solution) = common::solve(&scene, SolverParams::default());
+    let objects = solution.object_radiosity(&mesh);
+    let (front, back) = (objects[1].radiosity.r, objects[1].radiosity_back.unwrap().r);
+    let renderer = Renderer::new(mesh.clone());
+    let mut seen = [0.0; 2];
+    for (i, (z, dir)) in [(0.5, DVec3::Z), (1.5, -DVec3::Z)].into_iter().enumerate() {
+        let mut sum = 0.0;
+        let mut n = 0;
+        for x in 1..8 {
+            for y in 1..8 {
+                let origin = DVec3::new(f64::from(x) / 8.0, f64::from(y) / 8.0, z);
+                let hit =
+                    renderer.trace(&solution, origin, dir, Shading::Flat).unwrap().expect("hits the plate");
+                assert!(hit.front_facing, "a two-sided face is seen from its lit side");
+                assert_eq!(hit.object, 1);
+                sum += hit.radiance.r * PI;
+                n += 1;
+            }
+        }
+        seen[i] = sum / f64::from(n);
+    }
+    // The mean over the plate's middle is near the object mean (the edges are darker).
+    assert!((seen[0] / front - 1.0).abs() < 0.15, "from below {} vs front {front}", seen[0]);
+    assert!((seen[1] / back - 1.0).abs() < 0.15, "from above {} vs back {back}", seen[1]);
+    assert!((seen[1] / seen[0] - 2.0).abs() < 1e-6 * 2.0, "faces {seen:?}: the ratio of the lamps");
+}
