@@ -61,6 +61,11 @@ pub struct SolveOpts {
     /// Longest element edge, scene units (overrides the scene's [mesh]).
     #[arg(long, allow_negative_numbers = true)]
     pub element_size: Option<f64>,
+    /// Smooth shading joins the facets of one object whose normals differ by less than this,
+    /// degrees in [0, 180); 0 shades every facet on its own [default: the scene's [mesh]
+    /// crease_angle, else 40].
+    #[arg(long, allow_negative_numbers = true, value_name = "DEGREES")]
+    pub crease_angle: Option<f64>,
     /// Stop when unshot power / emitted power falls to this, in (0, 1) [default: the scene's
     /// [solver], else the solver's default, 1e-3].
     #[arg(long, allow_negative_numbers = true)]
@@ -190,7 +195,9 @@ pub fn settings(scene_arg: &str, o: &SolveOpts) -> Result<Settings> {
     } else {
         base.element_size
     });
-    let mesh_params = MeshParams::try_new(patch, element).map_err(|e| input(format!("mesh options: {e}")))?;
+    let mesh_params = MeshParams::try_new(patch, element)
+        .and_then(|m| m.with_crease_angle(o.crease_angle.unwrap_or(base.crease_angle_deg)))
+        .map_err(|e| input(format!("mesh options: {e}")))?;
     // The scene file's limit is checked (with its line) by the loader; this is the option's.
     let time_limit = match o.time_limit.or(scene.solver.time_limit) {
         Some(t) if t > 0.0 && t <= radiosity_core::MAX_TIME_LIMIT_SECONDS => Some(Duration::from_secs_f64(t)),

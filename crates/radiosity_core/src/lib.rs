@@ -23,8 +23,8 @@ pub use canonical::{
 pub use color::Rgb;
 pub use film::CameraRays;
 pub use mesh::{
-    Element, MAX_ELEMENTS, Mesh, MeshError, MeshParams, Patch, Surface, estimate_elements,
-    first_object_over_limit,
+    DEFAULT_CREASE_ANGLE_DEG, Element, MAX_ELEMENTS, Mesh, MeshError, MeshParams, Patch, Smoothing, Surface,
+    estimate_elements, first_object_over_limit,
 };
 pub use one_line::{MAX_PART_CHARS, escape_controls, one_line};
 pub use scene::{

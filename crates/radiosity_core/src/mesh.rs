@@ -35,7 +35,16 @@ pub struct MeshParams {
     /// Longest element edge, scene units, > 0; clamped to `patch_size`. Elements receive;
     /// smaller gives sharper shadows and smoother shading.
     pub element_size: f64,
+    /// Smooth shading joins the surfaces of one object at a shared corner when their normals
+    /// differ by less than this, degrees in [0, 180); 0 keeps every surface apart. Default
+    /// [`DEFAULT_CREASE_ANGLE_DEG`].
+    pub crease_angle_deg: f64,
 }
+
+/// The default crease angle: a tessellated curve (a sphere of 24 segments turns 15° per
+/// facet, a coarse cylinder 30°) shades smooth, while a box's 90° edges and a chamfer's 45°
+/// stay sharp.
+pub const DEFAULT_CREASE_ANGLE_DEG: f64 = 40.0;
 
 impl MeshParams {
     /// Validated parameters.
@@ -48,19 +57,34 @@ impl MeshParams {
                 return Err(SceneError::BadMeshSize { key, value });
             }
         }
-        Ok(Self { patch_size, element_size: element_size.min(patch_size) })
+        Ok(Self {
+            patch_size,
+            element_size: element_size.min(patch_size),
+            crease_angle_deg: DEFAULT_CREASE_ANGLE_DEG,
+        })
+    }
+
+    /// The same sizes with crease angle `degrees`.
+    ///
+    /// # Errors
+    /// [`SceneError::BadCreaseAngle`] when `degrees` is not in [0, 180).
+    pub fn with_crease_angle(self, degrees: f64) -> Result<Self, SceneError> {
+        if !(0.0..180.0).contains(&degrees) {
+            return Err(SceneError::BadCreaseAngle { value: degrees });
+        }
+        Ok(Self { crease_angle_deg: degrees, ..self })
     }
 
     /// Default subdivision for a scene whose bounding-box diagonal is `diagonal`: patches of
     /// 1/8 and elements of 1/32 of it.
     pub fn for_extent(diagonal: f64) -> Self {
         let d = if diagonal.is_finite() && diagonal > 0.0 { diagonal } else { 1.0 };
-        Self { patch_size: d / 8.0, element_size: d / 32.0 }
+        Self { patch_size: d / 8.0, element_size: d / 32.0, crease_angle_deg: DEFAULT_CREASE_ANGLE_DEG }
     }
 
     /// The same parameters with both sizes multiplied by `factor` (e.g. 0.5 for a finer mesh).
     pub fn scaled(self, factor: f64) -> Self {
-        Self { patch_size: self.patch_size * factor, element_size: self.element_size * factor }
+        Self { patch_size: self.patch_size * factor, element_size: self.element_size * factor, ..self }
     }
 }
 
@@ -184,6 +208,94 @@ pub struct Mesh {
     /// The scene's geometry as triangles (input polygons fan-triangulated, sphere facets), for
     /// visibility: far fewer than the element triangles, hence faster rays.
     pub occluders: Vec<[DVec3; 3]>,
+    /// Vertices of other surfaces that smooth shading pools with each vertex.
+    pub smoothing: Smoothing,
+}
+
+/// Which vertices of *different* surfaces share their radiosity in smooth shading: those in
+/// one place, on one object and one face of it, whose normals differ by less than the crease
+/// angle. Vertices are never shared across surfaces (light must not leak round a corner),
+/// so a tessellated curve — one surface per facet — would otherwise shade as facets. The test
+/// is made per vertex against each neighbour, not chained, so a run of slight bends never
+/// carries smoothing across a sharp crease (the usual crease-angle rule of modelling tools).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Smoothing {
+    /// Per vertex, a range into `partners` (`offsets[v]..offsets[v + 1]`); empty when the
+    /// vertex pools with nobody (or the whole table is empty: no smoothing at all).
+    pub offsets: Vec<u32>,
+    /// The vertices pooled with each vertex, itself not included.
+    pub partners: Vec<u32>,
+}
+
+impl Smoothing {
+    /// The vertices pooled with vertex `v`.
+    pub fn partners_of(&self, v: usize) -> &[u32] {
+        match (self.offsets.get(v), self.offsets.get(v + 1)) {
+            (Some(&a), Some(&b)) => &self.partners[a as usize..b as usize],
+            _ => &[],
+        }
+    }
+
+    /// The table for `mesh` with `crease_angle_deg` (0: none). Places are matched on a grid
+    /// of 1e-7 of the scene's diagonal, so points an exporter or the mesher computed along
+    /// an edge from either end still meet.
+    fn new(mesh: &Mesh, crease_angle_deg: f64) -> Self {
+        if crease_angle_deg <= 0.0 || mesh.positions.is_empty() {
+            return Self::default();
+        }
+        let cos_limit = crease_angle_deg.to_radians().cos();
+        let mut vertex_surface = vec![u32::MAX; mesh.positions.len()];
+        for el in &mesh.elements {
+            let surface = mesh.patches[el.patch as usize].surface;
+            for &v in el.vertex_indices() {
+                vertex_surface[v as usize] = surface;
+            }
+        }
+        let (lo, hi) = mesh.bounds();
+        let grid = 1e-7 * (hi - lo).length().max(f64::MIN_POSITIVE);
+        let mut places: HashMap<(u32, bool, [i64; 3]), Vec<u32>> = HashMap::new();
+        for (v, &s) in vertex_surface.iter().enumerate() {
+            if s == u32::MAX {
+                continue;
+            }
+            let surface = &mesh.surfaces[s as usize];
+            let p = mesh.positions[v];
+            let key = [p.x, p.y, p.z].map(|c| (c / grid).round() as i64);
+            places.entry((surface.object, surface.back, key)).or_default().push(v as u32);
+        }
+        let mut pairs: Vec<(u32, u32)> = Vec::new();
+        for group in places.values().filter(|g| g.len() > 1) {
+            for &a in group {
+                for &b in group {
+                    let (na, nb) = (mesh.shading_normals[a as usize], mesh.shading_normals[b as usize]);
+                    if a != b
+                        && vertex_surface[a as usize] != vertex_surface[b as usize]
+                        && na.dot(nb) > cos_limit
+                    {
+                        pairs.push((a, b));
+                    }
+                }
+            }
+        }
+        if pairs.is_empty() {
+            return Self::default();
+        }
+        pairs.sort_unstable();
+        let mut offsets = Vec::with_capacity(mesh.positions.len() + 1);
+        let mut partners = Vec::with_capacity(pairs.len());
+        let mut next = pairs.iter().peekable();
+        for v in 0..mesh.positions.len() as u32 {
+            offsets.push(partners.len() as u32);
+            while let Some(&&(a, b)) = next.peek()
+                && a == v
+            {
+                partners.push(b);
+                next.next();
+            }
+        }
+        offsets.push(partners.len() as u32);
+        Self { offsets, partners }
+    }
 }
 
 /// Geometry of one surface before it joins the mesh: local vertices, elements labelled by a
@@ -668,6 +780,7 @@ impl Mesh {
                 }
             }
         }
+        mesh.smoothing = Smoothing::new(&mesh, params.crease_angle_deg);
         Ok(mesh)
     }
 
@@ -1071,5 +1184,61 @@ mod tests {
         let faces = box_faces(DVec3::ZERO, DVec3::ONE, Facing::Inward, 0.0).unwrap();
         let r = Mesh::build(&scene_of(Shape::Polygons(faces)), &MeshParams::try_new(1.0, 1e-5).unwrap());
         assert!(matches!(r, Err(MeshError::TooManyElements { .. })));
+    }
+
+    /// A UV sphere of `segments` around and `segments / 2` rings, as a model mesh of
+    /// triangles and quads (one surface per facet).
+    fn tessellated_sphere(segments: usize) -> PolygonMesh {
+        let rings = segments / 2;
+        let mut positions = vec![DVec3::new(0.0, -1.0, 0.0)];
+        for r in 1..rings {
+            let theta = std::f64::consts::PI * r as f64 / rings as f64;
+            for k in 0..segments {
+                let phi = 2.0 * std::f64::consts::PI * k as f64 / segments as f64;
+                positions.push(DVec3::new(theta.sin() * phi.cos(), -theta.cos(), theta.sin() * phi.sin()));
+            }
+        }
+        positions.push(DVec3::new(0.0, 1.0, 0.0));
+        let top = (positions.len() - 1) as u32;
+        let at = |r: usize, k: usize| (1 + (r - 1) * segments + k % segments) as u32;
+        let mut faces = Vec::new();
+        for k in 0..segments {
+            faces.push(vec![0, at(1, k + 1), at(1, k)]);
+            faces.push(vec![top, at(rings - 1, k), at(rings - 1, k + 1)]);
+            for r in 1..rings - 1 {
+                faces.push(vec![at(r, k), at(r, k + 1), at(r + 1, k + 1), at(r + 1, k)]);
+            }
+        }
+        PolygonMesh::try_new(positions, faces).unwrap()
+    }
+
+    /// A tessellated sphere pools every vertex with the facets around it; a box pools none
+    /// (its 90° edges are creases); a crease angle of 0 pools nothing.
+    #[test]
+    fn smoothing_joins_facets_below_the_crease_angle_only() {
+        let params = MeshParams::try_new(10.0, 10.0).unwrap();
+        let sphere = Mesh::build(&scene_of(Shape::Mesh(tessellated_sphere(24))), &params).unwrap();
+        assert!(sphere.surfaces.len() > 100, "one surface per facet");
+        // Every facet corner meets 3 or 4 other facets of the sphere (the poles 23).
+        for v in 0..sphere.positions.len() {
+            let partners = sphere.smoothing.partners_of(v);
+            assert!(partners.len() >= 3, "vertex {v}: {partners:?}");
+            for &u in partners {
+                assert!(sphere.positions[u as usize].distance(sphere.positions[v]) < 1e-12);
+            }
+        }
+        let faces = box_faces(DVec3::ZERO, DVec3::ONE, Facing::Outward, 0.0).unwrap();
+        let cube = Mesh::build(&scene_of(Shape::Polygons(faces)), &params).unwrap();
+        assert_eq!(cube.smoothing, Smoothing::default(), "a box's edges stay sharp");
+        let flat = Mesh::build(
+            &scene_of(Shape::Mesh(tessellated_sphere(24))),
+            &params.with_crease_angle(0.0).unwrap(),
+        )
+        .unwrap();
+        assert_eq!(flat.smoothing, Smoothing::default());
+        // 4 segments make an octahedron: 70.5° between neighbouring facets, above 40°.
+        let coarse = Mesh::build(&scene_of(Shape::Mesh(tessellated_sphere(4))), &params).unwrap();
+        assert_eq!(coarse.smoothing, Smoothing::default());
+        assert!(params.with_crease_angle(180.0).is_err() && params.with_crease_angle(f64::NAN).is_err());
     }
 }

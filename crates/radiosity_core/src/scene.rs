@@ -116,6 +116,12 @@ pub enum SceneError {
         /// Value given.
         value: f64,
     },
+    /// A crease angle outside [0, 180) degrees.
+    #[error("crease_angle must be a number of degrees in [0, 180), got {value}")]
+    BadCreaseAngle {
+        /// Value given.
+        value: f64,
+    },
     /// A camera is degenerate.
     #[error("camera is degenerate: {reason}")]
     BadCamera {

@@ -81,18 +81,21 @@ impl Solution {
     }
 }
 
-/// Area-weighted average of element values at each vertex.
+/// Area-weighted average of element values at each vertex, over the elements around it and
+/// around the vertices it is pooled with ([`radiosity_core::Smoothing`]).
 pub(crate) fn vertex_average(mesh: &Mesh, element_values: &[Rgb], vertex_area: &[f64]) -> Vec<Rgb> {
-    let mut v = vec![Rgb::ZERO; mesh.positions.len()];
+    let mut sums = vec![Rgb::ZERO; mesh.positions.len()];
     for (el, value) in mesh.elements.iter().zip(element_values) {
         for &i in el.vertex_indices() {
-            v[i as usize] += *value * el.area;
+            sums[i as usize] += *value * el.area;
         }
     }
-    for (value, area) in v.iter_mut().zip(vertex_area) {
-        if *area > 0.0 {
-            *value = *value / *area;
-        }
-    }
-    v
+    (0..sums.len())
+        .map(|v| {
+            let partners = mesh.smoothing.partners_of(v);
+            let sum = partners.iter().fold(sums[v], |s, &u| s + sums[u as usize]);
+            let area = partners.iter().fold(vertex_area[v], |a, &u| a + vertex_area[u as usize]);
+            if area > 0.0 { sum / area } else { sum }
+        })
+        .collect()
 }
