@@ -12,8 +12,8 @@ use glam::DVec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use radiosity_core::Camera;
 use radiosity_image::{
-    Exposure, Gather, HdrImage, RenderParams, Renderer, Shading, ToneOperator, ToneParams, encode_exr,
-    encode_pfm, encode_png, read_hdr, tone_map_image,
+    Exposure, Gather, HdrImage, PictureFormat, RenderParams, Renderer, Shading, ToneOperator, ToneParams,
+    encode_exr, encode_pfm, encode_picture, read_hdr, tone_map_image,
 };
 
 use crate::output::{self, Targets, note};
@@ -73,8 +73,10 @@ impl From<GatherArg> for Gather {
 /// Exposure and operator, shared by `render` and `tonemap`.
 #[derive(Args, Clone, Debug)]
 pub struct ToneOpts {
-    /// Exposure in stops (EV, e.g. -1.5), or `auto` to map the picture's log-average luminance
-    /// to middle grey. One exposure for the whole picture.
+    /// Exposure: `auto` maps the picture's log-average luminance to middle grey; `auto+1` or
+    /// `auto-0.5` is that many stops brighter or darker than auto; a plain number is a fixed
+    /// exposure in stops (EV, radiance × 2^EV: `1` is brighter than `0`, not than auto).
+    /// One exposure for the whole picture.
     #[arg(long, default_value = "auto", allow_hyphen_values = true)]
     pub exposure: Exposure,
     /// Tone-mapping operator.
@@ -87,7 +89,7 @@ pub struct ToneOpts {
 pub struct RenderArgs {
     /// Scene file (.toml) or built-in name (cornell, furnace, seed-room, two-plates).
     pub scene: String,
-    /// Tone-mapped 8-bit sRGB PNG to write.
+    /// Tone-mapped 8-bit sRGB picture to write: PNG (.png) or JPEG (.jpg, .jpeg).
     #[arg(short = 'o', long = "output")]
     pub output: Option<PathBuf>,
     /// Linear radiance as 32-bit float OpenEXR.
@@ -150,7 +152,7 @@ pub struct RenderArgs {
 pub struct TonemapArgs {
     /// Linear picture to read (.exr or .pfm), e.g. from `render --exr`.
     pub input: PathBuf,
-    /// Tone-mapped 8-bit sRGB PNG to write.
+    /// Tone-mapped 8-bit sRGB picture to write: PNG (.png) or JPEG (.jpg, .jpeg).
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
     #[command(flatten)]
@@ -214,11 +216,12 @@ impl RowProgress {
     }
 }
 
-/// Tone maps `radiance` with `tone` and writes it as PNG; returns the exposure used (EV).
+/// Tone maps `radiance` with `tone` and writes it as the picture format `path` names; returns
+/// the exposure used (EV).
 fn write_tonemapped(path: &Path, force: bool, radiance: &HdrImage, tone: &ToneOpts) -> Result<f64> {
     let ev = tone.exposure.ev_for(radiance);
     let png = tone_map_image(radiance, &ToneParams::new(ev, tone.tonemap.into()));
-    output::write_file(path, force, &encode_png(&png, path)?)?;
+    output::write_file(path, force, &encode_picture(&png, path)?)?;
     Ok(ev)
 }
 
@@ -247,6 +250,9 @@ pub fn run(a: RenderArgs) -> Result<()> {
         if let Some(path) = path {
             targets.file(path, option)?;
         }
+    }
+    if let Some(path) = &a.output {
+        PictureFormat::of(path).map_err(|e| input(format!("-o: {e}")))?;
     }
     let prepared = prepare(&a.scene, &a.solve)?;
     let base = prepared.scene.camera_or_framing();
@@ -319,6 +325,7 @@ fn write_pictures(a: &RenderArgs, radiance: &HdrImage) -> Result<()> {
 /// Runs `tonemap`.
 pub fn run_tonemap(a: TonemapArgs) -> Result<()> {
     Targets::new(a.force).file(&a.output, "-o")?;
+    PictureFormat::of(&a.output).map_err(|e| input(format!("-o: {e}")))?;
     // A missing or malformed input is the user's to fix: exit code 2.
     let radiance = read_hdr(&a.input).map_err(|e| input(e.to_string()))?;
     let ev = write_tonemapped(&a.output, a.force, &radiance, &a.tone)?;

@@ -113,6 +113,12 @@ pub fn run(a: ViewArgs) -> Result<()> {
     options.exposure_ev = match a.tone.exposure {
         Exposure::Ev(ev) => Some(ev),
         Exposure::Auto => None,
+        Exposure::AutoPlus(_) => {
+            return Err(crate::prepare::InputError(
+                "--exposure auto±EV is for pictures; in the viewer, start from auto and use its exposure slider".into(),
+            )
+            .into());
+        }
     };
     options.operator = a.tone.tonemap.into();
     radiosity_viewer::run(options)

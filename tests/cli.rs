@@ -209,3 +209,71 @@ fn bench_writes_every_case_as_json() {
     assert!(fast["peak_heap_bytes"].as_u64().unwrap() > 0);
     assert!(cases[3]["elements"].as_u64().unwrap() > 14_000);
 }
+
+/// The picture format follows `-o`'s extension: `.jpg` holds JPEG, `.png` PNG, anything else
+/// is refused before the solve (exit 2) rather than written in the wrong format.
+#[test]
+fn the_picture_format_follows_the_file_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let small = ["--max-shots", "5", "--width", "32", "--height", "24", "--spp", "1", "--gather", "none"];
+    for (name, magic) in
+        [("a.jpg", &[0xFF, 0xD8, 0xFF][..]), ("b.JPEG", &[0xFF, 0xD8, 0xFF]), ("c.png", b"\x89PNG")]
+    {
+        let path = dir.path().join(name);
+        let o = radiosity(&[&["render", "cornell", "-o", path.to_str().unwrap()][..], &small].concat());
+        assert!(o.status.success(), "{name}: {}", stderr(&o));
+        assert!(std::fs::read(&path).unwrap().starts_with(magic), "{name}");
+    }
+    let gif = dir.path().join("d.gif");
+    let o = radiosity(&[&["render", "cornell", "-o", gif.to_str().unwrap()][..], &small].concat());
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains(".jpg") && !stderr(&o).contains("shots"),
+        "refused before the solve: {}",
+        stderr(&o)
+    );
+    assert!(!gif.exists());
+}
+
+/// `--exposure auto+1` is one stop above the automatic exposure, `auto-1` one below: the
+/// summary line says which exposure was used.
+#[test]
+fn exposure_can_be_set_relative_to_auto() {
+    let dir = tempfile::tempdir().unwrap();
+    let pfm = dir.path().join("r.pfm");
+    let o = radiosity(
+        &["render", "cornell", "--max-shots", "5", "--width", "32", "--height", "24", "--spp", "1"]
+            .iter()
+            .copied()
+            .chain(["--gather", "none", "--pfm", pfm.to_str().unwrap()])
+            .collect::<Vec<_>>(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let ev = |exposure: &str| {
+        let png = dir.path().join(format!("t{exposure}.png"));
+        let o = radiosity(&[
+            "tonemap",
+            pfm.to_str().unwrap(),
+            "-o",
+            png.to_str().unwrap(),
+            "--exposure",
+            exposure,
+        ]);
+        assert!(o.status.success(), "{exposure}: {}", stderr(&o));
+        let err = stderr(&o);
+        let at = err.find("EV").unwrap_or_else(|| panic!("no EV in {err}"));
+        let number: String = err[..at]
+            .trim_end()
+            .chars()
+            .rev()
+            .take_while(|c| !c.is_whitespace())
+            .collect::<Vec<_>>()
+            .into_iter()
+            .rev()
+            .collect();
+        number.trim_start_matches(['(', '=']).parse::<f64>().unwrap_or_else(|_| panic!("{number} in {err}"))
+    };
+    let auto = ev("auto");
+    assert!((ev("auto+1") - auto - 1.0).abs() < 0.011, "auto {auto}");
+    assert!((ev("auto-1") - auto + 1.0).abs() < 0.011, "auto {auto}");
+}

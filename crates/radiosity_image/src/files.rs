@@ -34,8 +34,8 @@ pub enum ImageFileError {
         /// The cause.
         source: std::io::Error,
     },
-    /// The PNG encoder or decoder failed.
-    #[error("{path}: PNG: {source}")]
+    /// The PNG (or JPEG) encoder or decoder failed.
+    #[error("{path}: {source}")]
     Png {
         /// The file.
         path: PathBuf,
@@ -199,6 +199,51 @@ pub fn encode_png(image: &SrgbImage, path: &Path) -> Result<Vec<u8>, ImageFileEr
     )
     .map_err(|source| ImageFileError::Png { path: path.to_owned(), source })?;
     Ok(out.into_inner())
+}
+
+/// An 8-bit picture file format, chosen by the file name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PictureFormat {
+    /// Lossless, `.png`.
+    Png,
+    /// Lossy (quality 95), `.jpg` or `.jpeg`.
+    Jpeg,
+}
+
+impl PictureFormat {
+    /// The format `path`'s extension names (case-insensitive).
+    ///
+    /// # Errors
+    /// [`ImageFileError::UnknownFormat`] for any other name: a `.jpg` must not quietly hold
+    /// PNG bytes, nor a `.exr` an 8-bit picture.
+    pub fn of(path: &Path) -> Result<Self, ImageFileError> {
+        let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+        match ext.as_deref() {
+            Some("png") => Ok(Self::Png),
+            Some("jpg" | "jpeg") => Ok(Self::Jpeg),
+            _ => {
+                Err(ImageFileError::UnknownFormat { path: path.to_owned(), expected: ".png, .jpg or .jpeg" })
+            }
+        }
+    }
+}
+
+/// Encodes an 8-bit sRGB picture in the format its file name asks for ([`PictureFormat::of`]).
+///
+/// # Errors
+/// [`ImageFileError::UnknownFormat`] for another extension; the encoder's errors.
+pub fn encode_picture(image: &SrgbImage, path: &Path) -> Result<Vec<u8>, ImageFileError> {
+    match PictureFormat::of(path)? {
+        PictureFormat::Png => encode_png(image, path),
+        PictureFormat::Jpeg => {
+            check_not_empty(path, image.width, image.height)?;
+            let mut out = Cursor::new(Vec::new());
+            image::codecs::jpeg::JpegEncoder::new_with_quality(&mut out, 95)
+                .encode(&image.as_bytes(), image.width, image.height, image::ExtendedColorType::Rgb8)
+                .map_err(|source| ImageFileError::Png { path: path.to_owned(), source })?;
+            Ok(out.into_inner())
+        }
+    }
 }
 
 /// Reads a PNG as an 8-bit sRGB picture (grey or alpha channels are converted to RGB).

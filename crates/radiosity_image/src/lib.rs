@@ -30,8 +30,9 @@ mod render;
 mod tonemap;
 
 pub use files::{
-    HdrFormat, ImageFileError, MAX_PICTURE_PIXELS, decode_pfm, encode_exr, encode_pfm, encode_png, read_exr,
-    read_hdr, read_pfm, read_png, write_exr, write_file_atomic, write_hdr, write_pfm, write_png,
+    HdrFormat, ImageFileError, MAX_PICTURE_PIXELS, PictureFormat, decode_pfm, encode_exr, encode_pfm,
+    encode_picture, encode_png, read_exr, read_hdr, read_pfm, read_png, write_exr, write_file_atomic,
+    write_hdr, write_pfm, write_png,
 };
 pub use gather::Gather;
 pub use hdr::HdrImage;

@@ -65,8 +65,10 @@ pub enum ToneParseError {
     /// Not one of the operator names.
     #[error("unknown tone operator '{0}'; expected one of linear, reinhard, aces")]
     UnknownOperator(String),
-    /// Neither a finite number of stops nor `auto`.
-    #[error("exposure must be a number of stops (EV, e.g. -1.5) or 'auto', got '{0}'")]
+    /// Neither a finite number of stops nor `auto` nor `auto±stops`.
+    #[error(
+        "exposure must be a number of stops (EV, e.g. -1.5), 'auto', or 'auto+1' / 'auto-0.5' (stops from auto), got '{0}'"
+    )]
     BadExposure(String),
 }
 
@@ -90,6 +92,9 @@ pub enum Exposure {
     /// ([`AUTO_EXPOSURE_KEY`]). Still one exposure for the whole picture. The default.
     #[default]
     Auto,
+    /// [`Exposure::Auto`] plus this many stops (`auto+1` is one stop brighter than auto):
+    /// brighter or darker than the automatic choice, whatever the scene's scale.
+    AutoPlus(f64),
 }
 
 impl Exposure {
@@ -98,6 +103,7 @@ impl Exposure {
         match self {
             Exposure::Ev(ev) => ev,
             Exposure::Auto => auto_exposure_ev(image),
+            Exposure::AutoPlus(offset) => auto_exposure_ev(image) + offset,
         }
     }
 }
@@ -107,6 +113,7 @@ impl fmt::Display for Exposure {
         match self {
             Exposure::Ev(ev) => write!(f, "{ev}"),
             Exposure::Auto => f.write_str("auto"),
+            Exposure::AutoPlus(offset) => write!(f, "auto{offset:+}"),
         }
     }
 }
@@ -118,6 +125,14 @@ impl FromStr for Exposure {
         let t = s.trim();
         if t.eq_ignore_ascii_case("auto") {
             return Ok(Exposure::Auto);
+        }
+        if let Some(rest) = t.get(..4).filter(|a| a.eq_ignore_ascii_case("auto")).map(|_| &t[4..]) {
+            return match rest.trim().parse::<f64>() {
+                Ok(offset) if offset.is_finite() && rest.trim_start().starts_with(['+', '-']) => {
+                    Ok(Exposure::AutoPlus(offset))
+                }
+                _ => Err(ToneParseError::BadExposure(s.to_owned())),
+            };
         }
         match t.parse::<f64>() {
             Ok(ev) if ev.is_finite() => Ok(Exposure::Ev(ev)),
@@ -316,6 +331,14 @@ mod tests {
         assert_eq!("auto".parse::<Exposure>(), Ok(Exposure::Auto));
         assert_eq!("-1.5".parse::<Exposure>(), Ok(Exposure::Ev(-1.5)));
         assert!("bright".parse::<Exposure>().is_err());
+        assert_eq!("auto+1".parse::<Exposure>(), Ok(Exposure::AutoPlus(1.0)));
+        assert_eq!("AUTO-0.5".parse::<Exposure>(), Ok(Exposure::AutoPlus(-0.5)));
+        for bad in ["auto1", "auto+", "auto+nan", "autox", "auto+inf"] {
+            assert!(bad.parse::<Exposure>().is_err(), "{bad}");
+        }
+        let picture = HdrImage::from_pixels(2, 1, vec![Rgb::splat(0.5), Rgb::splat(2.0)]);
+        let auto = Exposure::Auto.ev_for(&picture);
+        assert_eq!(Exposure::AutoPlus(1.0).ev_for(&picture), auto + 1.0);
         assert!("nan".parse::<Exposure>().is_err());
         for op in ToneOperator::ALL {
             assert_eq!(op.as_str().parse::<ToneOperator>(), Ok(op));
