@@ -23,7 +23,7 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use radiosity_core::glam::{DMat4, DQuat, DVec3};
-use radiosity_core::{Camera, Material, Polygon, PolygonMesh, Rgb, SceneError};
+use radiosity_core::{Camera, Material, Polygon, PolygonMesh, Rgb, SceneError, Sides, srgb_decode};
 
 use crate::LoadError;
 use radiosity_core::escape_controls;
@@ -78,6 +78,10 @@ pub struct ModelPart {
     pub material: usize,
     /// The geometry, in world units (transform applied).
     pub mesh: PolygonMesh,
+    /// Faces that exchange light, as the format says: OBJ says nothing, and modellers show
+    /// its faces from both sides, so two-sided with a front-only emission; glTF's
+    /// `doubleSided` material flag, whose emission viewers show on both faces.
+    pub sides: Sides,
 }
 
 /// A model file read and validated.
@@ -203,6 +207,64 @@ pub(crate) fn model_material(
 ) -> Result<Material, LoadError> {
     Material::try_new(name, Rgb::from_array(reflectance), Rgb::from_array(emission))
         .map_err(|e| model_error(origin, line, e.to_string()))
+}
+
+/// Reflectance given to a model material that reflects 1 or more in a channel: a white
+/// (`Kd 1 1 1`, glTF's default factor) is common in real files, and ρ ≥ 1 never converges.
+pub const CLAMPED_REFLECTANCE: f64 = 0.95;
+
+/// `reflectance` with every channel ≥ 1 lowered to [`CLAMPED_REFLECTANCE`], and a warning
+/// naming the file, the material and the value when one was. Non-finite and negative values
+/// are left for the material's own check to refuse.
+pub(crate) fn clamp_reflectance(
+    origin: &str,
+    name: &str,
+    reflectance: [f64; 3],
+    warnings: &mut Vec<String>,
+) -> [f64; 3] {
+    if !reflectance.iter().any(|&v| v >= 1.0 && v.is_finite()) {
+        return reflectance;
+    }
+    warnings.push(format!(
+        "{origin}: material '{name}': reflectance {reflectance:?} has a channel ≥ 1 (light would never stop bouncing); clamped to {CLAMPED_REFLECTANCE}"
+    ));
+    reflectance.map(|v| if v >= 1.0 && v.is_finite() { CLAMPED_REFLECTANCE } else { v })
+}
+
+/// The warning for a material that the format describes as mirror-like or see-through, which
+/// the solver (diffuse only) cannot show; `why` names what in the file says so.
+pub(crate) fn specular_warning(origin: &str, name: &str, why: &str) -> String {
+    format!("material '{name}' ({origin}) is specular/transmissive ({why}); treated as diffuse")
+}
+
+/// Mean linear colour of 8-bit sRGB pixels of `channels` bytes each, red, green and blue
+/// first (RGB, RGBA), or `None` without a pixel or with fewer than three channels: what a
+/// texture contributes to a flat element's reflectance, as the mean of what it reflects.
+pub(crate) fn mean_linear_colour(pixels: &[u8], channels: usize) -> Option<[f64; 3]> {
+    if channels < 3 {
+        return None;
+    }
+    let lut: Vec<f64> = (0..256).map(|v| srgb_decode(v as f64 / 255.0)).collect();
+    let mut sum = [0.0; 3];
+    let mut n = 0usize;
+    for px in pixels.chunks_exact(channels) {
+        for c in 0..3 {
+            sum[c] += lut[px[c] as usize];
+        }
+        n += 1;
+    }
+    (n > 0).then(|| sum.map(|s| s / n as f64))
+}
+
+/// Mean linear colour of the image file at `path` (PNG or JPEG, 8-bit sRGB after decoding).
+///
+/// # Errors
+/// Why it cannot be read or decoded, one line without the path.
+pub(crate) fn texture_mean(path: &Path) -> Result<[f64; 3], String> {
+    let bytes = read_input_file(path, MAX_MODEL_BYTES)?;
+    let image = image::load_from_memory(&bytes).map_err(|e| e.to_string())?;
+    let rgb = image.to_rgb8();
+    mean_linear_colour(rgb.as_raw(), 3).ok_or_else(|| "the image has no pixels".to_owned())
 }
 
 /// Collects the faces of one part: welds positions, drops degenerate faces (counted), and
