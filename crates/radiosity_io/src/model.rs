@@ -2,15 +2,21 @@
 //! named parts of validated [`PolygonMesh`]es with diffuse [`Material`]s.
 //!
 //! What is taken from the files:
-//! * OBJ/MTL: `Kd` → reflectance, `Ke` → emission (emitted radiosity, W per unit², the same
-//!   quantity as `emission` in a scene file). A missing MTL file or an unknown `usemtl` gives
-//!   the default grey (ρ = 0.5) and a warning. Vertex normals and texture coordinates are
-//!   ignored: facets are flat for the solve.
+//! * OBJ/MTL: `Kd` (× the mean of the `map_Kd` texture, decoded from sRGB) → reflectance,
+//!   `Ke` → emission (emitted radiosity, W per unit², the same quantity as `emission` in a
+//!   scene file). A missing MTL file, an unknown `usemtl` or an unreadable texture gives the
+//!   default grey (ρ = 0.5) or `Kd` alone, and a warning. Vertex normals and texture
+//!   coordinates are ignored: facets are flat for the solve. Every part is two-sided
+//!   ([`ModelPart::sides`]).
 //! * glTF: `baseColorFactor` (times the mean of the base colour texture, decoded from sRGB,
 //!   when the texture's pixels can be read) → reflectance; `emissiveFactor` ×
 //!   `KHR_materials_emissive_strength` → emission; node transforms; the first perspective
-//!   camera. A primitive without a material gets the default grey and a warning (the glTF
-//!   default, white ρ = 1, would never converge).
+//!   camera; `doubleSided` → two-sided parts emitting from both faces. A primitive without a
+//!   material gets the default grey and a warning (the glTF default, white ρ = 1, would never
+//!   converge).
+//! * Both: reflectance ≥ 1 in a channel is clamped to [`CLAMPED_REFLECTANCE`], and a mirror
+//!   or glass material is read as diffuse, each with a warning: real files are full of both,
+//!   and refusing them would refuse the file.
 //!
 //! Faces are kept as polygons when planar and convex (so an OBJ of quads meshes exactly like
 //! the same quads in a scene file), fan-split when convex but not planar, ear-clipped when
@@ -153,8 +159,8 @@ pub(crate) fn read_input_file(path: &Path, limit: u64) -> Result<Vec<u8>, String
 ///
 /// # Errors
 /// [`LoadError::Model`], one line naming the file (and line, for OBJ/MTL) and the element:
-/// unreadable or malformed files, indices out of range, non-finite coordinates, reflectance
-/// outside [0, 1), negative emission, or no face left after dropping degenerate ones.
+/// unreadable or malformed files, indices out of range, non-finite coordinates, negative or
+/// non-finite reflectance, negative emission, or no face left after dropping degenerate ones.
 pub fn load_model(path: &Path, transform: &Transform) -> Result<Model, LoadError> {
     let origin = path.display().to_string();
     let bytes = read_input_file(path, MAX_MODEL_BYTES).map_err(|e| LoadError::Model {

@@ -159,14 +159,17 @@ fn scene_from_model(path: &Path, opts: &LoadOptions) -> Result<LoadedScene, Load
 /// (usually the path) starts every error message.
 ///
 /// The scene's name defaults to the file stem of `origin`; `[mesh]` sets [`Scene::mesh`] and
-/// `[solver]` sets [`Scene::solver`].
+/// `[solver]` sets [`Scene::solver`]. An object's sides are its `sides` key, else its
+/// material's, else one; a `mesh` object's parts keep their file's unless the object or an
+/// overriding material that gives `sides` says otherwise.
 ///
 /// # Errors
 /// [`LoadError::At`], naming line, column, key path and what was expected, for TOML syntax
 /// errors, unknown keys, wrong types, and every validation rule: reflectance in [0, 1),
 /// emission finite and ≥ 0, unique materials, known material references, finite coordinates,
 /// planar convex non-degenerate polygons of 3+ vertices, radius > 0, box min < max, a usable
-/// camera, sizes > 0, `unshot_threshold` in (0, 1), `max_shots` ≥ 1, `time_limit` > 0, at
+/// camera, sizes > 0, `sides` and `emission_sides` 1 or 2 (`emission_sides = 2` only with
+/// `sides = 2`), `unshot_threshold` in (0, 1), `max_shots` ≥ 1, `time_limit` > 0, at
 /// least one object and at least one light. TOML's `nan` and `inf` are rejected wherever a
 /// number is validated. [`LoadError::Model`] for a broken model file.
 pub fn parse_scene(text: &str, origin: &str) -> Result<LoadedScene, LoadError> {
