@@ -218,10 +218,8 @@ fn specular_and_transmissive_materials_are_diffuse_with_a_warning() {
                newmtl glass\nKd 0.5 0.5 0.5\nd 0.3\n\
                newmtl paint\nKd 0.5 0.5 0.5\nKs 0.5 0.5 0.5\nNs 250\nd 1\nillum 2\n";
     write(dir.path(), "m.mtl", mtl);
-    let obj = format!(
-        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n\
-         usemtl mirror\nf 1 2 3\nusemtl chrome\nf 2 4 3\nusemtl glass\nf 1 3 2\nusemtl paint\nf 2 3 4\n"
-    );
+    let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n\
+               usemtl mirror\nf 1 2 3\nusemtl chrome\nf 2 4 3\nusemtl glass\nf 1 3 2\nusemtl paint\nf 2 3 4\n";
     write(dir.path(), "m.obj", obj);
     let m = load_model(&dir.path().join("m.obj"), &Transform::default()).unwrap();
     let path = dir.path().join("m.mtl").display().to_string();
