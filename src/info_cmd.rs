@@ -6,12 +6,12 @@ use anyhow::Result;
 use clap::Args;
 use radiosity_core::Rgb;
 
-use crate::prepare::{SolveOpts, prepare};
+use crate::prepare::{SolveOpts, prepare_unlit};
 
 /// Arguments of `radiosity info`.
 #[derive(Args)]
 pub struct InfoArgs {
-    /// Scene file (.toml) or built-in name.
+    /// Scene file (.toml), model file (.obj, .gltf, .glb) or built-in name.
     pub scene: String,
     #[command(flatten)]
     pub solve: SolveOpts,
@@ -19,7 +19,9 @@ pub struct InfoArgs {
 
 /// Runs `info`.
 pub fn run(a: InfoArgs) -> Result<()> {
-    let p = prepare(&a.scene, &a.solve)?;
+    // A model without a light yet is described all the same: the light is what `info` says
+    // is missing.
+    let (p, no_light) = prepare_unlit(&a.scene, &a.solve)?;
     let (scene, mesh) = (&p.scene, p.problem.mesh());
     // One text, one write: a closed pipe or a full disk is one error, not a panic.
     let mut out = String::new();
@@ -37,6 +39,9 @@ pub fn run(a: InfoArgs) -> Result<()> {
         (0..mesh.elements.len()).map(|e| mesh.element_material(e).emission * mesh.elements[e].area).sum();
     let _ = writeln!(out, "emitted    [{:.6e}, {:.6e}, {:.6e}] W", emitted.r, emitted.g, emitted.b);
     let mut warnings = Vec::new();
+    if let Some(e) = no_light {
+        warnings.push(format!("no light: a solve would be black; {}", radiosity_core::one_line(&e)));
+    }
     for m in &scene.materials {
         if m.reflectance.max_channel() > 0.95 {
             warnings.push(format!(

@@ -113,6 +113,11 @@ pub struct SolveOpts {
     /// off).
     #[arg(long)]
     pub ambient: bool,
+    /// Sides of every object from a model file (an OBJ or glTF given as SCENE, `mesh`
+    /// objects): 1 (front faces only) or 2 (both faces receive and reflect), over what the
+    /// file and the scene file say [default: OBJ two-sided, glTF as its doubleSided flag].
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=2), value_name = "1|2")]
+    pub sides: Option<u8>,
 }
 
 impl From<FormFactorMethod> for FormFactorArg {
@@ -164,6 +169,20 @@ pub struct Settings {
 /// # Errors
 /// Bad scene files and out-of-range options (exit code 2).
 pub fn settings(scene_arg: &str, o: &SolveOpts) -> Result<Settings> {
+    let (settings, no_light) = load_settings(scene_arg, o)?;
+    // Said after the loader's warnings, which often explain it (a missing MTL).
+    match no_light {
+        Some(e) => Err(e.into()),
+        None => Ok(settings),
+    }
+}
+
+/// [`settings`] for a command that describes a scene rather than solving it: a scene in which
+/// nothing emits loads, with the error a solve would give.
+///
+/// # Errors
+/// As [`settings`], except a missing light.
+pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option<radiosity_io::LoadError>)> {
     if let Some(t) = o.threads
         && !(1..=MAX_THREADS).contains(&t)
     {
@@ -180,7 +199,16 @@ pub fn settings(scene_arg: &str, o: &SolveOpts) -> Result<Settings> {
     }
     // A model file given where a scene is expected loads as a scene of its parts; what the
     // loader dropped or defaulted (degenerate faces, a missing MTL) is said once, here.
-    let radiosity_io::LoadedScene { scene, warnings } = radiosity_io::resolve_scene(scene_arg)?;
+    let options = radiosity_io::LoadOptions {
+        model_sides: o.sides.map(|n| match n {
+            1 => radiosity_core::Sides::One,
+            _ => radiosity_core::Sides::Two { emits_back: false },
+        }),
+        // A missing light is returned after the warnings are out, not in place of them.
+        allow_no_light: true,
+    };
+    let radiosity_io::LoadedScene { scene, warnings, no_light } =
+        radiosity_io::resolve_scene_with(scene_arg, &options)?;
     for w in &warnings {
         crate::output::note(format_args!("warning: {w}"))?;
     }
@@ -245,7 +273,7 @@ pub fn settings(scene_arg: &str, o: &SolveOpts) -> Result<Settings> {
         row_cache_bytes: o.row_cache_mib.saturating_mul(1 << 20),
         ..defaults
     };
-    Ok(Settings { scene, mesh_params, solver_params })
+    Ok((Settings { scene, mesh_params, solver_params }, no_light))
 }
 
 /// [`settings`], then the light scale and the [`Problem`] (mesh and ray queries); sets the
@@ -254,7 +282,22 @@ pub fn settings(scene_arg: &str, o: &SolveOpts) -> Result<Settings> {
 /// # Errors
 /// Bad scene files, out-of-range options, meshes that would be too large (exit code 2).
 pub fn prepare(scene_arg: &str, o: &SolveOpts) -> Result<Prepared> {
-    let Settings { mut scene, mesh_params, solver_params } = settings(scene_arg, o)?;
+    mesh(settings(scene_arg, o)?, o)
+}
+
+/// [`prepare`] for a command that describes a scene: one without a light is meshed too,
+/// with the error a solve would give.
+///
+/// # Errors
+/// As [`prepare`], except a missing light.
+pub fn prepare_unlit(scene_arg: &str, o: &SolveOpts) -> Result<(Prepared, Option<radiosity_io::LoadError>)> {
+    let (settings, no_light) = load_settings(scene_arg, o)?;
+    Ok((mesh(settings, o)?, no_light))
+}
+
+/// The light scale and the [`Problem`] of checked settings.
+fn mesh(settings: Settings, o: &SolveOpts) -> Result<Prepared> {
+    let Settings { mut scene, mesh_params, solver_params } = settings;
     if let Some(t) = o.threads {
         // One call per process: an error is the system refusing the threads.
         rayon::ThreadPoolBuilder::new()

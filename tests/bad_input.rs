@@ -149,8 +149,10 @@ fn fifos_and_devices_are_refused_not_read() {
     // An OBJ whose MTL is a FIFO: the library is not read (a warning), the load goes on.
     let obj = write(dir.path(), "m.obj", &format!("mtllib m.mtl\n{}", OBJ_BODY));
     assert!(Command::new("mkfifo").arg(dir.path().join("m.mtl")).status().unwrap().success());
+    // `info` describes the model, lightless without its library.
     let o = run(&["info", obj.to_str().unwrap()]);
-    assert_input_error(&o, "fifo mtl", &["m.mtl", "not a regular file"]);
+    assert!(o.status.success(), "fifo mtl: {}", stderr(&o));
+    assert!(stderr(&o).contains("m.mtl: not a regular file"), "fifo mtl: {}", stderr(&o));
 }
 
 /// Two quads: a lamp (material `lamp`) above a floor (material `grey`).
@@ -185,12 +187,28 @@ fn malformed_mtl_lines_are_errors_with_their_line() {
     }
 }
 
+/// The warning that explains the missing light comes first, once; then the error, exit 2.
+/// `info` describes the same model, saying what a solve would lack.
 #[test]
-fn a_missing_mtl_is_named_in_the_no_light_error() {
+fn a_missing_mtl_is_warned_of_before_the_no_light_error() {
     let dir = tempfile::tempdir().unwrap();
     let obj = write(dir.path(), "m.obj", &format!("mtllib gone.mtl\n{OBJ_BODY}"));
+    let o = run(&["solve", obj.to_str().unwrap()]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    // The usemtl lines that name no known material are warned of too.
+    let (error, warnings) =
+        err.trim_end().lines().collect::<Vec<_>>().split_last().map(|(e, w)| (*e, w.to_vec())).unwrap();
+    assert!(error.starts_with("error: ") && error.contains("no light"), "{err}");
+    assert!(warnings.iter().all(|w| w.starts_with("warning: ")), "{err}");
+    assert!(warnings.iter().any(|w| w.contains("gone.mtl")), "{err}");
+    assert_eq!(err.matches("gone.mtl").count(), 1, "each warning once, none in the error: {err}");
+
     let o = run(&["info", obj.to_str().unwrap()]);
-    assert_input_error(&o, "missing mtl", &["gone.mtl"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(stderr(&o).matches("gone.mtl").count(), 1, "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("warning    no light: a solve would be black; "), "{out}");
 }
 
 #[test]

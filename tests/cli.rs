@@ -277,3 +277,105 @@ fn exposure_can_be_set_relative_to_auto() {
     assert!((ev("auto+1") - auto - 1.0).abs() < 0.011, "auto {auto}");
     assert!((ev("auto-1") - auto + 1.0).abs() < 0.011, "auto {auto}");
 }
+
+/// `solve --json -` of `scene` with small elements; the report.
+fn solve_json(scene: &Path, extra: &[&str]) -> serde_json::Value {
+    let mut args = vec![
+        "solve",
+        scene.to_str().unwrap(),
+        "--json",
+        "-",
+        "--patch-size",
+        "0.5",
+        "--element-size",
+        "0.25",
+    ];
+    args.extend_from_slice(extra);
+    let o = radiosity(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    serde_json::from_slice(&o.stdout).unwrap()
+}
+
+fn object<'a>(report: &'a serde_json::Value, name: &str) -> &'a serde_json::Value {
+    report["objects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|o| o["name"] == name)
+        .unwrap_or_else(|| panic!("{name}: {report}"))
+}
+
+fn rgb(v: &serde_json::Value) -> Vec<f64> {
+    v.as_array().unwrap().iter().map(|c| c.as_f64().unwrap()).collect()
+}
+
+/// A two-sided plate halfway between a lamp below (facing up) and one above (facing down):
+/// both faces are lit alike, and each is reported.
+#[test]
+fn a_two_sided_plate_between_two_lamps_is_lit_on_both_faces() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("plate.toml");
+    std::fs::write(
+        &scene,
+        r#"[[material]]
+name = "lamp"
+reflectance = [0, 0, 0]
+emission = [1, 1, 1]
+[[material]]
+name = "paper"
+reflectance = [0.5, 0.5, 0.5]
+sides = 2
+[[object]]
+name = "below"
+type = "polygon"
+material = "lamp"
+vertices = [[0, 0, 0], [0, 0, 1], [1, 0, 1], [1, 0, 0]]
+[[object]]
+name = "above"
+type = "polygon"
+material = "lamp"
+vertices = [[0, 2, 0], [1, 2, 0], [1, 2, 1], [0, 2, 1]]
+[[object]]
+name = "plate"
+type = "polygon"
+material = "paper"
+vertices = [[0, 1, 0], [0, 1, 1], [1, 1, 1], [1, 1, 0]]
+"#,
+    )
+    .unwrap();
+    let report = solve_json(&scene, &[]);
+    let plate = object(&report, "plate");
+    let (front, back) = (rgb(&plate["radiosity"]), rgb(&plate["radiosity_back"]));
+    for (f, b) in front.iter().zip(&back) {
+        // ρ · E · F(unit plates one apart) ≈ 0.5 · 0.2 = 0.1 on each face.
+        assert!(*f > 0.05 && *b > 0.05, "{plate}");
+        assert!((f - b).abs() < 0.05 * f, "the faces are lit alike: {plate}");
+    }
+    assert!(object(&report, "below").get("radiosity_back").is_none(), "{report}");
+}
+
+/// An OBJ is two-sided unless `--sides 1` says otherwise.
+#[test]
+fn obj_faces_are_two_sided_unless_sides_1() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("m.mtl"),
+        "newmtl lamp\nKd 0 0 0\nKe 1 1 1\nnewmtl grey\nKd 0.5 0.5 0.5\n",
+    )
+    .unwrap();
+    let obj = dir.path().join("m.obj");
+    std::fs::write(
+        &obj,
+        "mtllib m.mtl\nv 0 1 0\nv 0 1 1\nv 1 1 1\nv 1 1 0\nv 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\n\
+         o lamp\nusemtl lamp\nf 1 2 3 4\no floor\nusemtl grey\nf 5 6 7 8\n",
+    )
+    .unwrap();
+    let report = solve_json(&obj, &[]);
+    assert!(object(&report, "floor").get("radiosity_back").is_some(), "{report}");
+    let report = solve_json(&obj, &["--sides", "1"]);
+    for o in report["objects"].as_array().unwrap() {
+        assert!(o.get("radiosity_back").is_none(), "{report}");
+    }
+    let o = radiosity(&["solve", obj.to_str().unwrap(), "--sides", "3"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}

@@ -5,8 +5,10 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use radiosity_core::{Mesh, MeshParams, Rgb, Scene};
-use radiosity_io::{LoadError, ModelFormat, Transform, load_scene, parse_model, resolve_scene};
+use radiosity_core::{Mesh, MeshParams, Rgb, Scene, Sides};
+use radiosity_io::{
+    LoadError, LoadOptions, ModelFormat, Transform, load_scene, load_scene_with, parse_model, resolve_scene,
+};
 use radiosity_solver::{Problem, SolverParams};
 
 fn scenes() -> PathBuf {
@@ -32,8 +34,10 @@ fn cornell_box_as_obj_and_gltf_solves_like_the_toml() {
     let toml = resolve_scene("cornell").unwrap().scene;
     let params = toml.mesh_params();
     let expected = solve(&toml, &params);
+    // One-sided, as the TOML: an OBJ is two-sided by default, which adds back faces.
+    let one_sided = LoadOptions { model_sides: Some(Sides::One), ..LoadOptions::default() };
     for file in ["cornell.obj", "cornell.gltf"] {
-        let loaded = load_scene(&scenes().join(file)).unwrap();
+        let loaded = load_scene_with(&scenes().join(file), &one_sided).unwrap();
         assert!(loaded.warnings.is_empty(), "{file}: {:?}", loaded.warnings);
         let mesh = Mesh::build(&loaded.scene, &params).unwrap();
         let toml_mesh = Mesh::build(&toml, &params).unwrap();
@@ -148,16 +152,19 @@ fn broken_obj_files_are_one_line_errors() {
     assert!(user_message(&e).starts_with("no/such/model.obj: cannot read the model file"), "{e}");
 }
 
+/// ρ ≥ 1 is common in real MTL files (`Kd 1.0`): clamped with a warning, not refused; a
+/// negative one is still an error at its line.
 #[test]
-fn reflectance_of_one_is_rejected_at_its_mtl_line() {
+fn reflectance_of_one_is_clamped_and_a_negative_one_rejected_at_its_mtl_line() {
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(
-        dir.path().join("m.mtl"),
-        "newmtl lamp\nKd 0 0 0\nKe 5 5 5\n\nnewmtl snow\nKd 1.0 0.9 0.9\n",
-    )
-    .unwrap();
+    let mtl_text = "newmtl lamp\nKd 0 0 0\nKe 5 5 5\n\nnewmtl snow\nKd 1.0 0.9 0.9\n";
+    std::fs::write(dir.path().join("m.mtl"), mtl_text).unwrap();
     let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl snow\nf 1 2 3\n";
     std::fs::write(dir.path().join("m.obj"), obj).unwrap();
+    let m = radiosity_io::load_model(&dir.path().join("m.obj"), &Transform::default()).unwrap();
+    assert_eq!(m.materials[0].reflectance, Rgb::new(0.95, 0.9, 0.9));
+    assert!(m.warnings.iter().any(|w| w.contains("'snow'") && w.contains("clamped")), "{:?}", m.warnings);
+    std::fs::write(dir.path().join("m.mtl"), mtl_text.replace("Kd 1.0", "Kd -0.1")).unwrap();
     let e = load_scene(&dir.path().join("m.obj")).unwrap_err();
     let s = user_message(&e);
     let mtl = dir.path().join("m.mtl").display().to_string();
@@ -263,11 +270,13 @@ fn broken_gltf_files_are_one_line_errors() {
         "{e}"
     );
     let white = r#"{"name":"snow","pbrMetallicRoughness":{"baseColorFactor":[1,1,1,1]}}"#;
-    let e = gltf_result(&gltf_with(&tri, &[0, 1, 2], white)).unwrap_err();
+    // White (glTF's default) never converges: clamped, with a warning, not refused.
+    let m = gltf_result(&gltf_with(&tri, &[0, 1, 2], white)).unwrap();
+    assert_eq!(m.materials[0].reflectance, Rgb::splat(radiosity_io::CLAMPED_REFLECTANCE));
     assert!(
-        user_message(&e)
-            .starts_with("model.gltf: material 0: reflectance of material 'snow' must be in [0, 1)"),
-        "{e}"
+        m.warnings.iter().any(|w| w.starts_with("model.gltf: material 'snow': reflectance")),
+        "{:?}",
+        m.warnings
     );
     // Zero area only: an error; with another triangle: dropped and counted.
     let flat = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 2.0, 0.0, 0.0];
@@ -332,7 +341,9 @@ fn a_hundred_thousand_triangles_load_in_seconds() {
     let path = dir.path().join("grid.obj");
     std::fs::write(&path, &text).unwrap();
     let start = Instant::now();
-    let scene = load_scene(&path).unwrap().scene;
+    // One-sided: the surfaces of the front faces are counted below.
+    let one_sided = LoadOptions { model_sides: Some(Sides::One), ..LoadOptions::default() };
+    let scene = load_scene_with(&path, &one_sided).unwrap().scene;
     let load = start.elapsed().as_secs_f64();
     let radiosity_core::Shape::Mesh(floor) = &scene.objects[0].shape else { panic!("a mesh") };
     assert_eq!(floor.faces().len(), 2 * n * n);

@@ -575,6 +575,30 @@ impl Scene {
         materials: Vec<Material>,
         objects: Vec<Object>,
     ) -> Result<Self, SceneError> {
+        Self::build(name, camera, materials, objects, true)
+    }
+
+    /// [`Scene::try_new`] without the light rule: for describing a scene (`info` on a model
+    /// that has no light yet) rather than solving it, where a solve would only be black.
+    ///
+    /// # Errors
+    /// As [`Scene::try_new`], except [`SceneError::NoEmitter`].
+    pub fn try_new_unlit(
+        name: &str,
+        camera: Option<Camera>,
+        materials: Vec<Material>,
+        objects: Vec<Object>,
+    ) -> Result<Self, SceneError> {
+        Self::build(name, camera, materials, objects, false)
+    }
+
+    fn build(
+        name: &str,
+        camera: Option<Camera>,
+        materials: Vec<Material>,
+        objects: Vec<Object>,
+        needs_light: bool,
+    ) -> Result<Self, SceneError> {
         for (i, m) in materials.iter().enumerate() {
             if materials[..i].iter().any(|o| o.name == m.name) {
                 return Err(SceneError::DuplicateMaterial { name: m.name.clone() });
@@ -592,7 +616,7 @@ impl Scene {
                 });
             }
         }
-        if !objects.iter().any(|o| materials[o.material].is_emitter()) {
+        if needs_light && !objects.iter().any(|o| materials[o.material].is_emitter()) {
             return Err(SceneError::NoEmitter);
         }
         Ok(Self {

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use crate::{LoadError, LoadedScene, ModelFormat, Scene, load_scene, parse_scene};
+use crate::{LoadError, LoadOptions, LoadedScene, ModelFormat, Scene, load_scene_with, parse_scene};
 
 /// Built-in scene names with the origin shown in messages and the embedded text.
 const FILES: &[(&str, &str, &str)] = &[
@@ -36,15 +36,24 @@ pub fn builtin_scene(name: &str) -> Option<Scene> {
 /// As [`load_scene`] for a path; [`LoadError::UnknownScene`], listing the built-ins, for any
 /// other name.
 pub fn resolve_scene(arg: &str) -> Result<LoadedScene, LoadError> {
+    resolve_scene_with(arg, &LoadOptions::default())
+}
+
+/// [`resolve_scene`] with [`LoadOptions`] (a built-in scene has a light and no model file, so
+/// the options change nothing there).
+///
+/// # Errors
+/// As [`resolve_scene`].
+pub fn resolve_scene_with(arg: &str, opts: &LoadOptions) -> Result<LoadedScene, LoadError> {
     let path = Path::new(arg);
     // Anything there but a folder is read as a file, so a FIFO or a device is refused by
     // the loader rather than taken for an unknown built-in name.
     let present = std::fs::metadata(path).is_ok_and(|m| !m.is_dir());
     if present || arg.ends_with(".toml") || ModelFormat::from_path(path).is_some() {
-        return load_scene(path);
+        return load_scene_with(path, opts);
     }
     builtin_scene(arg)
-        .map(|scene| LoadedScene { scene, warnings: Vec::new() })
+        .map(|scene| LoadedScene { scene, warnings: Vec::new(), no_light: None })
         .ok_or_else(|| LoadError::UnknownScene { name: arg.to_owned(), known: BUILTIN_SCENES.join(", ") })
 }
 

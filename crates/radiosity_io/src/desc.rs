@@ -109,6 +109,11 @@ pub(crate) struct MaterialDesc {
     /// Emitted radiosity W/m² per channel, each ≥ 0; default 0.
     #[serde(default, deserialize_with = "point_opt")]
     pub(crate) emission: Option<Spanned<[f64; 3]>>,
+    /// Faces that exchange light, `1` (default) or `2` (signed so any other number gets our
+    /// message, at its span).
+    pub(crate) sides: Option<Spanned<i64>>,
+    /// Faces that emit, `1` (default: the front) or `2` (the back too; needs `sides = 2`).
+    pub(crate) emission_sides: Option<Spanned<i64>>,
 }
 
 /// One `[[object]]`: a flat struct rather than an enum tagged by `type`, because serde's
@@ -150,6 +155,8 @@ pub(crate) struct ObjectDesc {
     pub(crate) file: Option<Spanned<String>>,
     /// `mesh`: placement of the model.
     pub(crate) transform: Option<Spanned<TransformDesc>>,
+    /// Any type: `1` or `2`, overriding the material's sides (for `mesh`, the model file's).
+    pub(crate) sides: Option<Spanned<i64>>,
 }
 
 /// `transform = { … }` of a `mesh` object: scale, rotate about x, y, z, then translate.

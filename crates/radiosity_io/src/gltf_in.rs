@@ -11,10 +11,13 @@ use std::path::Path;
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 use radiosity_core::glam::{DMat4, DVec3};
-use radiosity_core::{Camera, Material, Rgb, srgb_decode, unique_names};
+use radiosity_core::{Camera, Material, Rgb, Sides, unique_names};
 
 use crate::LoadError;
-use crate::model::{DEFAULT_GREY, Model, ModelPart, PartBuilder, Transform, model_error, model_material};
+use crate::model::{
+    DEFAULT_GREY, Model, ModelPart, PartBuilder, Transform, clamp_reflectance, model_error, model_material,
+    specular_warning,
+};
 
 /// Checks that `accessor` can be read as `dims` of one of `types` without leaving its buffer.
 fn check_accessor(
@@ -80,16 +83,7 @@ fn mean_linear_colour(image: &gltf::image::Data) -> Option<[f64; 3]> {
         Format::R8G8B8A8 => 4,
         _ => return None,
     };
-    let lut: Vec<f64> = (0..256).map(|v| srgb_decode(v as f64 / 255.0)).collect();
-    let mut sum = [0.0; 3];
-    let mut n = 0usize;
-    for px in image.pixels.chunks_exact(channels) {
-        for c in 0..3 {
-            sum[c] += lut[px[c] as usize];
-        }
-        n += 1;
-    }
-    (n > 0).then(|| sum.map(|s| s / n as f64))
+    crate::model::mean_linear_colour(&image.pixels, channels)
 }
 
 /// Splits a GLB container into its JSON chunk and optional BIN chunk. Done here rather than by
@@ -265,6 +259,20 @@ pub(crate) fn parse_gltf(
                         None => {}
                     }
                 }
+                let reflectance = clamp_reflectance(origin, &name, reflectance, warnings);
+                // Metal reflects like a mirror, a transmissive material lets light through:
+                // neither is a diffuse reflectance, but its base colour is the best guess.
+                let metallic = pbr.metallic_factor();
+                let transmission = m.transmission().map_or(0.0, |t| t.transmission_factor());
+                if metallic > 0.5 {
+                    warnings.push(specular_warning(origin, &name, &format!("metallicFactor {metallic}")));
+                } else if transmission > 0.0 {
+                    warnings.push(specular_warning(
+                        origin,
+                        &name,
+                        &format!("KHR_materials_transmission {transmission}"),
+                    ));
+                }
                 let strength = m.emissive_strength().unwrap_or(1.0) as f64;
                 let emission = m.emissive_factor().map(|v| v as f64 * strength);
                 Material::try_new(&name, Rgb::from_array(reflectance), Rgb::from_array(emission))
@@ -416,6 +424,8 @@ pub(crate) fn parse_gltf(
             }
             dropped += b.dropped;
             let material = material_index(prim.material(), &mut warnings)?;
+            let sides =
+                if prim.material().double_sided() { Sides::Two { emits_back: true } } else { Sides::One };
             // Several primitives of one node are told apart by material (named below, once
             // the material list is complete).
             let name = node_name.clone();
@@ -425,7 +435,7 @@ pub(crate) fn parse_gltf(
             }
             let mesh = b.build().map_err(|m| err(format!("{what}: {m}")))?;
             by_material.push(primitives.len() > 1);
-            parts.push(ModelPart { name, material, mesh });
+            parts.push(ModelPart { name, material, mesh, sides });
         }
     }
     if skipped_modes > 0 {

@@ -35,9 +35,11 @@ mod model;
 mod obj;
 mod scene_file;
 
-pub use builtin::{BUILTIN_SCENES, builtin_scene, resolve_scene};
+pub use builtin::{BUILTIN_SCENES, builtin_scene, resolve_scene, resolve_scene_with};
 pub use error::LoadError;
-pub use model::{DEFAULT_GREY, Model, ModelFormat, ModelPart, Transform, load_model, parse_model};
-pub use scene_file::{LoadedScene, load_scene, parse_scene};
+pub use model::{
+    CLAMPED_REFLECTANCE, DEFAULT_GREY, Model, ModelFormat, ModelPart, Transform, load_model, parse_model,
+};
+pub use scene_file::{LoadOptions, LoadedScene, load_scene, load_scene_with, parse_scene, parse_scene_with};
 
 use radiosity_core::Scene;

@@ -2,15 +2,21 @@
 //! named parts of validated [`PolygonMesh`]es with diffuse [`Material`]s.
 //!
 //! What is taken from the files:
-//! * OBJ/MTL: `Kd` → reflectance, `Ke` → emission (emitted radiosity, W per unit², the same
-//!   quantity as `emission` in a scene file). A missing MTL file or an unknown `usemtl` gives
-//!   the default grey (ρ = 0.5) and a warning. Vertex normals and texture coordinates are
-//!   ignored: facets are flat for the solve.
+//! * OBJ/MTL: `Kd` (× the mean of the `map_Kd` texture, decoded from sRGB) → reflectance,
+//!   `Ke` → emission (emitted radiosity, W per unit², the same quantity as `emission` in a
+//!   scene file). A missing MTL file, an unknown `usemtl` or an unreadable texture gives the
+//!   default grey (ρ = 0.5) or `Kd` alone, and a warning. Vertex normals and texture
+//!   coordinates are ignored: facets are flat for the solve. Every part is two-sided
+//!   ([`ModelPart::sides`]).
 //! * glTF: `baseColorFactor` (times the mean of the base colour texture, decoded from sRGB,
 //!   when the texture's pixels can be read) → reflectance; `emissiveFactor` ×
 //!   `KHR_materials_emissive_strength` → emission; node transforms; the first perspective
-//!   camera. A primitive without a material gets the default grey and a warning (the glTF
-//!   default, white ρ = 1, would never converge).
+//!   camera; `doubleSided` → two-sided parts emitting from both faces. A primitive without a
+//!   material gets the default grey and a warning (the glTF default, white ρ = 1, would never
+//!   converge).
+//! * Both: reflectance ≥ 1 in a channel is clamped to [`CLAMPED_REFLECTANCE`], and a mirror
+//!   or glass material is read as diffuse, each with a warning: real files are full of both,
+//!   and refusing them would refuse the file.
 //!
 //! Faces are kept as polygons when planar and convex (so an OBJ of quads meshes exactly like
 //! the same quads in a scene file), fan-split when convex but not planar, ear-clipped when
@@ -23,7 +29,7 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use radiosity_core::glam::{DMat4, DQuat, DVec3};
-use radiosity_core::{Camera, Material, Polygon, PolygonMesh, Rgb, SceneError};
+use radiosity_core::{Camera, Material, Polygon, PolygonMesh, Rgb, SceneError, Sides, srgb_decode};
 
 use crate::LoadError;
 use radiosity_core::escape_controls;
@@ -78,6 +84,10 @@ pub struct ModelPart {
     pub material: usize,
     /// The geometry, in world units (transform applied).
     pub mesh: PolygonMesh,
+    /// Faces that exchange light, as the format says: OBJ says nothing, and modellers show
+    /// its faces from both sides, so two-sided with a front-only emission; glTF's
+    /// `doubleSided` material flag, whose emission viewers show on both faces.
+    pub sides: Sides,
 }
 
 /// A model file read and validated.
@@ -149,8 +159,8 @@ pub(crate) fn read_input_file(path: &Path, limit: u64) -> Result<Vec<u8>, String
 ///
 /// # Errors
 /// [`LoadError::Model`], one line naming the file (and line, for OBJ/MTL) and the element:
-/// unreadable or malformed files, indices out of range, non-finite coordinates, reflectance
-/// outside [0, 1), negative emission, or no face left after dropping degenerate ones.
+/// unreadable or malformed files, indices out of range, non-finite coordinates, negative or
+/// non-finite reflectance, negative emission, or no face left after dropping degenerate ones.
 pub fn load_model(path: &Path, transform: &Transform) -> Result<Model, LoadError> {
     let origin = path.display().to_string();
     let bytes = read_input_file(path, MAX_MODEL_BYTES).map_err(|e| LoadError::Model {
@@ -203,6 +213,64 @@ pub(crate) fn model_material(
 ) -> Result<Material, LoadError> {
     Material::try_new(name, Rgb::from_array(reflectance), Rgb::from_array(emission))
         .map_err(|e| model_error(origin, line, e.to_string()))
+}
+
+/// Reflectance given to a model material that reflects 1 or more in a channel: a white
+/// (`Kd 1 1 1`, glTF's default factor) is common in real files, and ρ ≥ 1 never converges.
+pub const CLAMPED_REFLECTANCE: f64 = 0.95;
+
+/// `reflectance` with every channel ≥ 1 lowered to [`CLAMPED_REFLECTANCE`], and a warning
+/// naming the file, the material and the value when one was. Non-finite and negative values
+/// are left for the material's own check to refuse.
+pub(crate) fn clamp_reflectance(
+    origin: &str,
+    name: &str,
+    reflectance: [f64; 3],
+    warnings: &mut Vec<String>,
+) -> [f64; 3] {
+    if !reflectance.iter().any(|&v| v >= 1.0 && v.is_finite()) {
+        return reflectance;
+    }
+    warnings.push(format!(
+        "{origin}: material '{name}': reflectance {reflectance:?} has a channel ≥ 1 (light would never stop bouncing); clamped to {CLAMPED_REFLECTANCE}"
+    ));
+    reflectance.map(|v| if v >= 1.0 && v.is_finite() { CLAMPED_REFLECTANCE } else { v })
+}
+
+/// The warning for a material that the format describes as mirror-like or see-through, which
+/// the solver (diffuse only) cannot show; `why` names what in the file says so.
+pub(crate) fn specular_warning(origin: &str, name: &str, why: &str) -> String {
+    format!("material '{name}' ({origin}) is specular/transmissive ({why}); treated as diffuse")
+}
+
+/// Mean linear colour of 8-bit sRGB pixels of `channels` bytes each, red, green and blue
+/// first (RGB, RGBA), or `None` without a pixel or with fewer than three channels: what a
+/// texture contributes to a flat element's reflectance, as the mean of what it reflects.
+pub(crate) fn mean_linear_colour(pixels: &[u8], channels: usize) -> Option<[f64; 3]> {
+    if channels < 3 {
+        return None;
+    }
+    let lut: Vec<f64> = (0..256).map(|v| srgb_decode(v as f64 / 255.0)).collect();
+    let mut sum = [0.0; 3];
+    let mut n = 0usize;
+    for px in pixels.chunks_exact(channels) {
+        for c in 0..3 {
+            sum[c] += lut[px[c] as usize];
+        }
+        n += 1;
+    }
+    (n > 0).then(|| sum.map(|s| s / n as f64))
+}
+
+/// Mean linear colour of the image file at `path` (PNG or JPEG, 8-bit sRGB after decoding).
+///
+/// # Errors
+/// Why it cannot be read or decoded, one line without the path.
+pub(crate) fn texture_mean(path: &Path) -> Result<[f64; 3], String> {
+    let bytes = read_input_file(path, MAX_MODEL_BYTES)?;
+    let image = image::load_from_memory(&bytes).map_err(|e| e.to_string())?;
+    let rgb = image.to_rgb8();
+    mean_linear_colour(rgb.as_raw(), 3).ok_or_else(|| "the image has no pixels".to_owned())
 }
 
 /// Collects the faces of one part: welds positions, drops degenerate faces (counted), and

@@ -12,13 +12,50 @@ use std::io::Cursor;
 use std::path::Path;
 
 use radiosity_core::glam::DVec3;
-use radiosity_core::unique_names;
+use radiosity_core::{Sides, unique_names};
 
 use crate::LoadError;
 use crate::model::{
-    DEFAULT_GREY, MAX_TEXT_BYTES, Model, ModelPart, PartBuilder, Transform, model_error, model_material,
-    read_input_file,
+    DEFAULT_GREY, MAX_TEXT_BYTES, Model, ModelPart, PartBuilder, Transform, clamp_reflectance, model_error,
+    model_material, read_input_file, specular_warning, texture_mean,
 };
+
+/// Sides of every OBJ part: the format says nothing, and modellers and Blender show its faces
+/// from both sides (the normals of many files face every which way). The emission stays on the
+/// front face, the side the file's winding points to.
+const OBJ_SIDES: Sides = Sides::Two { emits_back: false };
+
+/// What in an MTL material says it is mirror-like or see-through, or `None` for a diffuse
+/// one: an illumination model with reflection or refraction (3 to 7), a strong sharp
+/// highlight (`Ks` above 0.5 with `Ns` ≥ 100: a weak or broad one is the gloss of a diffuse
+/// paint), or transmission (`d` < 1, `Tr` > 0, `Tf` below 1).
+fn specular_reason(m: &tobj::Material) -> Option<String> {
+    if let Some(illum @ 3..=7) = m.illumination_model {
+        return Some(format!("illum {illum}"));
+    }
+    let ks = m.specular.map_or(0.0, |k| k.iter().copied().fold(0.0, f64::max));
+    let ns = m.shininess.unwrap_or(0.0);
+    if ks > 0.5 && ns >= 100.0 {
+        return Some(format!("Ks {ks} with Ns {ns}"));
+    }
+    if let Some(d) = m.dissolve.filter(|&d| d < 1.0) {
+        return Some(format!("d {d}"));
+    }
+    let numbers = |key: &str| -> Vec<f64> {
+        m.unknown_param
+            .get(key)
+            .map(|v| v.split_whitespace().filter_map(|w| w.parse().ok()).collect())
+            .unwrap_or_default()
+    };
+    if let Some(tr) = numbers("Tr").first().filter(|&&t| t > 0.0) {
+        return Some(format!("Tr {tr}"));
+    }
+    let tf = numbers("Tf");
+    if tf.len() == 3 && tf.iter().any(|&t| t < 1.0) {
+        return Some(format!("Tf {} {} {}", tf[0], tf[1], tf[2]));
+    }
+    None
+}
 
 /// What the line scan learns: the line of every face, in file order, and every `usemtl`.
 struct Scan {
@@ -266,13 +303,38 @@ pub(crate) fn parse_obj(
                     None => (origin, None),
                 };
                 let line = |key: &str| line_of.and_then(|t| mtl_line(t, &m.name, key));
-                let reflectance = m.diffuse.unwrap_or_else(|| {
-                    warnings.push(format!(
-                        "{mtl_origin}: material '{}' has no Kd; it is default grey ({DEFAULT_GREY})",
-                        m.name
-                    ));
-                    [DEFAULT_GREY; 3]
+                // A texture is read from the MTL's folder; its mean colour scales Kd, as glTF's
+                // base colour texture scales its factor.
+                let texture = m.diffuse_texture.as_deref().and_then(|file| {
+                    let folder = Path::new(mtl_origin).parent().filter(|_| line_of.is_some())?;
+                    match texture_mean(&folder.join(file)) {
+                        Ok(mean) => Some(mean),
+                        Err(e) => {
+                            warnings.push(format!(
+                                "{mtl_origin}: material '{}': texture '{file}' not read ({e}); Kd alone used",
+                                m.name
+                            ));
+                            None
+                        }
+                    }
                 });
+                let reflectance = match (m.diffuse, texture) {
+                    (Some(kd), Some(mean)) => [kd[0] * mean[0], kd[1] * mean[1], kd[2] * mean[2]],
+                    (Some(kd), None) => kd,
+                    // The texture alone is what a viewer shows.
+                    (None, Some(mean)) => mean,
+                    (None, None) => {
+                        warnings.push(format!(
+                            "{mtl_origin}: material '{}' has no Kd; it is default grey ({DEFAULT_GREY})",
+                            m.name
+                        ));
+                        [DEFAULT_GREY; 3]
+                    }
+                };
+                let reflectance = clamp_reflectance(mtl_origin, &m.name, reflectance, warnings);
+                if let Some(why) = specular_reason(m) {
+                    warnings.push(specular_warning(mtl_origin, &m.name, &why));
+                }
                 let emission = m.emissive.unwrap_or([0.0; 3]);
                 // Name the line of the value at fault: Kd unless only the emission is wrong.
                 let bad_kd = !reflectance.iter().all(|v| v.is_finite() && (0.0..1.0).contains(v));
@@ -370,7 +432,7 @@ pub(crate) fn parse_obj(
             continue;
         }
         let mesh = b.build().map_err(|m| model_error(origin, None, format!("object '{name}': {m}")))?;
-        parts.push(ModelPart { name, material, mesh });
+        parts.push(ModelPart { name, material, mesh, sides: OBJ_SIDES });
     }
     if dropped > 0 {
         warnings.push(format!("{origin}: {dropped} degenerate face(s) (zero area) dropped"));

@@ -11,8 +11,8 @@ use std::path::Path;
 
 use radiosity_core::glam::DVec3;
 use radiosity_core::{
-    Camera, Facing, Material, MeshParams, Object, Polygon, Rgb, Scene, SceneError, Shape, SolverSettings,
-    Sphere, box_faces,
+    Camera, Facing, Material, MeshParams, Object, Polygon, Rgb, Scene, SceneError, Shape, Sides,
+    SolverSettings, Sphere, box_faces,
 };
 use toml::Spanned;
 
@@ -45,6 +45,43 @@ pub struct LoadedScene {
     pub scene: Scene,
     /// Warnings, each one line naming its file.
     pub warnings: Vec<String>,
+    /// Only when loaded with [`LoadOptions::allow_no_light`] and nothing emits: the error a
+    /// strict load gives, for a caller that describes the scene to report, or one that
+    /// solves it to return once the warnings (which may explain it) are out.
+    pub no_light: Option<LoadError>,
+}
+
+/// How a scene is loaded. The default is what a solve needs: every rule, and the sides that
+/// the files say.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LoadOptions {
+    /// Sides of every object read from a model file (a model given as the scene, the parts
+    /// of `mesh` objects), over what the file and the scene file's `sides` keys say:
+    /// [`Sides::One`] turns an OBJ's two-sidedness off; with [`Sides::Two`] the back emits
+    /// when `emits_back` is set or the file already made it emit.
+    pub model_sides: Option<Sides>,
+    /// Accept a scene in which nothing emits (a solve of it would be black), setting
+    /// [`LoadedScene::no_light`] instead of failing; every other rule still applies.
+    pub allow_no_light: bool,
+}
+
+/// Whether the back face of `sides` emits.
+fn emits_back(sides: Sides) -> bool {
+    matches!(sides, Sides::Two { emits_back: true })
+}
+
+/// `sides` with the count set by a `sides = 1 | 2` key; a back face keeps `base`'s emission.
+fn with_count(count: u8, base: Sides) -> Sides {
+    if count == 1 { Sides::One } else { Sides::Two { emits_back: emits_back(base) } }
+}
+
+/// The sides of an object from a model file, after [`LoadOptions::model_sides`].
+fn model_sides(sides: Sides, opts: &LoadOptions) -> Sides {
+    match opts.model_sides {
+        None => sides,
+        Some(Sides::One) => Sides::One,
+        Some(Sides::Two { emits_back: back }) => Sides::Two { emits_back: back || emits_back(sides) },
+    }
 }
 
 /// Loads and validates a TOML scene file or a model file (`.obj`, `.gltf`, `.glb`, chosen by
@@ -58,8 +95,16 @@ pub struct LoadedScene {
 /// as [`parse_scene`], with the path as origin; [`LoadError::Model`] for model files, and for a
 /// model without any emitting material.
 pub fn load_scene(path: &Path) -> Result<LoadedScene, LoadError> {
+    load_scene_with(path, &LoadOptions::default())
+}
+
+/// [`load_scene`] with [`LoadOptions`].
+///
+/// # Errors
+/// As [`load_scene`] (without the light rule when `opts` allows no light).
+pub fn load_scene_with(path: &Path, opts: &LoadOptions) -> Result<LoadedScene, LoadError> {
     if ModelFormat::from_path(path).is_some() {
-        return scene_from_model(path);
+        return scene_from_model(path, opts);
     }
     let bytes = crate::model::read_input_file(path, crate::model::MAX_TEXT_BYTES)
         .map_err(|reason| LoadError::Unreadable { path: path.to_owned(), reason })?;
@@ -67,32 +112,46 @@ pub fn load_scene(path: &Path) -> Result<LoadedScene, LoadError> {
         path: path.to_owned(),
         reason: format!("not a text file (invalid UTF-8 at byte {})", e.utf8_error().valid_up_to()),
     })?;
-    parse_scene(&text, &path.display().to_string())
+    parse_scene_with(&text, &path.display().to_string(), opts)
 }
 
-fn scene_from_model(path: &Path) -> Result<LoadedScene, LoadError> {
+fn scene_from_model(path: &Path, opts: &LoadOptions) -> Result<LoadedScene, LoadError> {
     let origin = path.display().to_string();
     let model = load_model(path, &Transform::default())?;
-    let objects = model.parts.into_iter().map(|p| Object {
-        name: p.name,
-        material: p.material,
-        shape: Shape::Mesh(p.mesh),
-        sides: radiosity_core::Sides::One,
-    });
+    let objects: Vec<Object> = model
+        .parts
+        .into_iter()
+        .map(|p| Object {
+            name: p.name,
+            material: p.material,
+            shape: Shape::Mesh(p.mesh),
+            sides: model_sides(p.sides, opts),
+        })
+        .collect();
     let name = path.file_stem().map_or_else(|| "model".to_owned(), |s| s.to_string_lossy().into_owned());
-    let scene = Scene::try_new(&name, model.camera, model.materials, objects.collect()).map_err(|e| {
+    let error = |e: SceneError, notes: &str| {
         let hint = match e {
             SceneError::NoEmitter => {
                 "; give a material an emission (OBJ/MTL: `Ke r g b`; glTF: emissiveFactor) or place the model in a scene file with a light"
             }
             _ => "",
         };
-        // What the loader noticed (a missing MTL, an unknown material) often explains the
-        // error, and would otherwise be lost with the scene.
-        let notes: String = model.warnings.iter().map(|w| format!(" (warning: {w})")).collect();
         model_error(&origin, None, format!("{e}{hint}{notes}"))
-    })?;
-    Ok(LoadedScene { scene, warnings: model.warnings })
+    };
+    let lit = objects.iter().any(|o| model.materials.get(o.material).is_some_and(Material::is_emitter));
+    if opts.allow_no_light {
+        // The caller shows the warnings before it reports or returns the missing light.
+        let scene =
+            Scene::try_new_unlit(&name, model.camera, model.materials, objects).map_err(|e| error(e, ""))?;
+        let no_light = (!lit).then(|| error(SceneError::NoEmitter, ""));
+        return Ok(LoadedScene { scene, warnings: model.warnings, no_light });
+    }
+    // What the loader noticed (a missing MTL, an unknown material) often explains the error,
+    // and would otherwise be lost with the scene.
+    let notes: String = model.warnings.iter().map(|w| format!(" (warning: {w})")).collect();
+    let scene =
+        Scene::try_new(&name, model.camera, model.materials, objects).map_err(|e| error(e, &notes))?;
+    Ok(LoadedScene { scene, warnings: model.warnings, no_light: None })
 }
 
 /// Parses and validates the text of a scene file, with the loader's warnings (from the model
@@ -100,21 +159,32 @@ fn scene_from_model(path: &Path) -> Result<LoadedScene, LoadError> {
 /// (usually the path) starts every error message.
 ///
 /// The scene's name defaults to the file stem of `origin`; `[mesh]` sets [`Scene::mesh`] and
-/// `[solver]` sets [`Scene::solver`].
+/// `[solver]` sets [`Scene::solver`]. An object's sides are its `sides` key, else its
+/// material's, else one; a `mesh` object's parts keep their file's unless the object or an
+/// overriding material that gives `sides` says otherwise.
 ///
 /// # Errors
 /// [`LoadError::At`], naming line, column, key path and what was expected, for TOML syntax
 /// errors, unknown keys, wrong types, and every validation rule: reflectance in [0, 1),
 /// emission finite and ≥ 0, unique materials, known material references, finite coordinates,
 /// planar convex non-degenerate polygons of 3+ vertices, radius > 0, box min < max, a usable
-/// camera, sizes > 0, `unshot_threshold` in (0, 1), `max_shots` ≥ 1, `time_limit` > 0, at
+/// camera, sizes > 0, `sides` and `emission_sides` 1 or 2 (`emission_sides = 2` only with
+/// `sides = 2`), `unshot_threshold` in (0, 1), `max_shots` ≥ 1, `time_limit` > 0, at
 /// least one object and at least one light. TOML's `nan` and `inf` are rejected wherever a
 /// number is validated. [`LoadError::Model`] for a broken model file.
 pub fn parse_scene(text: &str, origin: &str) -> Result<LoadedScene, LoadError> {
+    parse_scene_with(text, origin, &LoadOptions::default())
+}
+
+/// [`parse_scene`] with [`LoadOptions`].
+///
+/// # Errors
+/// As [`parse_scene`] (without the light rule when `opts` allows no light).
+pub fn parse_scene_with(text: &str, origin: &str, opts: &LoadOptions) -> Result<LoadedScene, LoadError> {
     let loc = Locator { origin, text };
     let desc: SceneDesc = toml::from_str(text).map_err(|e| loc.toml_error(&e))?;
 
-    let mut materials = materials(&loc, &desc.material)?;
+    let (mut materials, material_sides) = materials(&loc, &desc.material)?;
     let declared = materials.len();
     let mut objects = Vec::new();
     // For each object, the `[[object]]` it came from (a `mesh` object gives several).
@@ -122,10 +192,12 @@ pub fn parse_scene(text: &str, origin: &str) -> Result<LoadedScene, LoadError> {
     let mut warnings = Vec::new();
     for (i, o) in desc.object.iter().enumerate() {
         if o.get_ref().kind.get_ref() == "mesh" {
-            let parts = mesh_object(&loc, i, o, &desc.material[..declared], &mut materials, &mut warnings)?;
+            let declared = Declared { descs: &desc.material[..declared], sides: &material_sides };
+            let parts = mesh_object(&loc, i, o, &declared, opts, &mut materials, &mut warnings)?;
             objects.extend(parts);
         } else {
-            objects.push(object(&loc, i, o, &desc.material, &materials[..declared])?);
+            let declared = Declared { descs: &desc.material, sides: &material_sides };
+            objects.push(object(&loc, i, o, &declared, &materials[..declared.descs.len()])?);
         }
         origins.resize(objects.len(), i);
     }
@@ -143,7 +215,9 @@ pub fn parse_scene(text: &str, origin: &str) -> Result<LoadedScene, LoadError> {
         .enumerate()
         .find(|(i, m)| m.is_emitter() && !objects.iter().any(|o| o.material == *i))
         .map(|(i, _)| i);
-    let mut scene = Scene::try_new(&name, camera, materials, objects).map_err(|e| match e {
+    let lit = objects.iter().any(|o| materials.get(o.material).is_some_and(Material::is_emitter));
+    let build = if opts.allow_no_light { Scene::try_new_unlit } else { Scene::try_new };
+    let scene_error = |e: SceneError| match e {
         SceneError::NoObjects => loc.at(
             0..0,
             "object",
@@ -164,11 +238,57 @@ pub fn parse_scene(text: &str, origin: &str) -> Result<LoadedScene, LoadError> {
         },
         // Duplicates and unknown references were reported above with their spans.
         other => loc.at(0..0, "scene", other.to_string()),
-    })?;
+    };
+    let mut scene = build(&name, camera, materials, objects).map_err(scene_error)?;
     scene.mesh = mesh;
     scene.solver = solver;
     check_element_count(&loc, &desc, &scene, &origins)?;
-    Ok(LoadedScene { scene, warnings })
+    let no_light = (!lit).then(|| scene_error(SceneError::NoEmitter));
+    Ok(LoadedScene { scene, warnings, no_light })
+}
+
+/// The `[[material]]` entries of a file with the sides each one gives (`None`: it says
+/// nothing, so a `mesh` object keeps its file's sides and other objects are one-sided).
+struct Declared<'a> {
+    descs: &'a [Spanned<MaterialDesc>],
+    sides: &'a [Option<Sides>],
+}
+
+/// `1` or `2` from a `sides` or `emission_sides` key, or an error at its value.
+fn side_count(loc: &Locator, key: String, v: &Spanned<i64>) -> Result<u8, LoadError> {
+    match *v.get_ref() {
+        1 => Ok(1),
+        2 => Ok(2),
+        other => Err(loc.at(
+            v.span(),
+            key,
+            format!("expected 1 (the front face only) or 2 (both faces), got {other}"),
+        )),
+    }
+}
+
+/// What a material's `sides` and `emission_sides` keys say, `None` when neither is given.
+fn material_sides(loc: &Locator, key: &str, m: &MaterialDesc) -> Result<Option<Sides>, LoadError> {
+    let sides = m.sides.as_ref().map(|v| side_count(loc, format!("{key}.sides"), v)).transpose()?;
+    let emission_sides = m
+        .emission_sides
+        .as_ref()
+        .map(|v| Ok::<_, LoadError>((side_count(loc, format!("{key}.emission_sides"), v)?, v.span())))
+        .transpose()?;
+    let back = matches!(emission_sides, Some((2, _)));
+    if let Some((2, span)) = emission_sides
+        && sides != Some(2)
+    {
+        return Err(loc.at(
+            span,
+            format!("{key}.emission_sides"),
+            "emission_sides = 2 needs sides = 2: a one-sided material has no back face to emit from",
+        ));
+    }
+    Ok(sides.map(|n| match n {
+        1 => Sides::One,
+        _ => Sides::Two { emits_back: back },
+    }))
 }
 
 /// Refuses, with a line, a scene whose mesh would pass [`radiosity_core::MAX_ELEMENTS`]: at
@@ -198,8 +318,12 @@ fn check_element_count(
     })
 }
 
-fn materials(loc: &Locator, descs: &[Spanned<MaterialDesc>]) -> Result<Vec<Material>, LoadError> {
+fn materials(
+    loc: &Locator,
+    descs: &[Spanned<MaterialDesc>],
+) -> Result<(Vec<Material>, Vec<Option<Sides>>), LoadError> {
     let mut materials: Vec<Material> = Vec::with_capacity(descs.len());
+    let mut sides = Vec::with_capacity(descs.len());
     for (i, m) in descs.iter().enumerate() {
         let m = m.get_ref();
         let key = format!("material[{i}]");
@@ -223,8 +347,9 @@ fn materials(loc: &Locator, descs: &[Spanned<MaterialDesc>]) -> Result<Vec<Mater
                     _ => loc.at(m.reflectance.span(), format!("{key}.reflectance"), e.to_string()),
                 })?;
         materials.push(material);
+        sides.push(material_sides(loc, &key, m)?);
     }
-    Ok(materials)
+    Ok((materials, sides))
 }
 
 fn camera(loc: &Locator, c: &Spanned<CameraDesc>) -> Result<Camera, LoadError> {
@@ -305,9 +430,10 @@ fn object(
     loc: &Locator,
     i: usize,
     o: &Spanned<ObjectDesc>,
-    material_descs: &[Spanned<MaterialDesc>],
+    declared: &Declared,
     materials: &[Material],
 ) -> Result<Object, LoadError> {
+    let material_descs = declared.descs;
     let d = o.get_ref();
     let name = d.name.get_ref().clone();
     let key = format!("object[{i}]");
@@ -395,7 +521,12 @@ fn object(
         }
         _ => unreachable!("mesh objects go through mesh_object; allowed_fields accepts only these types"),
     };
-    Ok(Object { name, material, shape, sides: radiosity_core::Sides::One })
+    let sides = declared.sides.get(material).copied().flatten().unwrap_or(Sides::One);
+    let sides = match &d.sides {
+        Some(v) => with_count(side_count(loc, format!("{key}.sides"), v)?, sides),
+        None => sides,
+    };
+    Ok(Object { name, material, shape, sides })
 }
 
 /// A field of another type (a `radius` on a box) is an error, not silently ignored.
@@ -425,7 +556,10 @@ fn check_fields(
             return Err(loc.at(
                 span,
                 format!("{key}.{field}"),
-                format!("'{field}' does not apply to type '{kind}' (it takes: {})", allowed.join(", ")),
+                format!(
+                    "'{field}' does not apply to type '{kind}' (it takes: {}; every type takes name, type, material, sides)",
+                    allowed.join(", ")
+                ),
             ));
         }
     }
@@ -509,10 +643,12 @@ fn mesh_object(
     loc: &Locator,
     i: usize,
     o: &Spanned<ObjectDesc>,
-    material_descs: &[Spanned<MaterialDesc>],
+    declared: &Declared,
+    opts: &LoadOptions,
     materials: &mut Vec<Material>,
     warnings: &mut Vec<String>,
 ) -> Result<Vec<Object>, LoadError> {
+    let material_descs = declared.descs;
     let d = o.get_ref();
     let name = d.name.get_ref().clone();
     let key = format!("object[{i}]");
@@ -529,6 +665,7 @@ fn mesh_object(
         .as_ref()
         .map(|m| material_index(loc, &key, &name, m, material_descs, &materials[..material_descs.len()]))
         .transpose()?;
+    let object_sides = d.sides.as_ref().map(|v| side_count(loc, format!("{key}.sides"), v)).transpose()?;
     let transform = d
         .transform
         .as_ref()
@@ -565,14 +702,21 @@ fn mesh_object(
             materials.push(m);
         }
     }
+    // The file's sides, then the overriding material's when it says, then the object's key,
+    // then the command line's.
+    let material_sides = override_material.and_then(|m| declared.sides.get(m).copied().flatten());
     Ok(model
         .parts
         .into_iter()
-        .map(|p| Object {
-            name: format!("{name}/{}", p.name),
-            material: override_material.unwrap_or(first + p.material),
-            shape: Shape::Mesh(p.mesh),
-            sides: radiosity_core::Sides::One,
+        .map(|p| {
+            let sides = material_sides.unwrap_or(p.sides);
+            let sides = object_sides.map_or(sides, |n| with_count(n, sides));
+            Object {
+                name: format!("{name}/{}", p.name),
+                material: override_material.unwrap_or(first + p.material),
+                shape: Shape::Mesh(p.mesh),
+                sides: model_sides(sides, opts),
+            }
         })
         .collect())
 }
