@@ -192,10 +192,61 @@ pub fn parse_model(
     format: ModelFormat,
     transform: &Transform,
 ) -> Result<Model, LoadError> {
-    match format {
+    let mut model = match format {
         ModelFormat::Obj => crate::obj::parse_obj(bytes, origin, base, transform),
         ModelFormat::Gltf => crate::gltf_in::parse_gltf(bytes, origin, base, transform),
+    }?;
+    let duplicates = drop_duplicate_faces(&mut model.parts);
+    if duplicates > 0 {
+        model.warnings.push(format!(
+            "{}: {duplicates} duplicate face(s) dropped (the same corners, facing the same way, as an earlier face): their light would have been reflected twice",
+            escape_controls(origin)
+        ));
     }
+    Ok(model)
+}
+
+/// Removes every face whose corners (the same points, in the same cyclic order, so facing
+/// the same way) repeat a face met earlier in `parts`, in this part or another: exporters
+/// repeat faces (McGuire's Cornell boxes give each block a "bottom face" that is one of its
+/// sides again), and two coincident faces would each receive and reflect the same light.
+/// A part left with no face is removed. Returns the number of faces dropped. Faces back to
+/// back (the same corners facing opposite ways) are kept: they are how a one-sided format
+/// models a thin two-sided sheet.
+fn drop_duplicate_faces(parts: &mut Vec<ModelPart>) -> usize {
+    let mut seen: std::collections::HashSet<Vec<[u64; 3]>> = std::collections::HashSet::new();
+    let mut dropped = 0;
+    let mut emptied = vec![false; parts.len()];
+    for (part, emptied) in parts.iter_mut().zip(&mut emptied) {
+        let positions = part.mesh.positions();
+        let key = |face: &[u32]| {
+            let mut corners: Vec<[u64; 3]> =
+                face.iter().map(|&i| positions[i as usize].to_array().map(f64::to_bits)).collect();
+            // The same cycle from any start: start at the smallest corner.
+            let first = (0..corners.len()).min_by_key(|&k| corners[k]).unwrap_or(0);
+            corners.rotate_left(first);
+            corners
+        };
+        let keep: Vec<bool> = part.mesh.faces().iter().map(|f| seen.insert(key(f))).collect();
+        let removed = keep.iter().filter(|k| !**k).count();
+        if removed == 0 {
+            continue;
+        }
+        dropped += removed;
+        let faces: Vec<Vec<u32>> =
+            part.mesh.faces().iter().zip(&keep).filter(|(_, k)| **k).map(|(f, _)| f.clone()).collect();
+        if faces.is_empty() {
+            *emptied = true;
+            continue;
+        }
+        // A subset of valid faces over the same points is valid.
+        if let Ok(mesh) = PolygonMesh::try_new(positions.to_vec(), faces) {
+            part.mesh = mesh;
+        }
+    }
+    let mut flags = emptied.into_iter();
+    parts.retain(|_| !flags.next().unwrap_or(false));
+    dropped
 }
 
 /// A model error at `origin` (and `line`, when known).

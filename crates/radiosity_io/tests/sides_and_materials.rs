@@ -312,3 +312,24 @@ fn a_scene_without_light_loads_only_when_allowed() {
         radiosity_io::parse_scene_with(&scene("", "", ""), "s.toml", &allowed).unwrap().no_light.is_none()
     );
 }
+
+/// A face repeated in another group (as McGuire's Cornell boxes repeat a block side as its
+/// "bottom face") is dropped with a warning, from any starting corner; the same corners
+/// facing the other way (a thin sheet modelled back to back) are kept.
+#[test]
+fn duplicate_faces_are_dropped_with_a_warning() {
+    let obj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n\
+               o block\nf 1 2 3 4\n\
+               o bottom\nf 3 4 1 2\n\
+               o sheet_back\nf 4 3 2 1\n";
+    let model =
+        parse_model(obj.as_bytes(), "dup.obj", None, ModelFormat::Obj, &Transform::default()).unwrap();
+    let names: Vec<&str> = model.parts.iter().map(|p| p.name.as_str()).collect();
+    assert_eq!(names, ["block", "sheet_back"], "the repeated face's part is emptied and removed");
+    let warning = model.warnings.iter().find(|w| w.contains("duplicate")).expect("a warning");
+    assert!(warning.starts_with("dup.obj: 1 duplicate face"), "{warning}");
+    let single = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n";
+    let clean =
+        parse_model(single.as_bytes(), "one.obj", None, ModelFormat::Obj, &Transform::default()).unwrap();
+    assert!(clean.warnings.iter().all(|w| !w.contains("duplicate")), "{:?}", clean.warnings);
+}
