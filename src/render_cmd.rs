@@ -263,6 +263,13 @@ pub fn run(a: RenderArgs) -> Result<()> {
         a.fov.unwrap_or(base.fov_y_deg),
     )
     .map_err(|e| input(format!("camera options (--camera-position, --look-at, --fov): {e}")))?;
+    let lit = prepared.scene.lit_share_seen_by(&camera);
+    if lit < 0.05 {
+        note(format_args!(
+            "warning: the camera sees almost no lit face ({:.0} % of a coarse probe): it looks at nothing or at the backs of one-sided surfaces, so the picture will be nearly black; move it (--camera-position, --look-at), or make the surfaces two-sided (--sides 2 for model files, sides = 2 in a scene file)",
+            lit * 100.0
+        ))?;
+    }
     if a.reference {
         let radiance = crate::verify_cmd::reference_picture(
             &prepared,

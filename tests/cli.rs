@@ -379,3 +379,24 @@ fn obj_faces_are_two_sided_unless_sides_1() {
     let o = radiosity(&["solve", obj.to_str().unwrap(), "--sides", "3"]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
 }
+
+/// A camera that sees only the backs of one-sided walls (the furnace from outside) is warned
+/// about before the black picture is made; the default camera of the same scene is not.
+#[test]
+fn a_camera_that_sees_no_lit_face_is_warned_about() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("f.png");
+    let args = |extra: &[&'static str]| {
+        let mut v =
+            vec!["render", "furnace", "--max-shots", "3", "--width", "16", "--height", "12", "--spp", "1"];
+        v.extend_from_slice(&["--gather", "none", "--force", "-o", png.to_str().unwrap()]);
+        v.extend_from_slice(extra);
+        v
+    };
+    let outside = radiosity(&args(&["--camera-position", "0.5,0.5,-3", "--look-at", "0.5,0.5,0.5"]));
+    assert!(outside.status.success(), "{}", stderr(&outside));
+    assert!(stderr(&outside).contains("warning: the camera sees almost no lit face"), "{}", stderr(&outside));
+    let default = radiosity(&args(&[]));
+    assert!(default.status.success(), "{}", stderr(&default));
+    assert!(!stderr(&default).contains("lit face"), "{}", stderr(&default));
+}

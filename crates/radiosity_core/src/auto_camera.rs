@@ -61,6 +61,11 @@ fn best_of(scene: &Scene, candidates: Vec<Camera>) -> (Camera, usize) {
     best
 }
 
+/// The share of the probe rays through `camera` that first meet a front (lit) face.
+pub(crate) fn lit_share(scene: &Scene, camera: &Camera) -> f64 {
+    front_faces_seen(scene, camera) as f64 / (PROBE.0 * PROBE.1) as f64
+}
+
 /// How many of the probe rays through `camera` first meet a front (lit) face.
 pub(crate) fn front_faces_seen(scene: &Scene, camera: &Camera) -> usize {
     let rays = CameraRays::new(camera, PROBE.0 as u32, PROBE.1 as u32);

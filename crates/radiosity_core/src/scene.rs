@@ -663,6 +663,13 @@ impl Scene {
         self.camera.unwrap_or_else(|| crate::auto_camera::choose(self))
     }
 
+    /// The share of a coarse grid of rays through `camera` (48 of them) that first meet a lit
+    /// face: near 0 when the view looks at the backs of one-sided surfaces (a closed room
+    /// from outside) or at nothing, so that a black picture can be explained before it is made.
+    pub fn lit_share_seen_by(&self, camera: &Camera) -> f64 {
+        crate::auto_camera::lit_share(self, camera)
+    }
+
     /// Mesh parameters of the scene, or [`crate::MeshParams::for_extent`] of its bounds.
     pub fn mesh_params(&self) -> crate::MeshParams {
         self.mesh.unwrap_or_else(|| {
