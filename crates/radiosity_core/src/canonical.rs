@@ -3,7 +3,7 @@
 
 use glam::DVec3;
 
-use crate::scene::{Facing, Object, Polygon, Scene, Shape, SolverSettings, Sphere, box_faces};
+use crate::scene::{Facing, Object, Polygon, PolygonMesh, Scene, Shape, SolverSettings, Sphere, box_faces};
 use crate::{Camera, Material, MeshParams, Rgb};
 
 fn material(name: &str, rho: f64, emission: f64) -> Material {
@@ -168,6 +168,40 @@ pub fn two_sided_plate(rho: f64, e_below: f64, e_above: f64) -> Scene {
     .expect("plate scene is valid");
     s.mesh = Some(MeshParams::try_new(0.25, 1.0 / 16.0).expect("sizes > 0"));
     s
+}
+
+/// A UV sphere as a model mesh, outward facing: `segments` facets around (≥ 3) and
+/// `segments / 2` rings (≥ 2), triangles at the poles and quads between; one surface per
+/// facet once meshed, as a tessellated model from a file would be.
+///
+/// # Panics
+/// When `segments` < 4 or `radius` is not > 0.
+pub fn uv_sphere_mesh(center: DVec3, radius: f64, segments: usize) -> PolygonMesh {
+    assert!(segments >= 4 && radius > 0.0, "a sphere of 4+ segments and radius > 0");
+    let rings = segments / 2;
+    let point = |theta: f64, phi: f64| {
+        center + DVec3::new(theta.sin() * phi.cos(), -theta.cos(), theta.sin() * phi.sin()) * radius
+    };
+    let mut positions = vec![center - DVec3::Y * radius];
+    for r in 1..rings {
+        let theta = std::f64::consts::PI * r as f64 / rings as f64;
+        for k in 0..segments {
+            positions.push(point(theta, 2.0 * std::f64::consts::PI * k as f64 / segments as f64));
+        }
+    }
+    positions.push(center + DVec3::Y * radius);
+    let top = (positions.len() - 1) as u32;
+    let at = |r: usize, k: usize| (1 + (r - 1) * segments + k % segments) as u32;
+    let mut faces = Vec::new();
+    for k in 0..segments {
+        // Counter-clockwise seen from outside.
+        faces.push(vec![0, at(1, k), at(1, k + 1)]);
+        faces.push(vec![top, at(rings - 1, k + 1), at(rings - 1, k)]);
+        for r in 1..rings - 1 {
+            faces.push(vec![at(r, k), at(r + 1, k), at(r + 1, k + 1), at(r, k + 1)]);
+        }
+    }
+    PolygonMesh::try_new(positions, faces).expect("a UV sphere's facets are planar and convex")
 }
 
 fn polygon(points: &[[f64; 3]]) -> Polygon {

@@ -19,6 +19,7 @@ mod srgb;
 
 pub use canonical::{
     cornell_box, furnace_box, furnace_sphere, two_plates, two_sided_plate, unit_cube_floor_light,
+    uv_sphere_mesh,
 };
 pub use color::Rgb;
 pub use film::CameraRays;

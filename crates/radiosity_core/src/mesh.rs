@@ -215,25 +215,35 @@ pub struct Mesh {
 /// Which vertices of *different* surfaces share their radiosity in smooth shading: those in
 /// one place, on one object and one face of it, whose normals differ by less than the crease
 /// angle. Vertices are never shared across surfaces (light must not leak round a corner),
-/// so a tessellated curve — one surface per facet — would otherwise shade as facets. The test
-/// is made per vertex against each neighbour, not chained, so a run of slight bends never
-/// carries smoothing across a sharp crease (the usual crease-angle rule of modelling tools).
+/// so a tessellated curve — one surface per facet — would otherwise shade as facets, and two
+/// coplanar polygons of one object (the Cornell ceiling round its lamp) would show their
+/// common edge. The test is made per vertex against each neighbour, not chained, so a run of
+/// slight bends never carries smoothing across a sharp crease (the usual crease-angle rule of
+/// modelling tools).
+///
+/// Where the two surfaces' lattices do not meet point for point (a T-junction: a vertex of
+/// one lies inside an element edge of the other), the vertex pools with that edge's two ends
+/// in proportion to where it lies on it, so both sides show nearly the same value there.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Smoothing {
-    /// Per vertex, a range into `partners` (`offsets[v]..offsets[v + 1]`); empty when the
-    /// vertex pools with nobody (or the whole table is empty: no smoothing at all).
+    /// Per vertex, a range into `partners` and `weights` (`offsets[v]..offsets[v + 1]`);
+    /// empty when the vertex pools with nobody (or the whole table is empty: no smoothing).
     pub offsets: Vec<u32>,
     /// The vertices pooled with each vertex, itself not included.
     pub partners: Vec<u32>,
+    /// The weight of each partner's element sums: 1 for a vertex in the same place, the
+    /// linear-interpolation weight for the ends of an edge it lies on.
+    pub weights: Vec<f32>,
 }
 
 impl Smoothing {
-    /// The vertices pooled with vertex `v`.
-    pub fn partners_of(&self, v: usize) -> &[u32] {
-        match (self.offsets.get(v), self.offsets.get(v + 1)) {
-            (Some(&a), Some(&b)) => &self.partners[a as usize..b as usize],
-            _ => &[],
-        }
+    /// The vertices pooled with vertex `v`, with their weights.
+    pub fn partners_of(&self, v: usize) -> impl Iterator<Item = (u32, f64)> + '_ {
+        let range = match (self.offsets.get(v), self.offsets.get(v + 1)) {
+            (Some(&a), Some(&b)) => a as usize..b as usize,
+            _ => 0..0,
+        };
+        self.partners[range.clone()].iter().copied().zip(self.weights[range].iter().map(|&w| f64::from(w)))
     }
 
     /// The table for `mesh` with `crease_angle_deg` (0: none). Places are matched on a grid
@@ -251,50 +261,116 @@ impl Smoothing {
                 vertex_surface[v as usize] = surface;
             }
         }
+        // Two vertices may pool: other surfaces, the same object and face, a bend below the
+        // crease angle.
+        let compatible = |a: u32, b: u32| {
+            let (sa, sb) = (vertex_surface[a as usize], vertex_surface[b as usize]);
+            let (ta, tb) = (&mesh.surfaces[sa as usize], &mesh.surfaces[sb as usize]);
+            sa != sb
+                && ta.object == tb.object
+                && ta.back == tb.back
+                && mesh.shading_normals[a as usize].dot(mesh.shading_normals[b as usize]) > cos_limit
+        };
         let (lo, hi) = mesh.bounds();
-        let grid = 1e-7 * (hi - lo).length().max(f64::MIN_POSITIVE);
-        let mut places: HashMap<(u32, bool, [i64; 3]), Vec<u32>> = HashMap::new();
-        for (v, &s) in vertex_surface.iter().enumerate() {
-            if s == u32::MAX {
-                continue;
-            }
-            let surface = &mesh.surfaces[s as usize];
+        let diagonal = (hi - lo).length().max(f64::MIN_POSITIVE);
+        let grid = 1e-7 * diagonal;
+        let mut places: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+        for v in (0..mesh.positions.len()).filter(|&v| vertex_surface[v] != u32::MAX) {
             let p = mesh.positions[v];
-            let key = [p.x, p.y, p.z].map(|c| (c / grid).round() as i64);
-            places.entry((surface.object, surface.back, key)).or_default().push(v as u32);
+            places.entry([p.x, p.y, p.z].map(|c| (c / grid).round() as i64)).or_default().push(v as u32);
         }
-        let mut pairs: Vec<(u32, u32)> = Vec::new();
+        let mut pairs: Vec<(u32, u32, f32)> = Vec::new();
         for group in places.values().filter(|g| g.len() > 1) {
             for &a in group {
-                for &b in group {
-                    let (na, nb) = (mesh.shading_normals[a as usize], mesh.shading_normals[b as usize]);
-                    if a != b
-                        && vertex_surface[a as usize] != vertex_surface[b as usize]
-                        && na.dot(nb) > cos_limit
-                    {
-                        pairs.push((a, b));
-                    }
-                }
+                pairs.extend(group.iter().filter(|&&b| compatible(a, b)).map(|&b| (a, b, 1.0)));
             }
         }
+        t_junctions(mesh, &vertex_surface, 1e-6 * diagonal, &compatible, &mut pairs);
         if pairs.is_empty() {
             return Self::default();
         }
-        pairs.sort_unstable();
+        pairs.sort_unstable_by_key(|&(a, b, _)| (a, b));
         let mut offsets = Vec::with_capacity(mesh.positions.len() + 1);
         let mut partners = Vec::with_capacity(pairs.len());
+        let mut weights = Vec::with_capacity(pairs.len());
         let mut next = pairs.iter().peekable();
         for v in 0..mesh.positions.len() as u32 {
             offsets.push(partners.len() as u32);
-            while let Some(&&(a, b)) = next.peek()
+            while let Some(&&(a, b, w)) = next.peek()
                 && a == v
             {
                 partners.push(b);
+                weights.push(w);
                 next.next();
             }
         }
         offsets.push(partners.len() as u32);
-        Self { offsets, partners }
+        Self { offsets, partners, weights }
+    }
+}
+
+/// Adds to `pairs`, for every vertex on a surface's outline that lies strictly inside an
+/// outline edge (a, b) of another surface it may pool with (`compatible`), the pairs
+/// (v, a, 1 − t) and (v, b, t), t its place along the edge. Outline edges are element edges
+/// used once within their surface; they are found through a uniform grid of cells as large
+/// as the longest of them, so each vertex tests only the edges of its own cell.
+fn t_junctions(
+    mesh: &Mesh,
+    vertex_surface: &[u32],
+    tolerance: f64,
+    compatible: &dyn Fn(u32, u32) -> bool,
+    pairs: &mut Vec<(u32, u32, f32)>,
+) {
+    let mut uses: HashMap<(u32, u32), u32> = HashMap::new();
+    for el in &mesh.elements {
+        let v = el.vertex_indices();
+        for k in 0..v.len() {
+            let (a, b) = (v[k], v[(k + 1) % v.len()]);
+            *uses.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+    }
+    let outline: Vec<(u32, u32)> = uses.into_iter().filter(|&(_, n)| n == 1).map(|(e, _)| e).collect();
+    let longest = outline
+        .iter()
+        .map(|&(a, b)| mesh.positions[a as usize].distance(mesh.positions[b as usize]))
+        .fold(0.0, f64::max);
+    if outline.is_empty() || longest <= 0.0 {
+        return;
+    }
+    let cell = |p: DVec3| (p / longest).floor().as_i64vec3().to_array();
+    let mut cells: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
+    for (i, &(a, b)) in outline.iter().enumerate() {
+        let (pa, pb) = (mesh.positions[a as usize], mesh.positions[b as usize]);
+        let (lo, hi) =
+            (cell(pa.min(pb) - DVec3::splat(tolerance)), cell(pa.max(pb) + DVec3::splat(tolerance)));
+        for x in lo[0]..=hi[0] {
+            for y in lo[1]..=hi[1] {
+                for z in lo[2]..=hi[2] {
+                    cells.entry([x, y, z]).or_default().push(i);
+                }
+            }
+        }
+    }
+    let mut on_outline: Vec<u32> = outline.iter().flat_map(|&(a, b)| [a, b]).collect();
+    on_outline.sort_unstable();
+    on_outline.dedup();
+    for v in on_outline {
+        let p = mesh.positions[v as usize];
+        let Some(edges) = cells.get(&cell(p)) else { continue };
+        for &i in edges {
+            let (a, b) = outline[i];
+            if vertex_surface[a as usize] == vertex_surface[v as usize] || !compatible(v, a) {
+                continue;
+            }
+            let (pa, pb) = (mesh.positions[a as usize], mesh.positions[b as usize]);
+            let d = pb - pa;
+            let t = (p - pa).dot(d) / d.length_squared();
+            let end = tolerance / d.length();
+            if t > end && t < 1.0 - end && (pa + d * t).distance(p) < tolerance {
+                pairs.push((v, a, (1.0 - t) as f32));
+                pairs.push((v, b, t as f32));
+            }
+        }
     }
 }
 
@@ -1186,58 +1262,36 @@ mod tests {
         assert!(matches!(r, Err(MeshError::TooManyElements { .. })));
     }
 
-    /// A UV sphere of `segments` around and `segments / 2` rings, as a model mesh of
-    /// triangles and quads (one surface per facet).
-    fn tessellated_sphere(segments: usize) -> PolygonMesh {
-        let rings = segments / 2;
-        let mut positions = vec![DVec3::new(0.0, -1.0, 0.0)];
-        for r in 1..rings {
-            let theta = std::f64::consts::PI * r as f64 / rings as f64;
-            for k in 0..segments {
-                let phi = 2.0 * std::f64::consts::PI * k as f64 / segments as f64;
-                positions.push(DVec3::new(theta.sin() * phi.cos(), -theta.cos(), theta.sin() * phi.sin()));
-            }
-        }
-        positions.push(DVec3::new(0.0, 1.0, 0.0));
-        let top = (positions.len() - 1) as u32;
-        let at = |r: usize, k: usize| (1 + (r - 1) * segments + k % segments) as u32;
-        let mut faces = Vec::new();
-        for k in 0..segments {
-            faces.push(vec![0, at(1, k + 1), at(1, k)]);
-            faces.push(vec![top, at(rings - 1, k), at(rings - 1, k + 1)]);
-            for r in 1..rings - 1 {
-                faces.push(vec![at(r, k), at(r, k + 1), at(r + 1, k + 1), at(r + 1, k)]);
-            }
-        }
-        PolygonMesh::try_new(positions, faces).unwrap()
-    }
-
     /// A tessellated sphere pools every vertex with the facets around it; a box pools none
     /// (its 90° edges are creases); a crease angle of 0 pools nothing.
     #[test]
     fn smoothing_joins_facets_below_the_crease_angle_only() {
         let params = MeshParams::try_new(10.0, 10.0).unwrap();
-        let sphere = Mesh::build(&scene_of(Shape::Mesh(tessellated_sphere(24))), &params).unwrap();
+        let sphere =
+            Mesh::build(&scene_of(Shape::Mesh(crate::uv_sphere_mesh(DVec3::ZERO, 1.0, 24))), &params)
+                .unwrap();
         assert!(sphere.surfaces.len() > 100, "one surface per facet");
         // Every facet corner meets 3 or 4 other facets of the sphere (the poles 23).
         for v in 0..sphere.positions.len() {
-            let partners = sphere.smoothing.partners_of(v);
+            let partners: Vec<(u32, f64)> = sphere
+                .smoothing
+                .partners_of(v)
+                .filter(|&(u, _)| sphere.positions[u as usize] == sphere.positions[v])
+                .collect();
             assert!(partners.len() >= 3, "vertex {v}: {partners:?}");
-            for &u in partners {
-                assert!(sphere.positions[u as usize].distance(sphere.positions[v]) < 1e-12);
-            }
         }
         let faces = box_faces(DVec3::ZERO, DVec3::ONE, Facing::Outward, 0.0).unwrap();
         let cube = Mesh::build(&scene_of(Shape::Polygons(faces)), &params).unwrap();
         assert_eq!(cube.smoothing, Smoothing::default(), "a box's edges stay sharp");
         let flat = Mesh::build(
-            &scene_of(Shape::Mesh(tessellated_sphere(24))),
+            &scene_of(Shape::Mesh(crate::uv_sphere_mesh(DVec3::ZERO, 1.0, 24))),
             &params.with_crease_angle(0.0).unwrap(),
         )
         .unwrap();
         assert_eq!(flat.smoothing, Smoothing::default());
         // 4 segments make an octahedron: 70.5° between neighbouring facets, above 40°.
-        let coarse = Mesh::build(&scene_of(Shape::Mesh(tessellated_sphere(4))), &params).unwrap();
+        let coarse =
+            Mesh::build(&scene_of(Shape::Mesh(crate::uv_sphere_mesh(DVec3::ZERO, 1.0, 4))), &params).unwrap();
         assert_eq!(coarse.smoothing, Smoothing::default());
         assert!(params.with_crease_angle(180.0).is_err() && params.with_crease_angle(f64::NAN).is_err());
     }

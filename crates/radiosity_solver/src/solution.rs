@@ -92,9 +92,11 @@ pub(crate) fn vertex_average(mesh: &Mesh, element_values: &[Rgb], vertex_area: &
     }
     (0..sums.len())
         .map(|v| {
-            let partners = mesh.smoothing.partners_of(v);
-            let sum = partners.iter().fold(sums[v], |s, &u| s + sums[u as usize]);
-            let area = partners.iter().fold(vertex_area[v], |a, &u| a + vertex_area[u as usize]);
+            let (mut sum, mut area) = (sums[v], vertex_area[v]);
+            for (u, w) in mesh.smoothing.partners_of(v) {
+                sum += sums[u as usize] * w;
+                area += vertex_area[u as usize] * w;
+            }
             if area > 0.0 { sum / area } else { sum }
         })
         .collect()
