@@ -194,6 +194,8 @@ pub(crate) struct MeshDesc {
     pub(crate) patch_size: Spanned<f64>,
     /// Longest element edge, scene units, > 0.
     pub(crate) element_size: Spanned<f64>,
+    /// Smooth shading joins facets of one object bent by less than this, degrees in [0, 180).
+    pub(crate) crease_angle: Option<Spanned<f64>>,
 }
 
 /// `[solver]`.

@@ -722,13 +722,19 @@ fn mesh_object(
 }
 
 fn mesh_params(loc: &Locator, d: &MeshDesc) -> Result<MeshParams, LoadError> {
-    MeshParams::try_new(*d.patch_size.get_ref(), *d.element_size.get_ref()).map_err(|e| {
+    let params = MeshParams::try_new(*d.patch_size.get_ref(), *d.element_size.get_ref()).map_err(|e| {
         let (field, span) = match e {
             SceneError::BadMeshSize { key: "patch_size", .. } => ("patch_size", d.patch_size.span()),
             _ => ("element_size", d.element_size.span()),
         };
         loc.at(span, format!("mesh.{field}"), e.to_string())
-    })
+    })?;
+    match &d.crease_angle {
+        Some(a) => params
+            .with_crease_angle(*a.get_ref())
+            .map_err(|e| loc.at(a.span(), "mesh.crease_angle", e.to_string())),
+        None => Ok(params),
+    }
 }
 
 fn solver_settings(loc: &Locator, d: &SolverDesc) -> Result<SolverSettings, LoadError> {

@@ -333,3 +333,17 @@ fn duplicate_faces_are_dropped_with_a_warning() {
         parse_model(single.as_bytes(), "one.obj", None, ModelFormat::Obj, &Transform::default()).unwrap();
     assert!(clean.warnings.iter().all(|w| !w.contains("duplicate")), "{:?}", clean.warnings);
 }
+
+/// `[mesh] crease_angle` sets the smoothing limit; outside [0, 180) it is an error at its line.
+#[test]
+fn the_crease_angle_comes_from_the_mesh_table() {
+    let base = "[[material]]\nname = \"l\"\nreflectance = [0, 0, 0]\nemission = [1, 1, 1]\n\
+                [[object]]\nname = \"o\"\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"l\"\n\
+                [mesh]\npatch_size = 1\nelement_size = 0.5\n";
+    let scene = parse_scene(&format!("{base}crease_angle = 15\n"), "c.toml").unwrap().scene;
+    assert_eq!(scene.mesh.unwrap().crease_angle_deg, 15.0);
+    let default = parse_scene(base, "d.toml").unwrap().scene;
+    assert_eq!(default.mesh.unwrap().crease_angle_deg, radiosity_core::DEFAULT_CREASE_ANGLE_DEG);
+    let err = parse_scene(&format!("{base}crease_angle = 180\n"), "e.toml").unwrap_err().to_string();
+    assert!(err.starts_with("e.toml:14:") && err.contains("mesh.crease_angle"), "{err}");
+}
