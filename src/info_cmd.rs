@@ -39,6 +39,7 @@ pub fn run(a: InfoArgs) -> Result<()> {
         (0..mesh.elements.len()).map(|e| mesh.element_material(e).emission * mesh.elements[e].area).sum();
     let _ = writeln!(out, "emitted    [{:.6e}, {:.6e}, {:.6e}] W", emitted.r, emitted.g, emitted.b);
     let mut warnings = Vec::new();
+    let has_light = no_light.is_none();
     if let Some(e) = no_light {
         warnings.push(format!("no light: a solve would be black; {}", radiosity_core::one_line(&e)));
     }
@@ -57,6 +58,22 @@ pub fn run(a: InfoArgs) -> Result<()> {
     }
     if mesh.elements.len() > 1_000_000 {
         warnings.push(format!("{} elements: solving will be slow; raise element_size", mesh.elements.len()));
+    }
+    // Large flat surfaces that no light is in front of, summed per object.
+    let total = mesh.total_area();
+    let mut away = vec![0.0; mesh.object_names.len()];
+    for (surface, area) in mesh.surfaces.iter().zip(mesh.area_facing_away_from_light()) {
+        if area > 0.05 * total {
+            away[surface.object as usize] += area;
+        }
+    }
+    for (name, away) in mesh.object_names.iter().zip(away) {
+        if has_light && away > 0.0 {
+            warnings.push(format!(
+                "object '{name}': one-sided surfaces making {:.0} % of the scene's area face away from every light, so they get no direct light; if they should, flip their normals or make them two-sided (sides = 2, --sides 2)",
+                away / total * 100.0
+            ));
+        }
     }
     if scene.camera.is_none() {
         warnings.push("no [camera]: views frame the whole scene".into());

@@ -385,5 +385,15 @@ pub fn run_solver(p: &Prepared) -> Result<(Solver, StepReport)> {
         bar.set_message(message);
     };
     bar.finish_and_clear();
+    // A light behind a wall or facing out of the scene: everything it emitted escaped and the
+    // converged picture is black. Say why instead of leaving it to be guessed.
+    let energy = solver.energy();
+    let emitted = energy.emitted.max_channel();
+    // Every surface absorbs (1 − ρ) > 0 of what reaches it: nothing absorbed, most escaped.
+    if energy.absorbed.max_channel() <= 1e-9 * emitted && energy.escaped.max_channel() >= 0.5 * emitted {
+        crate::output::note(format_args!(
+            "warning: no light reached any surface: all the emitted power left the scene. Is the light behind a wall or above a ceiling, or facing away from the scene (emission leaves the front face, the side its normal points to)?"
+        ))?;
+    }
     Ok((solver, report))
 }

@@ -400,3 +400,35 @@ fn a_camera_that_sees_no_lit_face_is_warned_about() {
     assert!(default.status.success(), "{}", stderr(&default));
     assert!(!stderr(&default).contains("lit face"), "{}", stderr(&default));
 }
+
+/// A room modelled with its walls facing out: `info` says which object faces away from every
+/// light; a lamp above the ceiling: `solve` says no light reached any surface. The Cornell box
+/// gets neither warning.
+#[test]
+fn dark_by_construction_scenes_are_explained() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = |normals: &str, lamp_y: f64| {
+        format!(
+            "[[material]]\nname = \"l\"\nreflectance = [0, 0, 0]\nemission = [1, 1, 1]\n\
+             [[material]]\nname = \"w\"\nreflectance = [0.5, 0.5, 0.5]\n\
+             [[object]]\nname = \"room\"\ntype = \"box\"\nmin = [0, 0, 0]\nmax = [4, 3, 5]\nnormals = \"{normals}\"\nmaterial = \"w\"\n\
+             [[object]]\nname = \"lamp\"\ntype = \"polygon\"\nmaterial = \"l\"\n\
+             vertices = [[1, {lamp_y}, 1], [2, {lamp_y}, 1], [2, {lamp_y}, 2], [1, {lamp_y}, 2]]\n"
+        )
+    };
+    let inside_out = dir.path().join("inside_out.toml");
+    std::fs::write(&inside_out, scene("outward", 2.9)).unwrap();
+    let o = radiosity(&["info", inside_out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("object 'room'") && text.contains("face away from every light"), "{text}");
+    let above = dir.path().join("above.toml");
+    std::fs::write(&above, scene("inward", 3.2)).unwrap();
+    let o = radiosity(&["solve", above.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("warning: no light reached any surface"), "{}", stderr(&o));
+    let info = radiosity(&["info", "cornell"]);
+    assert!(!String::from_utf8_lossy(&info.stdout).contains("face away"));
+    let solve = radiosity(&["solve", "cornell", "--max-shots", "20"]);
+    assert!(!stderr(&solve).contains("no light reached"), "{}", stderr(&solve));
+}

@@ -1004,6 +1004,36 @@ impl Mesh {
         })
     }
 
+    /// Per surface, the area of its one-sided, non-emitting patches that no emitter lies in
+    /// front of (every corner of every emitting patch on or behind the patch's plane, some
+    /// strictly behind): they
+    /// can receive only reflected light, never direct light, whatever is in between. A large
+    /// flat surface like that usually has its normals the wrong way round (a room's walls
+    /// modelled facing out); a curved object's far side is many small surfaces.
+    pub fn area_facing_away_from_light(&self) -> Vec<f64> {
+        let mut away = vec![0.0; self.surfaces.len()];
+        let emitting =
+            |p: &Patch| self.materials[self.surfaces[p.surface as usize].material as usize].is_emitter();
+        let lamps: Vec<DVec3> =
+            self.patches.iter().filter(|p| emitting(p)).flat_map(|p| p.corners().to_vec()).collect();
+        let (lo, hi) = self.bounds();
+        let margin = 1e-9 * (hi - lo).length();
+        for p in self.patches.iter().filter(|p| !emitting(p)) {
+            let surface = &self.surfaces[p.surface as usize];
+            // A lamp in the surface's own plane (the Cornell lamp in its ceiling) lights it
+            // no more than one behind it, but it is no sign of a wrong normal: it needs one
+            // lamp point strictly behind.
+            let side = |q: &DVec3| p.normal.dot(*q - p.centre);
+            if surface.twin.is_none()
+                && lamps.iter().all(|q| side(q) <= margin)
+                && lamps.iter().any(|q| side(q) < -margin)
+            {
+                away[p.surface as usize] += p.area;
+            }
+        }
+        away
+    }
+
     /// Total area, scene units².
     pub fn total_area(&self) -> f64 {
         self.elements.iter().map(|e| e.area).sum()
@@ -1294,5 +1324,42 @@ mod tests {
             Mesh::build(&scene_of(Shape::Mesh(crate::uv_sphere_mesh(DVec3::ZERO, 1.0, 4))), &params).unwrap();
         assert_eq!(coarse.smoothing, Smoothing::default());
         assert!(params.with_crease_angle(180.0).is_err() && params.with_crease_angle(f64::NAN).is_err());
+    }
+
+    /// The furnace's walls face each other: none faces away from the light. Turned inside out
+    /// (outward walls, lit by one of them), every wall but the lamp's faces away from it.
+    #[test]
+    fn walls_facing_away_from_every_emitter_are_found() {
+        let params = MeshParams::try_new(0.5, 0.5).unwrap();
+        let inward = box_faces(DVec3::ZERO, DVec3::ONE, Facing::Inward, 0.0).unwrap();
+        let room = Mesh::build(&scene_of(Shape::Polygons(inward)), &params).unwrap();
+        assert_eq!(room.area_facing_away_from_light(), vec![0.0; 6]);
+        let outward = box_faces(DVec3::ZERO, DVec3::ONE, Facing::Outward, 0.0).unwrap();
+        let lamp = Material::try_new("lamp", Rgb::ZERO, Rgb::ONE).unwrap();
+        let grey = Material::try_new("grey", Rgb::splat(0.5), Rgb::ZERO).unwrap();
+        let floor = Polygon::try_new(vec![
+            DVec3::new(0.2, 0.1, 0.2),
+            DVec3::new(0.8, 0.1, 0.2),
+            DVec3::new(0.8, 0.1, 0.8),
+            DVec3::new(0.2, 0.1, 0.8),
+        ])
+        .unwrap();
+        let scene = Scene::try_new(
+            "inside out",
+            None,
+            vec![lamp, grey],
+            vec![
+                Object::new("walls", 1, Shape::Polygons(outward)),
+                Object::new("lamp", 0, Shape::Polygons(vec![floor])),
+            ],
+        )
+        .unwrap();
+        let mesh = Mesh::build(&scene, &params).unwrap();
+        let away = mesh.area_facing_away_from_light();
+        // The lamp faces down (counter-clockwise from below is clockwise from above): the
+        // walls' outward faces, one surface each, all have it behind them.
+        assert_eq!(away.len(), 7);
+        assert!(away[..6].iter().all(|a| (a - 1.0).abs() < 1e-9), "{away:?}");
+        assert_eq!(away[6], 0.0, "emitters are not counted");
     }
 }
