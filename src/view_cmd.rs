@@ -38,8 +38,8 @@ pub enum WireframeArg {
 /// Arguments of `radiosity view`.
 #[derive(Args)]
 pub struct ViewArgs {
-    /// Scene file (.toml) or built-in name.
-    #[arg(default_value = "cornell")]
+    /// The scene to load: see [`SCENE_HELP`](crate::prepare::SCENE_HELP).
+    #[arg(help = crate::prepare::SCENE_HELP, default_value = "cornell")]
     pub scene: String,
     /// Write the window's content to this PNG once the solve has done --after-shots shots (or
     /// has stopped, without it), then exit. Runs headless under scripts/xvfb-run.sh.
