@@ -15,7 +15,8 @@ use crate::render_cmd::{GatherArg, ToneOpts};
 /// Arguments of `radiosity export`.
 #[derive(Args)]
 pub struct ExportArgs {
-    /// Scene file (.toml), model file (.obj, .gltf, .glb) or built-in name.
+    /// The scene to load: see [`SCENE_HELP`](crate::prepare::SCENE_HELP).
+    #[arg(help = crate::prepare::SCENE_HELP)]
     pub scene: String,
     /// Lit mesh to write: .glb, .gltf (buffer embedded) or .ply (binary little endian).
     #[arg(short = 'o', long = "output")]

@@ -6,22 +6,26 @@ use anyhow::Result;
 use clap::Args;
 use radiosity_core::Rgb;
 
-use crate::prepare::{SolveOpts, prepare_unlit};
+use crate::prepare::{MeshOpts, SolveOpts, prepare_unlit};
 
 /// Arguments of `radiosity info`.
 #[derive(Args)]
 pub struct InfoArgs {
-    /// Scene file (.toml), model file (.obj, .gltf, .glb) or built-in name.
+    /// The scene to load: see [`SCENE_HELP`](crate::prepare::SCENE_HELP).
+    #[arg(help = crate::prepare::SCENE_HELP)]
     pub scene: String,
     #[command(flatten)]
-    pub solve: SolveOpts,
+    pub mesh: MeshOpts,
+    /// Multiply every emission by this (the emitted power reported).
+    #[arg(long, allow_negative_numbers = true, default_value_t = 1.0)]
+    pub light_scale: f64,
 }
 
 /// Runs `info`.
 pub fn run(a: InfoArgs) -> Result<()> {
     // A model without a light yet is described all the same: the light is what `info` says
     // is missing.
-    let (p, no_light) = prepare_unlit(&a.scene, &a.solve)?;
+    let (p, no_light) = prepare_unlit(&a.scene, &SolveOpts::with_mesh(a.mesh, a.light_scale))?;
     let (scene, mesh) = (&p.scene, p.problem.mesh());
     // One text, one write: a closed pipe or a full disk is one error, not a panic.
     let mut out = String::new();

@@ -52,9 +52,15 @@ pub enum FormFactorArg {
     Point,
 }
 
-/// Options shared by every command that solves; each overrides the scene file.
+/// Help of every command's SCENE argument: each form [`radiosity_io::resolve_scene_with`]
+/// takes, so that none of them is a surprise.
+pub const SCENE_HELP: &str = "A scene file (.toml), a model file (.obj with its .mtl, .gltf, .glb) or a built-in \
+                              name (cornell, furnace, seed-room, two-plates)";
+
+/// Options that decide the mesh, shared by every command that meshes a scene; each
+/// overrides the scene file. `info` takes only these: it counts, it does not solve.
 #[derive(Args, Clone, Debug)]
-pub struct SolveOpts {
+pub struct MeshOpts {
     /// Longest patch edge, scene units (overrides the scene's [mesh]).
     #[arg(long, allow_negative_numbers = true)]
     pub patch_size: Option<f64>,
@@ -66,6 +72,18 @@ pub struct SolveOpts {
     /// crease_angle, else 40].
     #[arg(long, allow_negative_numbers = true, value_name = "DEGREES")]
     pub crease_angle: Option<f64>,
+    /// Sides of every object from a model file (an OBJ or glTF given as SCENE, `mesh`
+    /// objects): 1 (front faces only) or 2 (both faces receive and reflect), over what the
+    /// file and the scene file say [default: OBJ two-sided, glTF as its doubleSided flag].
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=2), value_name = "1|2")]
+    pub sides: Option<u8>,
+}
+
+/// Options shared by every command that solves; each overrides the scene file.
+#[derive(Args, Clone, Debug)]
+pub struct SolveOpts {
+    #[command(flatten)]
+    pub mesh: MeshOpts,
     /// Stop when unshot power / emitted power falls to this, in (0, 1) [default: the scene's
     /// [solver], else the solver's default, 1e-3].
     #[arg(long, allow_negative_numbers = true)]
@@ -113,11 +131,21 @@ pub struct SolveOpts {
     /// off).
     #[arg(long)]
     pub ambient: bool,
-    /// Sides of every object from a model file (an OBJ or glTF given as SCENE, `mesh`
-    /// objects): 1 (front faces only) or 2 (both faces receive and reflect), over what the
-    /// file and the scene file say [default: OBJ two-sided, glTF as its doubleSided flag].
-    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=2), value_name = "1|2")]
-    pub sides: Option<u8>,
+}
+
+impl SolveOpts {
+    /// The solve options of a command line that gives only `mesh` and `light_scale`: every
+    /// other option at the default its `#[arg]` declares, so the defaults live in one place.
+    pub fn with_mesh(mesh: MeshOpts, light_scale: f64) -> Self {
+        /// A command line of solve options alone, to read their defaults from.
+        #[derive(clap::Parser)]
+        struct Defaults {
+            #[command(flatten)]
+            solve: SolveOpts,
+        }
+        let defaults = <Defaults as clap::Parser>::parse_from(["radiosity"]).solve;
+        SolveOpts { mesh, light_scale, ..defaults }
+    }
 }
 
 impl From<FormFactorMethod> for FormFactorArg {
@@ -200,7 +228,7 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
     // A model file given where a scene is expected loads as a scene of its parts; what the
     // loader dropped or defaulted (degenerate faces, a missing MTL) is said once, here.
     let options = radiosity_io::LoadOptions {
-        model_sides: o.sides.map(|n| match n {
+        model_sides: o.mesh.sides.map(|n| match n {
             1 => radiosity_core::Sides::One,
             _ => radiosity_core::Sides::Two { emits_back: false },
         }),
@@ -217,14 +245,14 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
     }
     check_light_scale(&scene, o.light_scale)?;
     let base = scene.mesh_params();
-    let patch = o.patch_size.unwrap_or(base.patch_size);
-    let element = o.element_size.unwrap_or(if o.patch_size.is_some() {
+    let patch = o.mesh.patch_size.unwrap_or(base.patch_size);
+    let element = o.mesh.element_size.unwrap_or(if o.mesh.patch_size.is_some() {
         patch.min(base.element_size)
     } else {
         base.element_size
     });
     let mesh_params = MeshParams::try_new(patch, element)
-        .and_then(|m| m.with_crease_angle(o.crease_angle.unwrap_or(base.crease_angle_deg)))
+        .and_then(|m| m.with_crease_angle(o.mesh.crease_angle.unwrap_or(base.crease_angle_deg)))
         .map_err(|e| input(format!("mesh options: {e}")))?;
     // The scene file's limit is checked (with its line) by the loader; this is the option's.
     let time_limit = match o.time_limit.or(scene.solver.time_limit) {
@@ -396,4 +424,32 @@ pub fn run_solver(p: &Prepared) -> Result<(Solver, StepReport)> {
         ))?;
     }
     Ok((solver, report))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The SCENE help names every built-in scene the loader knows, and no other.
+    #[test]
+    fn scene_help_names_every_builtin() {
+        let listed = SCENE_HELP.rsplit_once('(').unwrap().1.trim_end_matches(')');
+        let listed: Vec<&str> = listed.split(", ").collect();
+        assert_eq!(listed, radiosity_io::BUILTIN_SCENES);
+    }
+
+    /// `info`'s solve options are the declared defaults with its own mesh options and scale.
+    #[test]
+    fn solve_options_from_mesh_options_keep_the_declared_defaults() {
+        let mesh =
+            MeshOpts { patch_size: Some(50.0), element_size: None, crease_angle: Some(0.0), sides: Some(1) };
+        let o = SolveOpts::with_mesh(mesh, 2.0);
+        assert_eq!((o.mesh.patch_size, o.mesh.crease_angle, o.mesh.sides), (Some(50.0), Some(0.0), Some(1)));
+        assert_eq!(o.light_scale, 2.0);
+        let d = SolverParams::default();
+        assert_eq!(
+            (o.seed, o.visibility_rays, o.max_shots, o.threads),
+            (d.seed, d.visibility_rays, None, None)
+        );
+    }
 }

@@ -87,7 +87,8 @@ pub struct ToneOpts {
 /// Arguments of `radiosity render`.
 #[derive(Args)]
 pub struct RenderArgs {
-    /// Scene file (.toml) or built-in name (cornell, furnace, seed-room, two-plates).
+    /// The scene to load: see [`SCENE_HELP`](crate::prepare::SCENE_HELP).
+    #[arg(help = crate::prepare::SCENE_HELP)]
     pub scene: String,
     /// Tone-mapped 8-bit sRGB picture to write: PNG (.png) or JPEG (.jpg, .jpeg).
     #[arg(short = 'o', long = "output")]

@@ -10,7 +10,8 @@ use crate::prepare::{Prepared, SolveOpts, prepare, run_solver};
 /// Arguments of `radiosity solve`.
 #[derive(Args)]
 pub struct SolveArgs {
-    /// Scene file (.toml) or built-in name (cornell, furnace, seed-room, two-plates).
+    /// The scene to load: see [`SCENE_HELP`](crate::prepare::SCENE_HELP).
+    #[arg(help = crate::prepare::SCENE_HELP)]
     pub scene: String,
     /// Write the JSON report here (`-` for stdout).
     #[arg(long)]

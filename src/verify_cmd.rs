@@ -23,7 +23,8 @@ use crate::prepare::{InputError, Prepared, SolveOpts, prepare, run_solver};
 /// Arguments of `radiosity verify`.
 #[derive(Args)]
 pub struct VerifyArgs {
-    /// Scene file (.toml), model file or built-in name (cornell, furnace, seed-room, two-plates).
+    /// The scene to load: see [`SCENE_HELP`](crate::prepare::SCENE_HELP).
+    #[arg(help = crate::prepare::SCENE_HELP)]
     pub scene: String,
     /// Paths per object for the reference (a fixed count); default: as many as it takes to
     /// bring every channel's standard error to --stderr-target of its mean (at most 2^26).

@@ -38,8 +38,8 @@ pub enum WireframeArg {
 /// Arguments of `radiosity view`.
 #[derive(Args)]
 pub struct ViewArgs {
-    /// Scene file (.toml) or built-in name.
-    #[arg(default_value = "cornell")]
+    /// The scene to load: see [`SCENE_HELP`](crate::prepare::SCENE_HELP).
+    #[arg(help = crate::prepare::SCENE_HELP, default_value = "cornell")]
     pub scene: String,
     /// Write the window's content to this PNG once the solve has done --after-shots shots (or
     /// has stopped, without it), then exit. Runs headless under scripts/xvfb-run.sh.
@@ -121,5 +121,22 @@ pub fn run(a: ViewArgs) -> Result<()> {
         }
     };
     options.operator = a.tone.tonemap.into();
+    options.command = command_line();
     radiosity_viewer::run(options)
+}
+
+/// This process's command line as the user would type it again (`radiosity view …`, with
+/// its options), for the error that says to run it under a virtual display.
+fn command_line() -> String {
+    let quote = |arg: String| {
+        if !arg.is_empty() && arg.chars().all(|c| c.is_ascii_alphanumeric() || "-_./=:,+@%".contains(c)) {
+            arg
+        } else {
+            format!("'{}'", arg.replace('\'', r"'\''"))
+        }
+    };
+    std::iter::once("radiosity".to_owned())
+        .chain(std::env::args().skip(1).map(quote))
+        .collect::<Vec<_>>()
+        .join(" ")
 }

@@ -130,6 +130,29 @@ fn info_prints_counts_and_power() {
     }
 }
 
+/// `info` counts and does not solve: it takes the mesh options and the light scale, which
+/// change what it prints, and refuses the solver's options as unknown (exit code 2).
+#[test]
+fn info_takes_mesh_options_only() {
+    let value = |args: &[&str], key: &str| {
+        let o = radiosity(args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let out = String::from_utf8_lossy(&o.stdout).into_owned();
+        out.lines().find_map(|l| l.strip_prefix(key)).unwrap_or_else(|| panic!("{out}")).trim().to_owned()
+    };
+    let elements = |args: &[&str]| value(args, "elements").parse::<usize>().unwrap();
+    assert!(elements(&["info", "cornell", "--element-size", "70"]) < elements(&["info", "cornell"]));
+    assert_ne!(
+        value(&["info", "cornell", "--light-scale", "2"], "emitted"),
+        value(&["info", "cornell"], "emitted")
+    );
+    for solver_option in [&["--max-shots", "5"][..], &["--seed", "3"], &["--ambient"], &["--threads", "1"]] {
+        let o = radiosity(&[&["info", "cornell"][..], solver_option].concat());
+        assert_eq!(o.status.code(), Some(2), "info took {solver_option:?}");
+        assert!(stderr(&o).contains(solver_option[0]), "{}", stderr(&o));
+    }
+}
+
 /// The furnace rendered from inside through `render --pfm`: every pixel holds the linear
 /// radiance L = E / ((1 − ρ) π) = 2/π; 1 % covers the 1e-3 unshot remainder and quadrature.
 #[test]

@@ -145,3 +145,31 @@ fn view_of_a_bad_file_fails_with_the_loader_error() {
     assert!(stderr.starts_with("error: ") && stderr.trim_end().lines().count() == 1, "{stderr}");
     assert!(stderr.contains("bad.toml:"), "names the file: {stderr}");
 }
+
+/// Without a display, `view` fails at once and its first line says what to do — run it under
+/// the virtual display script — before winit's cause, which loses the path into winit's
+/// source that its message carries.
+#[test]
+fn without_a_display_the_error_says_to_use_xvfb_first() {
+    let out = Command::new(env!("CARGO_BIN_EXE_radiosity"))
+        .args(["view", "cornell"])
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .env_remove("WAYLAND_SOCKET")
+        .stdin(Stdio::null())
+        .output()
+        .expect("run radiosity view");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "view without a display succeeded:\n{stderr}");
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    let first = stderr.lines().next().unwrap_or_default();
+    assert!(
+        first.starts_with("error: no display to open a window on")
+            && first.contains("scripts/xvfb-run.sh radiosity view cornell"),
+        "{stderr}"
+    );
+    let cause = first.split_once("(cause: ").map(|(_, c)| c).unwrap_or_default();
+    assert!(cause.contains("DISPLAY"), "the cause is gone: {stderr}");
+    assert!(!stderr.contains(".cargo/registry") && !stderr.contains("panicked"), "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+}

@@ -11,7 +11,9 @@
 //!   [`VertexColours`] for what `COLOR_0` holds.
 //! * PLY: binary little endian; per vertex `float x y z`, `uchar red green blue` (sRGB-encoded
 //!   display colour, what PLY viewers show) and `float radiosity_r radiosity_g radiosity_b`
-//!   (linear B); faces are the elements (triangles and quads) as `list uchar uint`.
+//!   (linear B); faces are the elements' triangles (a quad element gives two, as in glTF) as
+//!   `list uchar uint`: triangles only, because common readers (trimesh among them) refuse a
+//!   face list that mixes triangles and quads.
 //! * Lightmaps: see [`write_lightmaps`].
 //!
 //! Scene files come in through `radiosity_io`; lit meshes go out here, so the scene loader
@@ -240,7 +242,8 @@ pub fn glb_bytes(mesh: &Mesh, solution: &Solution, mode: VertexColours) -> Vec<u
 }
 
 /// A binary little-endian PLY of the element mesh: display colour as `uchar` and linear
-/// radiosity as `float` per vertex; `display` sets the tone mapping of the former.
+/// radiosity as `float` per vertex; `display` sets the tone mapping of the former. Faces are
+/// triangles only ([`Mesh::element_triangles`], the split the glTF output uses).
 pub fn ply_bytes(mesh: &Mesh, solution: &Solution, display: ToneParams) -> Vec<u8> {
     let shown = vertex_colours(solution, VertexColours::Display(display));
     let mut header = String::new();
@@ -256,7 +259,7 @@ pub fn ply_bytes(mesh: &Mesh, solution: &Solution, display: ToneParams) -> Vec<u
         display.operator,
         display.exposure_ev,
         mesh.positions.len(),
-        mesh.elements.len()
+        mesh.element_triangles().count()
     );
     let mut out = header.into_bytes();
     for (v, p) in mesh.positions.iter().enumerate() {
@@ -268,9 +271,9 @@ pub fn ply_bytes(mesh: &Mesh, solution: &Solution, display: ToneParams) -> Vec<u
             out.extend_from_slice(&(c as f32).to_le_bytes());
         }
     }
-    for e in &mesh.elements {
-        out.push(e.vertex_count);
-        for &i in e.vertex_indices() {
+    for (_, triangle) in mesh.element_triangles() {
+        out.push(3);
+        for i in triangle {
             out.extend_from_slice(&i.to_le_bytes());
         }
     }

@@ -126,11 +126,26 @@ fn ply_holds_display_colours_and_radiosity() {
     let header = std::str::from_utf8(&bytes[..end]).unwrap();
     assert!(header.starts_with("ply\nformat binary_little_endian 1.0\n"));
     assert!(header.contains(&format!("element vertex {}\n", mesh.positions.len())));
-    assert!(header.contains(&format!("element face {}\n", mesh.elements.len())));
+    // A quad element is two triangles, a triangle element one: the Cornell box has both.
+    let triangles: usize = mesh.elements.iter().map(|e| e.vertex_count as usize - 2).sum();
+    assert!(triangles > mesh.elements.len(), "the box has quad elements");
+    assert!(header.contains(&format!("element face {triangles}\n")), "{header}");
     // 3 floats, 3 bytes, 3 floats per vertex; then each face: a count byte and its indices.
     let vertex_size = 12 + 3 + 12;
-    let faces: usize = mesh.elements.iter().map(|e| 1 + 4 * e.vertex_count as usize).sum();
-    assert_eq!(bytes.len(), end + vertex_size * mesh.positions.len() + faces);
+    let faces_at = end + vertex_size * mesh.positions.len();
+    assert_eq!(bytes.len(), faces_at + triangles * (1 + 3 * 4));
+    // Every face has 3 indices, and the faces are the elements' triangles, in order.
+    let expected: Vec<[u32; 3]> = mesh.element_triangles().map(|(_, t)| t).collect();
+    let mut area = 0.0;
+    for (face, want) in bytes[faces_at..].chunks_exact(13).zip(&expected) {
+        assert_eq!(face[0], 3, "a face that is not a triangle");
+        let index = |k: usize| u32::from_le_bytes(face[1 + 4 * k..5 + 4 * k].try_into().unwrap());
+        assert_eq!([index(0), index(1), index(2)], *want);
+        let [a, b, c] = want.map(|i| mesh.positions[i as usize]);
+        area += 0.5 * (b - a).cross(c - a).length();
+    }
+    // The two halves of each quad cover it: the faces' area is the elements' area.
+    assert!((area - mesh.total_area()).abs() < 1e-9 * mesh.total_area(), "{area} vs {}", mesh.total_area());
     let shown = vertex_colours(&solution, VertexColours::Display(tone));
     for v in [0, mesh.positions.len() / 2, mesh.positions.len() - 1] {
         let at = end + v * vertex_size;

@@ -65,6 +65,9 @@ pub struct ViewerOptions {
     pub exposure_ev: Option<f64>,
     /// Tone-map operator at start.
     pub operator: radiosity_image::ToneOperator,
+    /// The command line that opened the viewer, as the user would type it again: the error
+    /// when no window can be opened shows it under `scripts/xvfb-run.sh`.
+    pub command: String,
 }
 
 impl ViewerOptions {
@@ -87,6 +90,7 @@ impl ViewerOptions {
             wireframe: Wireframe::Off,
             exposure_ev: None,
             operator: radiosity_image::ToneOperator::Aces,
+            command: format!("radiosity view {scene_label}"),
         }
     }
 }
@@ -114,6 +118,7 @@ pub fn run(options: ViewerOptions) -> anyhow::Result<()> {
         dithering: false,
         ..Default::default()
     };
+    let command = options.command.clone();
     let outcome: app::Outcome = Arc::new(Mutex::new(None));
     let app_outcome = outcome.clone();
     eframe::run_native(
@@ -124,18 +129,44 @@ pub fn run(options: ViewerOptions) -> anyhow::Result<()> {
             Ok(Box::new(app))
         }),
     )
-    .map_err(|e| {
-        let headless = std::env::var_os("DISPLAY").is_none() && std::env::var_os("WAYLAND_DISPLAY").is_none();
-        if headless {
-            anyhow::anyhow!(
-                "cannot open the viewer window: {e} (no display: run it under scripts/xvfb-run.sh)"
-            )
-        } else {
-            anyhow::anyhow!("cannot open the viewer window: {e}")
-        }
-    })?;
+    .map_err(|e| window_error(&e, &command))?;
     let result = outcome.lock().unwrap_or_else(|e| e.into_inner()).take();
     result.unwrap_or(Ok(()))
+}
+
+/// The error for a window that could not be opened. Without a display (none set, or one
+/// that cannot be reached) what to do comes first, then the cause as winit gives it, without
+/// the location in winit's source that its message carries.
+fn window_error(e: &eframe::Error, command: &str) -> anyhow::Error {
+    let cause = without_source_locations(&e.to_string());
+    match e {
+        eframe::Error::Winit(_) | eframe::Error::WinitEventLoop(_) => anyhow::anyhow!(
+            "no display to open a window on (DISPLAY/WAYLAND_DISPLAY unset or unusable); run it under a \
+             virtual display: scripts/xvfb-run.sh {command} (cause: {cause})"
+        ),
+        _ => anyhow::anyhow!("cannot open the viewer window: {cause}"),
+    }
+}
+
+/// `text` without the source locations that winit puts in its errors ("os error at
+/// /…/.cargo/registry/…/winit-…/src/platform_impl/linux/mod.rs:765: neither … is set"): a path
+/// into someone's crate cache tells the user nothing.
+fn without_source_locations(text: &str) -> String {
+    let mut words: Vec<&str> = Vec::new();
+    for word in text.split(' ') {
+        if word.contains(".rs:") && word.contains('/') {
+            // The location's lead-in ("os error at") goes with it.
+            if words.last() == Some(&"at") {
+                words.pop();
+            }
+            if words.ends_with(&["os", "error"]) {
+                words.truncate(words.len() - 2);
+            }
+            continue;
+        }
+        words.push(word);
+    }
+    words.join(" ")
 }
 
 /// Samples per pixel for the window: 4 (smooth edges) on a GPU, 1 on a CPU rasteriser
@@ -187,5 +218,17 @@ mod tests {
         let missing = load_scene("no-such-scene-anywhere").unwrap_err();
         assert!(missing.contains("no-such-scene-anywhere"), "{missing}");
         assert!(load_scene("cornell").is_ok());
+    }
+
+    /// winit's message loses the path into its source, keeps what went wrong.
+    #[test]
+    fn source_locations_are_left_out_of_window_errors() {
+        let winit = "winit EventLoopError: os error at /root/.cargo/registry/src/index.crates.io-1949cf8c6b5b557f/\
+                     winit-0.30.13/src/platform_impl/linux/mod.rs:765: neither WAYLAND_DISPLAY nor DISPLAY is set.";
+        assert_eq!(
+            without_source_locations(winit),
+            "winit EventLoopError: neither WAYLAND_DISPLAY nor DISPLAY is set."
+        );
+        assert_eq!(without_source_locations("no adapter at all"), "no adapter at all");
     }
 }
