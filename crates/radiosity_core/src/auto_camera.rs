@@ -6,6 +6,10 @@
 //! view whose rays meet the most front faces wins: from outside on each side (the open side
 //! of an open box), or from the middle looking along each horizontal axis (inside a closed
 //! room). `render` and `view` both take their default camera from here, so they agree.
+//!
+//! The back face of a two-sided object (every OBJ face, by default) counts, but less than a
+//! front face: it is lit only where something lights it, and the outside of a room or of an
+//! open box's walls is lit by nothing, so a view of it would be black.
 
 use glam::DVec3;
 
@@ -35,9 +39,10 @@ pub(crate) fn choose(scene: &Scene) -> Camera {
         }
     }
     // From outside first: an open scene (a box without a front wall, a model on a plane) is
-    // shown as a whole from its open side whenever some side shows enough lit faces.
+    // shown as a whole from its open side whenever some side shows enough front faces (the
+    // backs of two-sided walls, seen from outside, are not enough: nothing lights them).
     let best_outside = best_of(scene, candidates);
-    if best_outside.1 >= PROBE.0 * PROBE.1 / 4 {
+    if best_outside.2 >= PROBE.0 * PROBE.1 / 4 {
         return best_outside.0;
     }
     // A closed room shows only the backs of its walls from outside: look from its middle.
@@ -48,52 +53,74 @@ pub(crate) fn choose(scene: &Scene) -> Camera {
     if best_inside.1 > best_outside.1 { best_inside.0 } else { best_outside.0 }
 }
 
-/// The candidate that sees the most front faces and how many; ties keep the earlier one (the
-/// classic framing first). `candidates` must not be empty.
-fn best_of(scene: &Scene, candidates: Vec<Camera>) -> (Camera, usize) {
-    let mut best = (candidates[0], 0usize);
+/// What a probe ray meets first.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum Seen {
+    /// The front face of anything.
+    Front,
+    /// The back face of a two-sided object: lit if something lights it.
+    TwoSidedBack,
+    /// The back of a one-sided face: black.
+    Back,
+}
+
+/// The candidate with the best score (a front face 2, a two-sided back face 1), its score
+/// and its front faces; ties keep the earlier one (the classic framing first). `candidates`
+/// must not be empty.
+fn best_of(scene: &Scene, candidates: Vec<Camera>) -> (Camera, usize, usize) {
+    let mut best = (candidates[0], 0usize, 0usize);
     for camera in candidates {
-        let score = front_faces_seen(scene, &camera);
+        let seen = probe(scene, &camera);
+        let fronts = seen.iter().filter(|&&s| s == Seen::Front).count();
+        let score = 2 * fronts + seen.iter().filter(|&&s| s == Seen::TwoSidedBack).count();
         if score > best.1 {
-            best = (camera, score);
+            best = (camera, score, fronts);
         }
     }
     best
 }
 
-/// The share of the probe rays through `camera` that first meet a front (lit) face.
+/// The share of the probe rays through `camera` that first meet a lit side: a front face, or
+/// either face of a two-sided object.
 pub(crate) fn lit_share(scene: &Scene, camera: &Camera) -> f64 {
-    front_faces_seen(scene, camera) as f64 / (PROBE.0 * PROBE.1) as f64
+    probe(scene, camera).into_iter().filter(|&s| s != Seen::Back).count() as f64 / (PROBE.0 * PROBE.1) as f64
 }
 
-/// How many of the probe rays through `camera` first meet a front (lit) face.
-pub(crate) fn front_faces_seen(scene: &Scene, camera: &Camera) -> usize {
+/// What each probe ray through `camera` meets first (rays that meet nothing are left out).
+fn probe(scene: &Scene, camera: &Camera) -> Vec<Seen> {
     let rays = CameraRays::new(camera, PROBE.0 as u32, PROBE.1 as u32);
-    let mut seen = 0;
-    for j in 0..PROBE.1 {
-        for i in 0..PROBE.0 {
+    (0..PROBE.1)
+        .flat_map(|j| (0..PROBE.0).map(move |i| (i, j)))
+        .filter_map(|(i, j)| {
             let dir = rays.direction(i as f64 + 0.5, j as f64 + 0.5);
-            if let Some((_, front)) = first_hit(scene, camera.position, dir) {
-                seen += usize::from(front);
-            }
-        }
-    }
-    seen
+            first_hit(scene, camera.position, dir).map(|(_, seen)| seen)
+        })
+        .collect()
 }
 
-/// The nearest surface along `origin + t·dir` (t > 0): its distance and whether the ray meets
-/// its lit side.
-fn first_hit(scene: &Scene, origin: DVec3, dir: DVec3) -> Option<(f64, bool)> {
-    let mut best: Option<(f64, bool)> = None;
-    let mut take = |t: f64, front: bool| {
-        if best.is_none_or(|(b, _)| t < b) {
-            best = Some((t, front));
-        }
-    };
+/// How many of the probe rays through `camera` first meet a lit side: a front face, or either
+/// face of a two-sided object.
+#[cfg(test)]
+pub(crate) fn front_faces_seen(scene: &Scene, camera: &Camera) -> usize {
+    probe(scene, camera).into_iter().filter(|&s| s != Seen::Back).count()
+}
+
+/// The nearest surface along `origin + t·dir` (t > 0): its distance and which of its faces
+/// the ray meets.
+fn first_hit(scene: &Scene, origin: DVec3, dir: DVec3) -> Option<(f64, Seen)> {
+    let mut best: Option<(f64, Seen)> = None;
     for object in &scene.objects {
-        // Both faces of a two-sided object are lit sides.
         let two_sided = object.sides != Sides::One;
-        let mut take = |t: f64, front: bool| take(t, front || two_sided);
+        let mut take = |t: f64, front: bool| {
+            let seen = match (front, two_sided) {
+                (true, _) => Seen::Front,
+                (false, true) => Seen::TwoSidedBack,
+                (false, false) => Seen::Back,
+            };
+            if best.is_none_or(|(b, _)| t < b) {
+                best = Some((t, seen));
+            }
+        };
         match &object.shape {
             Shape::Polygons(ps) => {
                 ps.iter().filter_map(|p| hit_polygon(p, origin, dir)).for_each(|h| take(h.0, h.1))
@@ -168,6 +195,46 @@ mod tests {
         let camera = scene.camera_or_framing();
         assert!(camera.position.z < 0.0 && camera.look_at.z > camera.position.z, "{camera:?}");
         assert!(front_faces_seen(&scene, &camera) >= PROBE.0 * PROBE.1 / 4);
+    }
+
+    /// The same box with two-sided walls (an OBJ's default): the backs of its walls count as
+    /// lit, so every side sees "lit" faces, but only the open side shows faces that are lit by
+    /// anything; the view from behind the back wall would be black.
+    #[test]
+    fn a_two_sided_open_box_is_seen_through_its_open_side() {
+        let mut scene = cornell_box();
+        scene.camera = None;
+        for o in &mut scene.objects {
+            o.sides = Sides::Two { emits_back: false };
+        }
+        let camera = scene.camera_or_framing();
+        assert!(camera.position.z < 0.0 && camera.look_at.z > camera.position.z, "{camera:?}");
+        let seen = probe(&scene, &camera);
+        assert!(seen.iter().filter(|&&s| s == Seen::Front).count() >= PROBE.0 * PROBE.1 / 4, "{seen:?}");
+        // Turned round, so that it opens towards +z as McGuire's OBJ does: still seen from the
+        // open side.
+        for o in &mut scene.objects {
+            let Shape::Polygons(ps) = &mut o.shape else { continue };
+            for p in ps.iter_mut() {
+                let turned: Vec<DVec3> =
+                    p.vertices().iter().map(|v| DVec3::new(556.0 - v.x, v.y, 559.2 - v.z)).collect();
+                *p = Polygon::try_new(turned).unwrap();
+            }
+        }
+        let camera = scene.camera_or_framing();
+        assert!(camera.position.z > 559.2 && camera.look_at.z < camera.position.z, "{camera:?}");
+    }
+
+    /// A closed room of two-sided walls is seen from inside, not from behind a wall.
+    #[test]
+    fn a_closed_two_sided_room_is_seen_from_inside() {
+        let mut scene = furnace_box(0.5, 1.0);
+        for o in &mut scene.objects {
+            o.sides = Sides::Two { emits_back: false };
+        }
+        let camera = scene.camera_or_framing();
+        let (lo, hi) = scene.bounds();
+        assert!(camera.position.cmpgt(lo).all() && camera.position.cmplt(hi).all(), "{camera:?}");
     }
 
     /// Two facing plates show their lit sides.

@@ -78,7 +78,11 @@ pub(crate) fn check_mtl(text: &str, origin: &str) -> Result<String, LoadError> {
         let line = raw.trim();
         let mut words = line.split_whitespace();
         let key = words.next().unwrap_or("");
-        let values: Vec<&str> = words.collect();
+        // A comment after a number key's values ends them (`Ka 0.63 0.065 0.05 # Red`, as in
+        // McGuire's Cornell box); a name or file name may hold a '#', so only number keys.
+        let numeric = matches!(key, "Ka" | "Kd" | "Ks" | "Ke" | "Ns" | "Ni" | "d" | "illum" | "Tr" | "Tf");
+        let values: Vec<&str> =
+            if numeric { words.take_while(|w| !w.starts_with('#')).collect() } else { words.collect() };
         let number = |w: &str| w.parse::<f64>().ok().filter(|v| v.is_finite());
         match key {
             "Ka" | "Kd" | "Ks" | "Ke" => {
@@ -105,8 +109,12 @@ pub(crate) fn check_mtl(text: &str, origin: &str) -> Result<String, LoadError> {
             }
             _ => {}
         }
-        out.push_str(raw);
-        out.push('\n');
+        if numeric {
+            out.push_str(&format!("{key} {}\n", values.join(" ")));
+        } else {
+            out.push_str(raw);
+            out.push('\n');
+        }
     }
     Ok(out)
 }
@@ -478,7 +486,12 @@ mod tests {
         assert_eq!(ok, "newmtl a\nKd 0.5 0.5 0.5\nKe 1 2 3\nNs 10\nillum 2\n# Kd\n");
         let (materials, _) = tobj::load_mtl_buf(&mut Cursor::new(ok.as_bytes())).unwrap();
         assert_eq!(materials[0].diffuse, Some([0.5; 3]));
+        // A comment after the numbers is dropped before tobj reads them.
+        let commented = "newmtl a\r\n  Ka 0.63 0.065 0.05 # Red\r\nKd 0.5 #grey\r\nNs 10.0 # soft\r\n";
+        let ok = check_mtl(commented, "m.mtl").unwrap();
+        assert_eq!(ok, "newmtl a\nKa 0.63 0.065 0.05\nKd 0.5 0.5 0.5\nNs 10.0\n");
         for (text, expected) in [
+            ("newmtl a\nKd # 0.5 0.5 0.5\n", "m.mtl:2: Kd: expected three finite numbers"),
             ("newmtl a\nKd\n", "m.mtl:2: Kd: expected three finite numbers"),
             ("newmtl a\nKd 1 2\n", "m.mtl:2: Kd"),
             ("newmtl a\nKa 1 2 3 4\n", "m.mtl:2: Ka"),
