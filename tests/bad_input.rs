@@ -431,8 +431,8 @@ fn a_full_disk_is_an_error_and_keeps_the_old_file() {
     for (flag, name, path) in &cases {
         let mut cmd = Command::new("sh");
         // Signal disposition "ignored" survives exec, so the write returns EFBIG instead of the
-        // process dying of SIGXFSZ. 64 blocks (32 or 64 KiB) is far below any of the pictures.
-        cmd.args(["-c", "trap '' XFSZ; ulimit -f 64; exec \"$@\"", "sh"])
+        // process dying of SIGXFSZ. 8 blocks (4 or 8 KiB) is far below any of the pictures (the PNG, the smallest, is ~16 KB).
+        cmd.args(["-c", "trap '' XFSZ; ulimit -f 8; exec \"$@\"", "sh"])
             .arg(env!("CARGO_BIN_EXE_radiosity"))
             .args(["render", "two-plates", "--max-shots", "1", "--width", "512", "--height", "512"])
             .args(["--spp", "1", "--gather", "none", "--force", flag, path.to_str().unwrap()]);

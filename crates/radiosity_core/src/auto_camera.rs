@@ -28,15 +28,10 @@ pub(crate) fn choose(scene: &Scene) -> Camera {
     let framing = Camera::framing(lo, hi);
     let centre = (lo + hi) * 0.5;
     let mut candidates = vec![framing];
-    for d in [DVec3::Z, -DVec3::Z, DVec3::X, -DVec3::X, -DVec3::Y, DVec3::Y] {
-        if d == DVec3::Z {
-            continue; // the framing view already looks along +z
-        }
-        let distance = (framing.look_at - framing.position).length();
+    for d in [-DVec3::Z, DVec3::X, -DVec3::X, -DVec3::Y, DVec3::Y] {
+        // The framing view already looks along +z.
         let up = if d.y.abs() > 0.5 { DVec3::Z } else { DVec3::Y };
-        if let Ok(c) = Camera::try_new(centre - d * distance, centre, up, framing.fov_y_deg) {
-            candidates.push(c);
-        }
+        candidates.push(Camera::fitting(lo, hi, d, up));
     }
     // From outside first: an open scene (a box without a front wall, a model on a plane) is
     // shown as a whole from its open side whenever some side shows enough front faces (the

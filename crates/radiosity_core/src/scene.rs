@@ -516,11 +516,32 @@ impl Camera {
 
     /// A camera that frames the box `[min, max]` from the -z side, looking at its centre.
     pub fn framing(min: DVec3, max: DVec3) -> Self {
-        let centre = (min + max) * 0.5;
-        let radius = ((max - min).length() * 0.5).max(1e-9);
+        Self::fitting(min, max, DVec3::Z, DVec3::Y)
+    }
+
+    /// A camera looking along `direction` at the centre of the box `[min, max]`, just far
+    /// enough back that all eight corners fit a 4:3 picture with a 45° vertical field of view
+    /// (a 5 % margin): the box fills the frame instead of its bounding sphere, which from a
+    /// face leaves a third of the picture empty. `up` must not be parallel to `direction`.
+    pub fn fitting(min: DVec3, max: DVec3, direction: DVec3, up: DVec3) -> Self {
+        const ASPECT: f64 = 4.0 / 3.0;
         let fov_y_deg = 45.0_f64;
-        let distance = radius / (fov_y_deg.to_radians() * 0.5).sin();
-        Self { position: centre - DVec3::Z * distance, look_at: centre, up: DVec3::Y, fov_y_deg }
+        let tan_y = (fov_y_deg.to_radians() * 0.5).tan();
+        let forward = direction.normalize();
+        let right = forward.cross(up).normalize();
+        let true_up = right.cross(forward);
+        let centre = (min + max) * 0.5;
+        let half = (max - min) * 0.5;
+        let mut distance: f64 = 1e-9;
+        for i in 0..8 {
+            let sign = |bit: usize| if i & bit == 0 { -1.0 } else { 1.0 };
+            let c = DVec3::new(half.x * sign(1), half.y * sign(2), half.z * sign(4));
+            // The corner's depth D + c·f must be at least |y| / tan and |x| / (tan · aspect).
+            let needed = (c.dot(true_up).abs() / tan_y).max(c.dot(right).abs() / (tan_y * ASPECT));
+            distance = distance.max(needed - c.dot(forward));
+        }
+        let distance = distance * 1.05;
+        Self { position: centre - forward * distance, look_at: centre, up, fov_y_deg }
     }
 }
 

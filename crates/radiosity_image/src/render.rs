@@ -220,6 +220,9 @@ pub struct Renderer {
     /// How far a secondary ray's origin is lifted off its surface: 1e-6 of the scene's
     /// diagonal, far above f32 round-off of positions, far below any feature.
     lift: f64,
+    /// Per vertex, the normal a final gather shades with (see [`shading_normals`]); empty
+    /// when every vertex's is its own surface's normal (no smoothing across facets).
+    shading_normals: Vec<DVec3>,
 }
 
 impl Renderer {
@@ -234,7 +237,24 @@ impl Renderer {
         let emitters = Emitters::new(&mesh);
         let (lo, hi) = mesh.bounds();
         let lift = 1e-6 * (hi - lo).length().max(f64::MIN_POSITIVE);
-        Self { mesh, accel, triangle_element, emitters, lift }
+        let shading_normals = shading_normals(&mesh);
+        Self { mesh, accel, triangle_element, emitters, lift, shading_normals }
+    }
+
+    /// The unit normal a gather uses at `p` on element `e`: its own, or where the mesh
+    /// smooths across facets, the vertex normals interpolated as the radiosity is (Phong
+    /// 1975), so the direct light computed per pixel does not bring back the facets that the
+    /// smoothed indirect part hides.
+    fn shading_normal(&self, e: usize, p: DVec3) -> DVec3 {
+        let el = &self.mesh.elements[e];
+        if self.shading_normals.is_empty()
+            || el.vertex_indices().iter().all(|&v| self.shading_normals[v as usize] == el.normal)
+        {
+            return el.normal;
+        }
+        let n = self.interpolate_values(&self.shading_normals, e, p).normalize_or_zero();
+        // Far from the facet's own normal only on a degenerate fan; keep the facet's there.
+        if n.dot(el.normal) > 0.1 { n } else { el.normal }
     }
 
     /// The element a ray along `dir` sees at BVH triangle `triangle`: where a two-sided
@@ -330,7 +350,10 @@ impl Renderer {
     }
 
     /// Any per-vertex quantity at `p` (on element `e`'s plane), interpolated from `e`'s vertices.
-    fn interpolate_values(&self, vertex_values: &[Rgb], e: usize, p: DVec3) -> Rgb {
+    fn interpolate_values<T>(&self, vertex_values: &[T], e: usize, p: DVec3) -> T
+    where
+        T: Copy + std::ops::Mul<f64, Output = T> + std::ops::Add<Output = T>,
+    {
         let el = &self.mesh.elements[e];
         let idx = el.vertex_indices();
         let pos = |k: usize| self.mesh.positions[idx[k] as usize];
@@ -470,7 +493,7 @@ impl Renderer {
         rng: &mut Rng,
     ) -> Rgb {
         let material = self.mesh.element_material(e);
-        let n = self.mesh.elements[e].normal;
+        let n = self.shading_normal(e, x);
         let lights = if self.emitters.is_empty() { 0 } else { params.shadow_rays };
         let cosines = match gather {
             Gather::Full => params.gather_rays,
@@ -617,6 +640,35 @@ fn inverse_bilinear(p: DVec2, a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> (f64, f
     let s = s_of(t);
     let s = if s.is_finite() { s } else { 0.0 };
     (s.clamp(0.0, 1.0), t.clamp(0.0, 1.0))
+}
+
+/// Per vertex of `mesh`, the mean of its own surface's normal and those of the surfaces it
+/// pools with ([`Mesh::smoothing`], weighted as the radiosity is), normalised: a shading
+/// normal that turns smoothly across the facets of a curved model. Empty when no vertex's
+/// differs from its own surface's (flat scenes such as the Cornell box), so they render
+/// exactly as before.
+fn shading_normals(mesh: &Mesh) -> Vec<DVec3> {
+    let mut own = vec![DVec3::ZERO; mesh.positions.len()];
+    for el in &mesh.elements {
+        for &v in el.vertex_indices() {
+            own[v as usize] = el.normal;
+        }
+    }
+    let mut turned = false;
+    let normals: Vec<DVec3> = (0..own.len())
+        .map(|v| {
+            let sum = mesh.smoothing.partners_of(v).fold(own[v], |n, (q, w)| n + own[q as usize] * w);
+            let n = sum.normalize_or_zero();
+            // Coplanar partners (the Cornell ceiling's four polygons) leave it as it was.
+            if n == DVec3::ZERO || n.dot(own[v]) > 1.0 - 1e-12 {
+                own[v]
+            } else {
+                turned = true;
+                n
+            }
+        })
+        .collect();
+    if turned { normals } else { Vec::new() }
 }
 
 #[cfg(test)]
