@@ -38,6 +38,12 @@ pub fn run(a: InfoArgs) -> Result<()> {
     let _ = writeln!(out, "patches    {}", mesh.patches.len());
     let _ = writeln!(out, "elements   {}", mesh.elements.len());
     let _ = writeln!(out, "occluders  {} triangles", mesh.occluders.len());
+    // Contact cuts: what each object lost under the solids standing on it.
+    for (name, hidden) in mesh.object_names.iter().zip(&mesh.hidden_area) {
+        if *hidden > 0.0 {
+            let _ = writeln!(out, "hidden     {hidden:.6e} units² of '{name}' under solids standing on it");
+        }
+    }
     let _ = writeln!(out, "area       {:.6e}", mesh.total_area());
     let emitted: Rgb =
         (0..mesh.elements.len()).map(|e| mesh.element_material(e).emission * mesh.elements[e].area).sum();
@@ -78,6 +84,10 @@ pub fn run(a: InfoArgs) -> Result<()> {
                 away / total * 100.0
             ));
         }
+    }
+    if mesh.contacts_incomplete {
+        warnings
+            .push("too many large faces to look for contacts on all of them: some are meshed whole".into());
     }
     if scene.camera.is_none() {
         warnings.push("no [camera]: views frame the whole scene".into());

@@ -77,6 +77,11 @@ pub struct MeshOpts {
     /// file and the scene file say [default: OBJ two-sided, glTF as its doubleSided flag].
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=2), value_name = "1|2")]
     pub sides: Option<u8>,
+    /// Cut surfaces along the outlines of solids standing on them (a block on the floor) and
+    /// leave the covered part out of the solve [default: the scene's [mesh] contacts, else
+    /// true].
+    #[arg(long, value_name = "true|false")]
+    pub contacts: Option<bool>,
 }
 
 /// Options shared by every command that solves; each overrides the scene file.
@@ -253,6 +258,7 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
     });
     let mesh_params = MeshParams::try_new(patch, element)
         .and_then(|m| m.with_crease_angle(o.mesh.crease_angle.unwrap_or(base.crease_angle_deg)))
+        .map(|m| m.with_contacts(o.mesh.contacts.unwrap_or(base.contacts)))
         .map_err(|e| input(format!("mesh options: {e}")))?;
     // The scene file's limit is checked (with its line) by the loader; this is the option's.
     let time_limit = match o.time_limit.or(scene.solver.time_limit) {
@@ -441,8 +447,13 @@ mod tests {
     /// `info`'s solve options are the declared defaults with its own mesh options and scale.
     #[test]
     fn solve_options_from_mesh_options_keep_the_declared_defaults() {
-        let mesh =
-            MeshOpts { patch_size: Some(50.0), element_size: None, crease_angle: Some(0.0), sides: Some(1) };
+        let mesh = MeshOpts {
+            patch_size: Some(50.0),
+            element_size: None,
+            crease_angle: Some(0.0),
+            sides: Some(1),
+            contacts: None,
+        };
         let o = SolveOpts::with_mesh(mesh, 2.0);
         assert_eq!((o.mesh.patch_size, o.mesh.crease_angle, o.mesh.sides), (Some(50.0), Some(0.0), Some(1)));
         assert_eq!(o.light_scale, 2.0);

@@ -101,6 +101,22 @@ fn with_back_faces(objects: Vec<ObjectRadiosity>) -> Vec<ObjectRadiosity> {
     objects.into_iter().chain(backs).collect()
 }
 
+/// Each object's means spread over its whole input area: the mesh leaves out what solids
+/// standing on a surface cover (`Mesh::hidden_area`), while the reference samples the whole
+/// input polygon, whose covered part no light reaches (it sees only the inside of the solid).
+fn over_whole_area(mut objects: Vec<ObjectRadiosity>, hidden: &[f64]) -> Vec<ObjectRadiosity> {
+    for (o, &hidden) in objects.iter_mut().zip(hidden) {
+        let whole = o.area + hidden;
+        if hidden > 0.0 && whole > 0.0 {
+            let f = o.area / whole;
+            o.radiosity *= f;
+            o.radiosity_back = o.radiosity_back.map(|b| b * f);
+            o.area = whole;
+        }
+    }
+    objects
+}
+
 /// A progress bar for the reference on stderr when it is a terminal.
 fn reference_bar(what: &str) -> ProgressBar {
     if !std::io::stderr().is_terminal() {
@@ -221,7 +237,7 @@ pub fn run(a: VerifyArgs) -> Result<()> {
     let Prepared { scene, problem, .. } = &prepared;
     let mesh = problem.mesh();
     let solution = solver.solution();
-    let solved = with_back_faces(solution.object_radiosity(mesh));
+    let solved = with_back_faces(over_whole_area(solution.object_radiosity(mesh), &mesh.hidden_area));
     let solve_secs = report.elapsed.as_secs_f64();
     let stop = report.stop_reason.map_or("running", |s| s.as_str());
     crate::output::note(format_args!(

@@ -10,6 +10,7 @@
 mod auto_camera;
 mod canonical;
 mod color;
+mod contacts;
 mod film;
 mod mesh;
 mod one_line;

@@ -24,6 +24,7 @@ use glam::DVec3;
 use thiserror::Error;
 
 use crate::Material;
+use crate::contacts::{Contacts, PolygonId};
 use crate::scene::{Facing, Polygon, PolygonMesh, Scene, SceneError, Shape, Sides, Sphere};
 
 /// Subdivision of surfaces (the source document's "discrétisation", S10).
@@ -39,6 +40,9 @@ pub struct MeshParams {
     /// differ by less than this, degrees in [0, 180); 0 keeps every surface apart. Default
     /// [`DEFAULT_CREASE_ANGLE_DEG`].
     pub crease_angle_deg: f64,
+    /// Cut surfaces along the footprints of solids standing on them and leave the covered
+    /// part out (see the `contacts` module). Default true.
+    pub contacts: bool,
 }
 
 /// The default crease angle: a tessellated curve (a sphere of 24 segments turns 15° per
@@ -61,7 +65,13 @@ impl MeshParams {
             patch_size,
             element_size: element_size.min(patch_size),
             crease_angle_deg: DEFAULT_CREASE_ANGLE_DEG,
+            contacts: true,
         })
+    }
+
+    /// The same parameters with contact cutting on or off.
+    pub fn with_contacts(self, contacts: bool) -> Self {
+        Self { contacts, ..self }
     }
 
     /// The same sizes with crease angle `degrees`.
@@ -79,7 +89,12 @@ impl MeshParams {
     /// 1/8 and elements of 1/32 of it.
     pub fn for_extent(diagonal: f64) -> Self {
         let d = if diagonal.is_finite() && diagonal > 0.0 { diagonal } else { 1.0 };
-        Self { patch_size: d / 8.0, element_size: d / 32.0, crease_angle_deg: DEFAULT_CREASE_ANGLE_DEG }
+        Self {
+            patch_size: d / 8.0,
+            element_size: d / 32.0,
+            crease_angle_deg: DEFAULT_CREASE_ANGLE_DEG,
+            contacts: true,
+        }
     }
 
     /// The same parameters with both sizes multiplied by `factor` (e.g. 0.5 for a finer mesh).
@@ -210,6 +225,12 @@ pub struct Mesh {
     pub occluders: Vec<[DVec3; 3]>,
     /// Vertices of other surfaces that smooth shading pools with each vertex.
     pub smoothing: Smoothing,
+    /// Per object, the area left out of the mesh because a solid stands on it or it lies
+    /// flat against another surface ([`MeshParams::contacts`]), scene units².
+    pub hidden_area: Vec<f64>,
+    /// True when the scene had too many large faces to look for contacts on all of them:
+    /// some were meshed whole.
+    pub contacts_incomplete: bool,
 }
 
 /// Which vertices of *different* surfaces share their radiosity in smooth shading: those in
@@ -792,8 +813,10 @@ impl Mesh {
         let mut mesh = Mesh {
             object_names: scene.objects.iter().map(|o| o.name.clone()).collect(),
             materials: scene.materials.clone(),
+            hidden_area: vec![0.0; scene.objects.len()],
             ..Mesh::default()
         };
+        let contacts = params.contacts.then(|| Contacts::new(scene));
         // The back face of an emitting material that emits from its front only: the same
         // reflectance, no emission (one per material, made when first needed).
         let mut dark_back = HashMap::new();
@@ -801,12 +824,15 @@ impl Mesh {
             let first_surface = mesh.surfaces.len() as u32;
             match &o.shape {
                 Shape::Polygons(ps) => {
-                    for p in ps {
-                        let mut b = SurfaceBuilder::default();
-                        mesh_polygon(&mut b, p, params);
-                        mesh.push_surface(b, oi, o.material);
+                    for (index, p) in ps.iter().enumerate() {
                         let v = p.vertices();
                         mesh.occluders.extend((1..v.len() - 1).map(|i| [v[0], v[i], v[i + 1]]));
+                        let id = PolygonId { object: oi, index };
+                        if contacts.as_ref().is_some_and(|c| c.is_pressed_flat(id, p)) {
+                            mesh.hidden_area[oi] += p.area();
+                            continue;
+                        }
+                        mesh.mesh_cut_polygon(contacts.as_ref(), p, Some(id), oi, o.material, params);
                     }
                 }
                 Shape::Sphere(s) => {
@@ -819,20 +845,22 @@ impl Mesh {
                 }
                 Shape::Mesh(m) => {
                     for group in group_mesh_faces(m, params) {
-                        let mut b = SurfaceBuilder::default();
                         let first = group[0] as usize;
                         if m.faces()[first].len() > 3 {
-                            mesh_polygon(&mut b, &m.polygons()[first], params);
+                            let id = PolygonId { object: oi, index: first };
+                            let p = &m.polygons()[first];
+                            mesh.mesh_cut_polygon(contacts.as_ref(), p, Some(id), oi, o.material, params);
                         } else if let [a, c] = group[..]
                             && let Some(quad) = pair_as_quad(m, a as usize, c as usize)
                         {
                             // Two triangles that make a convex quad (how exporters write one
                             // quad) are meshed as that quad, exactly as a quad polygon would be.
-                            mesh_polygon(&mut b, &quad, params);
+                            mesh.mesh_cut_polygon(contacts.as_ref(), &quad, None, oi, o.material, params);
                         } else {
+                            let mut b = SurfaceBuilder::default();
                             mesh_triangle_group(&mut b, m, &group, params);
+                            mesh.push_surface(b, oi, o.material);
                         }
-                        mesh.push_surface(b, oi, o.material);
                     }
                     for p in m.polygons() {
                         let v = p.vertices();
@@ -856,8 +884,36 @@ impl Mesh {
                 }
             }
         }
+        mesh.contacts_incomplete = contacts.is_some_and(|c| c.budget_spent());
         mesh.smoothing = Smoothing::new(&mesh, params.crease_angle_deg);
         Ok(mesh)
+    }
+
+    /// Meshes polygon `p` of object `object` as one surface, or, where solids stand on it,
+    /// as one surface per piece of it around their footprints (the covered area counted in
+    /// [`Mesh::hidden_area`]).
+    fn mesh_cut_polygon(
+        &mut self,
+        contacts: Option<&Contacts>,
+        p: &Polygon,
+        id: Option<PolygonId>,
+        object: usize,
+        material: usize,
+        params: &MeshParams,
+    ) {
+        let cut = contacts.and_then(|c| c.cut(p, id, |q| estimate_polygon_elements(q, params)));
+        let pieces = match &cut {
+            Some(cut) => {
+                self.hidden_area[object] += cut.hidden;
+                &cut.pieces[..]
+            }
+            None => std::slice::from_ref(p),
+        };
+        for piece in pieces {
+            let mut b = SurfaceBuilder::default();
+            mesh_polygon(&mut b, piece, params);
+            self.push_surface(b, object, material);
+        }
     }
 
     fn push_surface(&mut self, b: SurfaceBuilder, object: usize, material: usize) {
@@ -1324,6 +1380,70 @@ mod tests {
             Mesh::build(&scene_of(Shape::Mesh(crate::uv_sphere_mesh(DVec3::ZERO, 1.0, 4))), &params).unwrap();
         assert_eq!(coarse.smoothing, Smoothing::default());
         assert!(params.with_crease_angle(180.0).is_err() && params.with_crease_angle(f64::NAN).is_err());
+    }
+
+    /// The Cornell box's blocks stand on its floor: the floor's mesh leaves out exactly their
+    /// footprints (no element of the floor lies under a block, and mesh area plus hidden
+    /// area is the floor's), and nothing else is cut. Without contacts the floor is whole.
+    #[test]
+    fn the_cornell_floor_is_cut_around_the_blocks() {
+        let scene = crate::cornell_box();
+        let params = scene.mesh_params();
+        let floor_of = |mesh: &Mesh| {
+            let o = mesh.object_names.iter().position(|n| n == "floor").unwrap();
+            let elements: Vec<Element> = mesh
+                .elements
+                .iter()
+                .enumerate()
+                .filter(|(e, _)| mesh.element_object(*e) == o)
+                .map(|x| *x.1)
+                .collect();
+            (o, elements)
+        };
+        let cut = Mesh::build(&scene, &params).unwrap();
+        let whole = Mesh::build(&scene, &params.with_contacts(false)).unwrap();
+        let (o, elements) = floor_of(&cut);
+        let input_area = match &scene.objects[o].shape {
+            Shape::Polygons(ps) => ps.iter().map(Polygon::area).sum::<f64>(),
+            _ => unreachable!(),
+        };
+        let meshed: f64 = elements.iter().map(|e| e.area).sum();
+        assert!(
+            (meshed + cut.hidden_area[o] - input_area).abs() < 1e-6 * input_area,
+            "{meshed} + {}",
+            cut.hidden_area[o]
+        );
+        // The two footprints: the blocks' side faces' bottom corners, about 165 mm square.
+        assert!((cut.hidden_area[o] / (2.0 * 165.0 * 165.0) - 1.0).abs() < 0.05, "{}", cut.hidden_area[o]);
+        assert_eq!(cut.hidden_area.iter().filter(|&&a| a > 0.0).count(), 1, "only the floor is cut");
+        // The blocks' own corners on the floor, and every floor element's centre outside both.
+        let blocks: Vec<Vec<DVec3>> = ["short_block", "tall_block"]
+            .iter()
+            .map(|b| {
+                scene
+                    .objects
+                    .iter()
+                    .filter(|ob| ob.name.starts_with(b) && !ob.name.ends_with("top"))
+                    .flat_map(|ob| match &ob.shape {
+                        Shape::Polygons(ps) => {
+                            ps.iter().flat_map(|p| p.vertices().to_vec()).collect::<Vec<_>>()
+                        }
+                        _ => vec![],
+                    })
+                    .filter(|v| v.y.abs() < 1e-6)
+                    .collect()
+            })
+            .collect();
+        for corners in &blocks {
+            let (lo, hi) = corners.iter().fold((corners[0], corners[0]), |(l, h), &c| (l.min(c), h.max(c)));
+            let centre = (lo + hi) * 0.5;
+            // A point well inside the block's footprint (its corners' centre) has no element.
+            let covered = elements.iter().any(|e| (e.centre - centre).length() < 40.0);
+            assert!(!covered, "a floor element under the block at {centre}");
+        }
+        let (_, whole_elements) = floor_of(&whole);
+        assert!(whole.hidden_area.iter().all(|&a| a == 0.0));
+        assert!((whole_elements.iter().map(|e| e.area).sum::<f64>() - input_area).abs() < 1e-6 * input_area);
     }
 
     /// The furnace's walls face each other: none faces away from the light. Turned inside out

@@ -196,6 +196,8 @@ pub(crate) struct MeshDesc {
     pub(crate) element_size: Spanned<f64>,
     /// Smooth shading joins facets of one object bent by less than this, degrees in [0, 180).
     pub(crate) crease_angle: Option<Spanned<f64>>,
+    /// Cut surfaces along the footprints of solids standing on them (default true).
+    pub(crate) contacts: Option<bool>,
 }
 
 /// `[solver]`.

@@ -729,6 +729,7 @@ fn mesh_params(loc: &Locator, d: &MeshDesc) -> Result<MeshParams, LoadError> {
         };
         loc.at(span, format!("mesh.{field}"), e.to_string())
     })?;
+    let params = params.with_contacts(d.contacts.unwrap_or(true));
     match &d.crease_angle {
         Some(a) => params
             .with_crease_angle(*a.get_ref())

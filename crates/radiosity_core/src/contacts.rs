@@ -1,0 +1,542 @@
+//! Meshes that follow contacts: where a solid stands on a flat surface (a block on the floor,
+//! a cupboard against a wall), the surface is cut along the solid's footprint before it is
+//! meshed, and the covered part is left out — it neither shoots nor receives. These are the
+//! value discontinuities (D0) of discontinuity meshing (Heckbert 1992; Lischinski, Tampieri &
+//! Greenberg 1992): radiosity jumps from the lit floor to the dark floor under the block, so
+//! an element that straddles the outline averages the two, and that diluted value is what the
+//! block's sides then receive from the floor.
+//!
+//! A footprint is found from the solid's own faces: the edges of faces that stand on the
+//! surface's plane (one edge in it, the rest on its lit side) chain into a closed loop. A convex
+//! loop cuts; anything else (an open shape, a concave outline) is left as it was. A face lying
+//! flat against the surface, facing it (a box's bottom), is hidden whole.
+//!
+//! The surface minus a convex footprint is cut into convex pieces by the footprint's edge
+//! lines in turn (piece k: outside edge k, inside edges 1‥k−1), each piece meshed as its own
+//! surface; smoothing pools their vertices as it does for any coplanar surfaces of one object.
+//! Footprints of more than [`MAX_FOOTPRINT_CORNERS`] corners do not cut (see there).
+
+use std::collections::HashMap;
+
+use glam::DVec3;
+
+use crate::scene::{Polygon, Scene, Shape};
+
+/// A polygon of a scene: the object and the polygon's index within it (a face index for a
+/// model mesh).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) struct PolygonId {
+    pub(crate) object: usize,
+    pub(crate) index: usize,
+}
+
+/// Most corners of a footprint that cuts: boxes, wedges and prisms of furniture. The pieces
+/// around a footprint run from each of its edges to the surface's outline, so a round one
+/// (a cylinder's 24 sides) cuts the surface into thin wedges that mesh into many elements;
+/// those are meshed whole, as without contacts.
+const MAX_FOOTPRINT_CORNERS: usize = 8;
+
+/// Most polygon pairs looked at while finding contacts (bounding boxes first): a model of
+/// many large faces would otherwise cost targets × faces. Past it, surfaces are meshed uncut.
+const PAIR_BUDGET: u64 = 200_000_000;
+
+/// Every polygon of a scene that can stand on another, with its bounding box.
+pub(crate) struct Contacts<'a> {
+    candidates: Vec<(PolygonId, &'a Polygon, DVec3, DVec3)>,
+    pairs_left: std::cell::Cell<u64>,
+}
+
+/// A surface cut along footprints.
+pub(crate) struct Cut {
+    /// Convex pieces covering the surface minus the footprints, in a fixed order.
+    pub(crate) pieces: Vec<Polygon>,
+    /// Area covered by the footprints, scene units².
+    pub(crate) hidden: f64,
+}
+
+impl<'a> Contacts<'a> {
+    /// The polygons of `scene` (polygon objects and model meshes; spheres touch in a point).
+    pub(crate) fn new(scene: &'a Scene) -> Self {
+        let mut candidates = Vec::new();
+        for (object, o) in scene.objects.iter().enumerate() {
+            let polygons: &[Polygon] = match &o.shape {
+                Shape::Polygons(ps) => ps,
+                Shape::Mesh(m) => m.polygons(),
+                Shape::Sphere(_) => &[],
+            };
+            for (index, p) in polygons.iter().enumerate() {
+                let v = p.vertices();
+                let (lo, hi) = v.iter().fold((v[0], v[0]), |(lo, hi), &q| (lo.min(q), hi.max(q)));
+                candidates.push((PolygonId { object, index }, p, lo, hi));
+            }
+        }
+        Self { candidates, pairs_left: std::cell::Cell::new(PAIR_BUDGET) }
+    }
+
+    /// Whether the budget of polygon pairs ran out (some surfaces were meshed uncut).
+    pub(crate) fn budget_spent(&self) -> bool {
+        self.pairs_left.get() == 0
+    }
+
+    /// The candidates whose bounding boxes touch `[lo, hi]` widened by `eps`, or none once
+    /// the budget is spent.
+    fn near(
+        &self,
+        lo: DVec3,
+        hi: DVec3,
+        eps: f64,
+    ) -> impl Iterator<Item = &(PolygonId, &'a Polygon, DVec3, DVec3)> {
+        let n = self.candidates.len() as u64;
+        let left = self.pairs_left.get();
+        let allowed = left >= n;
+        self.pairs_left.set(if allowed { left - n } else { 0 });
+        self.candidates
+            .iter()
+            .filter(move |c| allowed && c.2.cmple(hi + eps).all() && c.3.cmpge(lo - eps).all())
+    }
+
+    /// Whether polygon `id` lies flat against another polygon and within it, facing it (a
+    /// box's bottom on the floor): no light can reach it.
+    pub(crate) fn is_pressed_flat(&self, id: PolygonId, poly: &Polygon) -> bool {
+        let v = poly.vertices();
+        let (lo, hi) = v.iter().fold((v[0], v[0]), |(lo, hi), &q| (lo.min(q), hi.max(q)));
+        self.near(lo, hi, tolerance(poly)).any(|&(other, p, _, _)| {
+            other != id && p.normal().dot(poly.normal()) < -0.999 && {
+                let eps = tolerance(p);
+                let (n, d) = plane(p);
+                v.iter().all(|&q| (n.dot(q) - d).abs() <= eps && contains_within(p.vertices(), n, q, eps))
+            }
+        })
+    }
+
+    /// `target` (polygon `id`, or a polygon made of model faces when `None`) cut along the
+    /// footprints of the solids standing on it; `None` when nothing stands on it or the cut
+    /// would not mesh well (then it is meshed whole, as without contacts).
+    pub(crate) fn cut(
+        &self,
+        target: &Polygon,
+        id: Option<PolygonId>,
+        estimate: impl Fn(&Polygon) -> usize,
+    ) -> Option<Cut> {
+        let footprints = self.footprints(target, id);
+        if footprints.is_empty() {
+            return None;
+        }
+        let n = target.normal();
+        let mut pieces = vec![target.vertices().to_vec()];
+        let mut hidden = 0.0;
+        for f in &footprints {
+            let mut next = Vec::new();
+            for piece in pieces {
+                let (outside, inside) = split(&piece, f, n);
+                next.extend(outside);
+                hidden += area(&inside, n);
+            }
+            pieces = next;
+        }
+        let whole = target.area();
+        if hidden <= 1e-9 * whole {
+            return None; // the footprints lie elsewhere on the plane
+        }
+        let mut polygons = Vec::new();
+        for piece in pieces {
+            if area(&piece, n) <= 1e-9 * whole {
+                continue;
+            }
+            // A piece the validation refuses (a sliver of round-off): keep the surface whole.
+            polygons.push(Polygon::try_new(clean(piece, target)).ok()?);
+        }
+        // Slivers mesh into many thin elements: cut only when the pieces cost at most four
+        // times the whole surface's elements.
+        let pieces_elements: usize = polygons.iter().map(&estimate).sum();
+        if pieces_elements > 4 * estimate(target).max(1) {
+            return None;
+        }
+        Some(Cut { pieces: polygons, hidden })
+    }
+
+    /// The convex footprints of the solids standing on `target`, each counter-clockwise about
+    /// its normal from its lowest corner, sorted by that corner (so a scene given as TOML,
+    /// OBJ or glTF cuts the same way).
+    fn footprints(&self, target: &Polygon, id: Option<PolygonId>) -> Vec<Vec<DVec3>> {
+        let v = target.vertices();
+        let (lo, hi) = v.iter().fold((v[0], v[0]), |(lo, hi), &q| (lo.min(q), hi.max(q)));
+        let eps = tolerance(target);
+        let (n, d) = plane(target);
+        let height = |q: DVec3| n.dot(q) - d;
+        let mut edges: Vec<(DVec3, DVec3, DVec3)> = Vec::new();
+        // A solid that stands partly over the edge is seen whole: faces up to the target's
+        // size beyond it count.
+        for &(other, p, _, _) in self.near(lo, hi, lo.distance(hi)) {
+            if Some(other) == id {
+                continue;
+            }
+            let pv = p.vertices();
+            let heights: Vec<f64> = pv.iter().map(|&q| height(q)).collect();
+            // Standing on the plane: nothing below it, something above it.
+            if heights.iter().any(|&h| h < -eps) || heights.iter().all(|&h| h <= eps) {
+                continue;
+            }
+            for i in 0..pv.len() {
+                let j = (i + 1) % pv.len();
+                if heights[i].abs() <= eps && heights[j].abs() <= eps {
+                    // Onto the plane exactly, so the loop's corners are the target's plane.
+                    edges.push((pv[i] - n * heights[i], pv[j] - n * heights[j], p.normal()));
+                }
+            }
+        }
+        let mut loops: Vec<Vec<DVec3>> = chain(&edges, n)
+            .into_iter()
+            .filter_map(|l| convex_loop(l, n))
+            .filter(|f| f.len() <= MAX_FOOTPRINT_CORNERS)
+            .filter(|f| self.enclosed(f.iter().copied().sum::<DVec3>() / f.len() as f64, n, eps))
+            .collect();
+        loops.sort_by(|a, b| lexicographic(a[0], b[0]));
+        loops
+    }
+}
+
+impl Contacts<'_> {
+    /// Whether `p`, a point of a footprint on a plane with normal `n`, lies inside a closed
+    /// solid: the first face straight above it is met from behind. An open box or a cup
+    /// standing on a table leaves the table inside it lit, so that footprint must not cut.
+    fn enclosed(&self, p: DVec3, n: DVec3, eps: f64) -> bool {
+        let origin = p + n * eps;
+        let far = DVec3::splat(f64::INFINITY);
+        let mut first: Option<(f64, bool)> = None;
+        for &(_, poly, _, _) in self.near(-far, far, 0.0) {
+            let pn = poly.normal();
+            let denominator = pn.dot(n);
+            if denominator.abs() < 1e-12 {
+                continue;
+            }
+            let t = pn.dot(poly.vertices()[0] - origin) / denominator;
+            if t > 0.0
+                && first.is_none_or(|(best, _)| t < best)
+                && contains(poly.vertices(), pn, origin + n * t)
+            {
+                first = Some((t, denominator > 0.0));
+            }
+        }
+        first.is_some_and(|(_, from_behind)| from_behind)
+    }
+}
+
+/// The tolerance for "on the plane": the planarity a [`Polygon`] is allowed (1e-4 of its
+/// bounding box's diagonal).
+fn tolerance(p: &Polygon) -> f64 {
+    let v = p.vertices();
+    let (lo, hi) = v.iter().fold((v[0], v[0]), |(lo, hi), &q| (lo.min(q), hi.max(q)));
+    1e-4 * lo.distance(hi)
+}
+
+/// Unit normal n and offset d of a polygon's plane n·x = d, through its vertex mean.
+fn plane(p: &Polygon) -> (DVec3, f64) {
+    let v = p.vertices();
+    let centre = v.iter().copied().sum::<DVec3>() / v.len() as f64;
+    (p.normal(), p.normal().dot(centre))
+}
+
+fn lexicographic(a: DVec3, b: DVec3) -> std::cmp::Ordering {
+    a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)).then(a.z.total_cmp(&b.z))
+}
+
+fn key(p: DVec3) -> [u64; 3] {
+    [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]
+}
+
+/// Closed loops of `edges` (matched by exact corner positions; faces of one solid share
+/// them) around which every edge's face turns its lit side outwards: the outline of a solid
+/// standing on the plane whose normal is `n`, not the walls of a room standing around its
+/// floor. A corner that does not join exactly two edges ends its component: no loop.
+fn chain(edges: &[(DVec3, DVec3, DVec3)], n: DVec3) -> Vec<Vec<DVec3>> {
+    let mut next: HashMap<[u64; 3], Vec<DVec3>> = HashMap::new();
+    let mut face_normal = HashMap::new();
+    for &(a, b, normal) in edges {
+        let (ka, kb) = (key(a), key(b));
+        let pair = if ka < kb { (ka, kb) } else { (kb, ka) };
+        // The same edge from two faces (a shell modelled with both sides) counts once.
+        if ka == kb || face_normal.insert(pair, normal).is_some() {
+            continue;
+        }
+        next.entry(key(a)).or_default().push(b);
+        next.entry(key(b)).or_default().push(a);
+    }
+    let mut starts: Vec<DVec3> = edges.iter().map(|e| e.0).collect();
+    let outwards = |lp: &[DVec3]| {
+        let sign = area_signed(lp, n).signum();
+        (0..lp.len()).all(|i| {
+            let (a, b) = (lp[i], lp[(i + 1) % lp.len()]);
+            let pair = if key(a) < key(b) { (key(a), key(b)) } else { (key(b), key(a)) };
+            // Right of a counter-clockwise edge is out of the loop.
+            face_normal.get(&pair).is_some_and(|f| f.dot((b - a).cross(n)) * sign > 0.0)
+        })
+    };
+    starts.sort_by(|a, b| lexicographic(*a, *b));
+    let mut seen = std::collections::HashSet::new();
+    let mut loops = Vec::new();
+    for start in starts {
+        if seen.contains(&key(start)) {
+            continue;
+        }
+        let mut lp = vec![start];
+        seen.insert(key(start));
+        let (mut prev, mut at) = (start, start);
+        let closed = loop {
+            let Some(ns) = next.get(&key(at)).filter(|ns| ns.len() == 2) else { break false };
+            let step = if key(ns[0]) != key(prev) || lp.len() == 1 { ns[0] } else { ns[1] };
+            if key(step) == key(start) {
+                break lp.len() >= 3;
+            }
+            if !seen.insert(key(step)) {
+                break false;
+            }
+            lp.push(step);
+            (prev, at) = (at, step);
+        };
+        if closed && outwards(&lp) {
+            loops.push(lp);
+        }
+    }
+    loops
+}
+
+/// `lp` without collinear corners, counter-clockwise about `n`, from its lowest corner; `None`
+/// unless convex with an area.
+fn convex_loop(lp: Vec<DVec3>, n: DVec3) -> Option<Vec<DVec3>> {
+    let scale = lp.iter().map(|p| p.distance(lp[0])).fold(0.0, f64::max);
+    let k = lp.len();
+    let turn = |i: usize| {
+        let (a, b, c) = (lp[(i + k - 1) % k], lp[i], lp[(i + 1) % k]);
+        (b - a).cross(c - b).dot(n)
+    };
+    let tiny = 1e-9 * scale * scale;
+    let mut corners: Vec<DVec3> = (0..k).filter(|&i| turn(i).abs() > tiny).map(|i| lp[i]).collect();
+    if corners.len() < 3 {
+        return None;
+    }
+    if area_signed(&corners, n) < 0.0 {
+        corners.reverse();
+    }
+    let k = corners.len();
+    let convex = (0..k).all(|i| {
+        let (a, b, c) = (corners[(i + k - 1) % k], corners[i], corners[(i + 1) % k]);
+        (b - a).cross(c - b).dot(n) > tiny
+    });
+    if !convex {
+        return None;
+    }
+    let first = (0..k).min_by(|&i, &j| lexicographic(corners[i], corners[j]))?;
+    corners.rotate_left(first);
+    Some(corners)
+}
+
+fn area_signed(pts: &[DVec3], n: DVec3) -> f64 {
+    let mut s = DVec3::ZERO;
+    for (i, &a) in pts.iter().enumerate() {
+        s += a.cross(pts[(i + 1) % pts.len()]);
+    }
+    0.5 * s.dot(n)
+}
+
+fn area(pts: &[DVec3], n: DVec3) -> f64 {
+    if pts.len() < 3 { 0.0 } else { area_signed(pts, n).abs() }
+}
+
+/// Whether `p` (on the plane) lies inside the convex polygon `poly` whose normal is `n`.
+fn contains(poly: &[DVec3], n: DVec3, p: DVec3) -> bool {
+    let k = poly.len();
+    (0..k).all(|i| (poly[(i + 1) % k] - poly[i]).cross(p - poly[i]).dot(n) >= 0.0)
+}
+
+/// Whether `p` (on the plane) lies inside the convex polygon `poly` whose normal is `n`, or
+/// within `eps` of its outline.
+fn contains_within(poly: &[DVec3], n: DVec3, p: DVec3, eps: f64) -> bool {
+    let k = poly.len();
+    (0..k).all(|i| {
+        let edge = poly[(i + 1) % k] - poly[i];
+        edge.cross(p - poly[i]).dot(n) >= -eps * edge.length()
+    })
+}
+
+/// The part of convex `poly` where `f(x) ≥ 0` for the affine `f` (Sutherland & Hodgman 1974,
+/// one clipping plane).
+fn clip(poly: &[DVec3], f: impl Fn(DVec3) -> f64) -> Vec<DVec3> {
+    let mut out = Vec::with_capacity(poly.len() + 1);
+    for i in 0..poly.len() {
+        let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
+        let (fa, fb) = (f(a), f(b));
+        if fa >= 0.0 {
+            out.push(a);
+        }
+        if (fa >= 0.0) != (fb >= 0.0) {
+            out.push(a + (b - a) * (fa / (fa - fb)));
+        }
+    }
+    out
+}
+
+/// Convex `piece` minus convex footprint `f` (both on the plane with normal `n`) as convex
+/// pieces, and `piece ∩ f`.
+fn split(piece: &[DVec3], f: &[DVec3], n: DVec3) -> (Vec<Vec<DVec3>>, Vec<DVec3>) {
+    let mut outside = Vec::new();
+    let mut rest = piece.to_vec();
+    for i in 0..f.len() {
+        let (a, b) = (f[i], f[(i + 1) % f.len()]);
+        // Inward normal of the edge within the plane (the footprint is counter-clockwise).
+        let m = n.cross(b - a);
+        let inside = |x: DVec3| m.dot(x - a);
+        let out = clip(&rest, |x| -inside(x));
+        if area(&out, n) > 0.0 {
+            outside.push(out);
+        }
+        rest = clip(&rest, inside);
+        if rest.len() < 3 {
+            return (outside, Vec::new());
+        }
+    }
+    (outside, rest)
+}
+
+/// A piece's corners without repeats (a cut through a corner gives it twice) and without
+/// corners on a straight line, within round-off of the target's size.
+fn clean(piece: Vec<DVec3>, target: &Polygon) -> Vec<DVec3> {
+    let eps = 1e-9 * tolerance(target) * 1e4;
+    let mut out: Vec<DVec3> = Vec::with_capacity(piece.len());
+    for p in piece {
+        if out.last().is_none_or(|q: &DVec3| q.distance(p) > eps) {
+            out.push(p);
+        }
+    }
+    while out.len() > 1 && out[0].distance(out[out.len() - 1]) <= eps {
+        out.pop();
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Facing, box_faces};
+    use crate::{Material, Object, Rgb};
+
+    fn quad(y: f64, size: f64) -> Polygon {
+        Polygon::try_new(vec![
+            DVec3::new(0.0, y, 0.0),
+            DVec3::new(0.0, y, size),
+            DVec3::new(size, y, size),
+            DVec3::new(size, y, 0.0),
+        ])
+        .unwrap()
+    }
+
+    fn floor_and(block: Vec<Polygon>) -> Scene {
+        let grey = Material::try_new("grey", Rgb::splat(0.5), Rgb::ZERO).unwrap();
+        let lamp = Material::try_new("lamp", Rgb::ZERO, Rgb::ONE).unwrap();
+        Scene::try_new(
+            "floor",
+            None,
+            vec![grey, lamp],
+            vec![
+                Object::new("floor", 0, Shape::Polygons(vec![quad(0.0, 4.0)])),
+                Object::new("block", 0, Shape::Polygons(block)),
+                Object::new("lamp", 1, Shape::Polygons(vec![quad(3.0, 1.0)])),
+            ],
+        )
+        .unwrap()
+    }
+
+    /// A box standing on the floor: the floor is cut into convex pieces around its footprint,
+    /// whose area is what goes missing; the box's bottom is pressed flat on the floor.
+    #[test]
+    fn a_box_on_the_floor_cuts_its_footprint_out() {
+        let block =
+            box_faces(DVec3::new(1.0, 0.0, 1.5), DVec3::new(2.0, 1.0, 3.0), Facing::Outward, 20.0).unwrap();
+        let scene = floor_and(block.clone());
+        let contacts = Contacts::new(&scene);
+        let Shape::Polygons(floor) = &scene.objects[0].shape else { unreachable!() };
+        let cut = contacts
+            .cut(&floor[0], Some(PolygonId { object: 0, index: 0 }), |q| (q.area() * 100.0) as usize)
+            .expect("a cut");
+        assert!((cut.hidden - 1.5).abs() < 1e-9, "hidden {}", cut.hidden);
+        let kept: f64 = cut.pieces.iter().map(Polygon::area).sum();
+        assert!((kept + cut.hidden - 16.0).abs() < 1e-9, "kept {kept}");
+        assert!(cut.pieces.len() >= 4 && cut.pieces.iter().all(|p| p.normal().dot(DVec3::Y) > 0.999));
+        // No piece overlaps the footprint (the bottom's outline, turned to face up): every
+        // piece's centre is outside it.
+        let bottom = block.iter().position(|p| p.normal().y < -0.99).unwrap();
+        let footprint: Vec<DVec3> = block[bottom].vertices().iter().rev().copied().collect();
+        for p in &cut.pieces {
+            let c = p.vertices().iter().copied().sum::<DVec3>() / p.vertices().len() as f64;
+            assert!(!contains(&footprint, DVec3::Y, c), "{c}");
+        }
+        assert!(contacts.is_pressed_flat(PolygonId { object: 1, index: bottom }, &block[bottom]));
+        // The floor is not pressed against the (smaller) bottom: only a face lying within
+        // the other one is.
+        assert!(!contacts.is_pressed_flat(PolygonId { object: 0, index: 0 }, &floor[0]));
+        let top = block.iter().position(|p| p.normal().y > 0.99).unwrap();
+        assert!(!contacts.is_pressed_flat(PolygonId { object: 1, index: top }, &block[top]));
+        // The lamp hangs above: it cuts nothing; the floor's own plane holds nothing else.
+        let Shape::Polygons(lamp) = &scene.objects[2].shape else { unreachable!() };
+        assert!(
+            contacts
+                .cut(&lamp[0], Some(PolygonId { object: 2, index: 0 }), |q| (q.area() * 100.0) as usize)
+                .is_none()
+        );
+    }
+
+    /// A box floating above the floor, or one sunk through it, or open at the bottom in a way
+    /// that leaves no closed outline: nothing is cut.
+    #[test]
+    fn only_solids_standing_on_the_surface_cut_it() {
+        let cut_of = |block: Vec<Polygon>| {
+            let scene = floor_and(block);
+            let contacts = Contacts::new(&scene);
+            let Shape::Polygons(floor) = &scene.objects[0].shape else { unreachable!() };
+            contacts
+                .cut(&floor[0], Some(PolygonId { object: 0, index: 0 }), |q| (q.area() * 100.0) as usize)
+                .map(|c| c.hidden)
+        };
+        let floating =
+            box_faces(DVec3::new(1.0, 0.1, 1.0), DVec3::new(2.0, 1.0, 2.0), Facing::Outward, 0.0).unwrap();
+        assert_eq!(cut_of(floating), None);
+        let sunk =
+            box_faces(DVec3::new(1.0, -0.5, 1.0), DVec3::new(2.0, 1.0, 2.0), Facing::Outward, 0.0).unwrap();
+        assert_eq!(cut_of(sunk), None);
+        // Three sides of a box: the outline does not close.
+        let mut open =
+            box_faces(DVec3::new(1.0, 0.0, 1.0), DVec3::new(2.0, 1.0, 2.0), Facing::Outward, 0.0).unwrap();
+        open.retain(|p| p.normal().x < 0.5 && p.normal().y.abs() < 0.5);
+        assert_eq!(cut_of(open), None);
+        // Four sides and no lid: the floor inside is lit from above.
+        let mut no_lid =
+            box_faces(DVec3::new(1.0, 0.0, 1.0), DVec3::new(2.0, 1.0, 2.0), Facing::Outward, 0.0).unwrap();
+        no_lid.retain(|p| p.normal().y.abs() < 0.5);
+        assert_eq!(cut_of(no_lid.clone()), None);
+        let standing =
+            box_faces(DVec3::new(1.0, 0.0, 1.0), DVec3::new(2.0, 1.0, 2.0), Facing::Outward, 0.0).unwrap();
+        assert!((cut_of(standing).unwrap() - 1.0).abs() < 1e-9);
+        // The same sides with a lid and no bottom (how the Cornell box's blocks are given).
+        let lid = box_faces(DVec3::new(1.0, 0.0, 1.0), DVec3::new(2.0, 1.0, 2.0), Facing::Outward, 0.0)
+            .unwrap()
+            .into_iter()
+            .filter(|p| p.normal().y > 0.5);
+        assert!((cut_of(no_lid.into_iter().chain(lid).collect()).unwrap() - 1.0).abs() < 1e-9);
+    }
+
+    /// A footprint half off the surface's edge hides only the part on it.
+    #[test]
+    fn a_footprint_over_the_edge_hides_its_overlap() {
+        let block =
+            box_faces(DVec3::new(3.5, 0.0, 1.0), DVec3::new(4.5, 1.0, 2.0), Facing::Outward, 0.0).unwrap();
+        let scene = floor_and(block);
+        let contacts = Contacts::new(&scene);
+        let Shape::Polygons(floor) = &scene.objects[0].shape else { unreachable!() };
+        let cut = contacts
+            .cut(&floor[0], Some(PolygonId { object: 0, index: 0 }), |q| (q.area() * 100.0) as usize)
+            .unwrap();
+        assert!((cut.hidden - 0.5).abs() < 1e-9, "{}", cut.hidden);
+        let kept: f64 = cut.pieces.iter().map(Polygon::area).sum();
+        assert!((kept - 15.5).abs() < 1e-9, "{kept}");
+    }
+}
