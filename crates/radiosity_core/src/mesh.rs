@@ -901,7 +901,11 @@ impl Mesh {
         material: usize,
         params: &MeshParams,
     ) {
-        let cut = contacts.and_then(|c| c.cut(p, id, |q| estimate_polygon_elements(q, params)));
+        // A face that meshes into a few elements gains nothing from a cut (the facets of a
+        // tessellated model): only surfaces of several elements are looked at.
+        let large = p.area() >= 4.0 * params.element_size * params.element_size;
+        let cut =
+            contacts.filter(|_| large).and_then(|c| c.cut(p, id, |q| estimate_polygon_elements(q, params)));
         let pieces = match &cut {
             Some(cut) => {
                 self.hidden_area[object] += cut.hidden;

@@ -119,7 +119,7 @@ enum Check {
     Run,
     /// Run it without a display: the scene loads and the options are checked (exit code 2
     /// otherwise), then the window cannot open (exit code 1, the no-display message). The
-    /// window itself is tested in tests/viewer.rs.
+    /// window itself is tested in tests/suite/viewer.rs.
     NoWindow,
     /// Too long for a test (minutes): its options are checked to parse (`--help` after them).
     Parse,

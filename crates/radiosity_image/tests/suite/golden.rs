@@ -6,11 +6,11 @@
 //! difference picture a failure writes).
 //!
 //! To regenerate them after an intended change: `REGEN_GOLDEN=1 cargo test -p radiosity_image
-//! --test golden`, then open the preview PNG it names and check the picture (red wall on the
+//! --test suite golden`, then open the preview PNG it names and check the picture (red wall on the
 //! left, green on the right, colour bleeding onto the white surfaces, soft shadows, no seams)
 //! before committing the new files.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 
@@ -108,7 +108,7 @@ fn small_cornell_render_matches_the_golden_statistics() {
         let golden = Golden {
             description: "Per-object mean radiance (W/sr/mm², linear) over interior pixels of a 64×64, 4 spp \
                           render of the Cornell box (scenes/cornell.toml) solved with SolverParams::default(); \
-                          regenerate with REGEN_GOLDEN=1 (see tests/golden.rs)"
+                          regenerate with REGEN_GOLDEN=1 (see tests/suite/golden.rs)"
                 .into(),
             width: WIDTH,
             height: HEIGHT,

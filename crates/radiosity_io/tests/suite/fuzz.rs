@@ -6,7 +6,7 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 
 use radiosity_io::parse_scene;
 
-const CORNELL: &str = include_str!("../../../scenes/cornell.toml");
+const CORNELL: &str = include_str!("../../../../scenes/cornell.toml");
 
 use radiosity_core::random::XorShift64;
 

@@ -1,7 +1,7 @@
 //! The renderer against physics: a closed furnace, and how radiosity is interpolated near
 //! element edges and surface corners.
 
-mod common;
+use crate::common;
 
 use std::f64::consts::PI;
 use std::sync::Arc;

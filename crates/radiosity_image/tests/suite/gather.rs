@@ -1,7 +1,7 @@
 //! Final gather against physics: the furnace (no light counted twice, none lost) and the
 //! Cornell box (the gathered picture estimates the same light as the radiosity mesh).
 
-mod common;
+use crate::common;
 
 use std::f64::consts::PI;
 

@@ -1,0 +1,16 @@
+//! The command and the crates end to end, as one test binary: one link instead of a dozen on
+//! a cold `cargo test`, and the files' tests run side by side instead of one binary after
+//! another. Each file is a module of its own.
+
+mod bad_input;
+mod cli;
+mod dependencies;
+mod discretisation;
+mod export;
+mod fast_paths;
+mod model_fuzz;
+mod models;
+mod public_models;
+mod readme;
+mod verify;
+mod viewer;
