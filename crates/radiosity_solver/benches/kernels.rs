@@ -1,4 +1,4 @@
-//! Criterion benchmarks of the solver's hot kernels: `cargo bench -p radiosity_solver`.
+//! Criterion benchmarks of the solver's hot kernels: `cargo bench -p radiosity_solver --features bench`.
 //!
 //! Per-call figures for the exact form factor (far, clipped, integrated over a receiver),
 //! occlusion rays through the BVH and through a shaft's candidate list, and one whole shot
