@@ -176,7 +176,8 @@ fn other_command(command: &str) -> Result<(), String> {
             let declared = manifest.lines().any(|l| l.starts_with(&format!("{feature} =")));
             if declared { Ok(()) } else { Err(format!("radiosity_viewer has no feature {feature}")) }
         }
-        ["cargo", "bench", "-p", crate_name] | ["cargo", "bench", "-p", crate_name, "--features", "bench"] => {
+        ["cargo", "bench", "-p", crate_name]
+        | ["cargo", "bench", "-p", crate_name, "--features", "bench"] => {
             exists(&format!("crates/{crate_name}/benches"))
         }
         ["cargo", "install", "--locked", "--path", "."] => exists("Cargo.toml"),

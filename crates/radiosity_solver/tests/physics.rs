@@ -326,3 +326,29 @@ fn a_mesh_with_patches_out_of_order_is_refused() {
     let err = Problem::from_mesh(Arc::new(mesh)).solver(SolverParams::default()).err().unwrap();
     assert!(matches!(err, radiosity_solver::SolverError::BadMesh { patch: 0 }), "{err}");
 }
+
+/// The Cornell box closed by a white front wall: all the light stays inside, so a converged
+/// solve must have absorbed what was emitted, less the unshot remainder (the measured box's
+/// slightly crooked edges let almost nothing out). Its floor patches half in the blocks'
+/// shadow are uneven shooters, whose weighting gives the block sides what they see of them;
+/// the power a side sees less of must go to the rest of the room, not vanish. Measured:
+/// 0.003 % escaped; 0.39 % when the weighting dropped it.
+#[test]
+fn a_closed_cornell_box_keeps_its_light() {
+    use radiosity_core::{Object, Polygon, Shape};
+    let mut scene = radiosity_core::cornell_box();
+    let front = Polygon::try_new(
+        [[0.0, 0.0, 0.0], [552.8, 0.0, 0.0], [556.0, 548.8, 0.0], [0.0, 548.8, 0.0]]
+            .iter()
+            .map(|&p| glam::DVec3::from_array(p))
+            .collect(),
+    )
+    .unwrap();
+    scene.objects.push(Object::new("front_wall", 0, Shape::Polygons(vec![front])));
+    let s = converged(&scene, 1e-3);
+    let e = s.energy();
+    let escaped = e.escaped.sum() / e.emitted.sum();
+    let unshot = e.unshot.sum() / e.emitted.sum();
+    assert!(unshot < 1e-3 * 1.01, "unshot {unshot}");
+    assert!(escaped < 0.001, "{:.3} % of the emitted power escaped a closed box", escaped * 100.0);
+}

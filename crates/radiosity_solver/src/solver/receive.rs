@@ -25,6 +25,8 @@ pub(super) struct Received {
     /// F_{e→shooter} without visibility (weighted for uneven shooters); 0 when it cannot
     /// receive.
     pub(super) unoccluded: f64,
+    /// The same before the uneven shooter's weighting (equal to `unoccluded` otherwise).
+    pub(super) unweighted: f64,
     /// Unblocked rays among `traced`.
     pub(super) visible: u32,
     /// Rays traced; 0 when the pair needs none (nothing can block it).
@@ -34,10 +36,16 @@ pub(super) struct Received {
 impl Received {
     /// The element's form factor with visibility.
     pub(super) fn factor(&self) -> f64 {
-        if self.traced == 0 {
-            return self.unoccluded;
-        }
-        self.unoccluded * f64::from(self.visible) / f64::from(self.traced)
+        self.unoccluded * self.visibility()
+    }
+
+    /// The form factor with visibility, before the uneven shooter's weighting.
+    pub(super) fn unweighted_factor(&self) -> f64 {
+        self.unweighted * self.visibility()
+    }
+
+    fn visibility(&self) -> f64 {
+        if self.traced == 0 { 1.0 } else { f64::from(self.visible) / f64::from(self.traced) }
     }
 }
 
@@ -61,9 +69,9 @@ pub(super) fn element_facing(shooter: &Patch, plan: &PatchPlan, receiver: &[DVec
             && receiver.iter().all(|p| shooter.normal.dot(*p - corner) > 1e-9 * shooter.area.sqrt()))
 }
 
-/// Element `e`'s form factor to the shooter without visibility (weighted for an uneven
-/// shooter).
-fn unoccluded(shot: &Shot, plan: &PatchPlan, e: usize) -> f64 {
+/// Element `e`'s form factor to the shooter without visibility: weighted for an uneven
+/// shooter, and before that weighting.
+fn unoccluded(shot: &Shot, plan: &PatchPlan, e: usize) -> (f64, f64) {
     let Shot { mesh, shooter, shooter_elements, uneven, params, .. } = *shot;
     let el = &mesh.elements[e];
     let pts = corners_of(mesh, e);
@@ -106,12 +114,14 @@ fn unoccluded(shot: &Shot, plan: &PatchPlan, e: usize) -> f64 {
                 // form factor keeps its quadrature; the weighting is taken at the centre.
                 // The whole patch is weighted, its elements off the plane too: they are the
                 // ones next to the contact line.
-                f *= density_weight(el.centre, el.normal, shooter.normal, &uneven, shooter_elements);
+                let weight = density_weight(el.centre, el.normal, shooter.normal, &uneven, shooter_elements);
+                return (f * weight, f);
             }
-            f
+            (f, f)
         }
         FormFactorMethod::PointToPoint => {
-            point_to_point(el.centre, el.normal, shooter.centre, shooter.normal, shooter.area)
+            let f = point_to_point(el.centre, el.normal, shooter.centre, shooter.normal, shooter.area);
+            (f, f)
         }
     }
 }
@@ -156,11 +166,13 @@ fn unoccluded_factors(shot: &Shot, plan: &PatchPlan, first: usize, out: &mut [Re
             let f = points_to_polygon_in_front_x4(&points, &normals, chunk.len(), corners);
             for (r, f) in chunk.iter_mut().zip(f) {
                 r.unoccluded = f.max(0.0);
+                r.unweighted = r.unoccluded;
             }
         }
     } else {
         for (k, r) in out.iter_mut().enumerate() {
-            r.unoccluded = unoccluded(shot, plan, first + k).max(0.0);
+            let (weighted, unweighted) = unoccluded(shot, plan, first + k);
+            (r.unoccluded, r.unweighted) = (weighted.max(0.0), unweighted.max(0.0));
         }
     }
 }
