@@ -194,9 +194,7 @@ impl<'a> Contacts<'a> {
         loops.sort_by(|a, b| lexicographic(a[0], b[0]));
         loops
     }
-}
 
-impl Contacts<'_> {
     /// Whether `p`, a point of a footprint on a plane with normal `n`, lies inside a closed
     /// solid: the first face straight above it is met from behind. An open box or a cup
     /// standing on a table leaves the table inside it lit, so that footprint must not cut.
@@ -398,10 +396,10 @@ fn split(piece: &[DVec3], f: &[DVec3], n: DVec3) -> (Vec<Vec<DVec3>>, Vec<DVec3>
     (outside, rest)
 }
 
-/// A piece's corners without repeats (a cut through a corner gives it twice) and without
-/// corners on a straight line, within round-off of the target's size.
+/// A piece's corners without repeats (a cut through a corner gives it twice), within
+/// round-off of the target's size (1e-9 of its bounding box's diagonal).
 fn clean(piece: Vec<DVec3>, target: &Polygon) -> Vec<DVec3> {
-    let eps = 1e-9 * tolerance(target) * 1e4;
+    let eps = 1e-5 * tolerance(target);
     let mut out: Vec<DVec3> = Vec::with_capacity(piece.len());
     for p in piece {
         if out.last().is_none_or(|q: &DVec3| q.distance(p) > eps) {
