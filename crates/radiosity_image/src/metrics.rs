@@ -14,11 +14,14 @@ pub struct ObjectPixels {
 }
 
 /// Per object (index into `Mesh::object_names`, `object_count` of them), the mean radiance of
-/// the pixels *inside* its silhouette: pixels whose centre ray hits the object and whose four
+/// the pixels *inside* its silhouette: pixels whose centre ray hits the object and whose eight
 /// neighbours' centre rays hit it too. `None` for an object with no such pixel.
 ///
 /// Edge pixels are left out because their jittered samples mix the object with whatever lies
 /// beside it; keeping them would make the statistic depend on the sampling, not on the light.
+/// The diagonal neighbours count too: next to an emitter's corner a pixel whose four side
+/// neighbours are all ceiling still has samples on the lamp, a thousand times brighter, and
+/// a handful of such pixels moved the Cornell ceiling's mean by 2–3 % from seed to seed.
 pub fn object_mean_radiance(rendering: &Rendering, object_count: usize) -> Vec<Option<ObjectPixels>> {
     let img = &rendering.radiance;
     let (w, h) = (img.width() as usize, img.height() as usize);
@@ -28,7 +31,9 @@ pub fn object_mean_radiance(rendering: &Rendering, object_count: usize) -> Vec<O
         for x in 1..w.saturating_sub(1) {
             let i = y * w + x;
             let Some(id) = ids[i] else { continue };
-            let interior = [i - 1, i + 1, i - w, i + w].iter().all(|&j| ids[j] == Some(id));
+            let interior = [i - w - 1, i - w, i - w + 1, i - 1, i + 1, i + w - 1, i + w, i + w + 1]
+                .iter()
+                .all(|&j| ids[j] == Some(id));
             if interior && (id as usize) < object_count {
                 let s = &mut sums[id as usize];
                 s.0 += img.pixels()[i];
