@@ -247,9 +247,7 @@ impl Renderer {
     /// smoothed indirect part hides.
     fn shading_normal(&self, e: usize, p: DVec3) -> DVec3 {
         let el = &self.mesh.elements[e];
-        if self.shading_normals.is_empty()
-            || el.vertex_indices().iter().all(|&v| self.shading_normals[v as usize] == el.normal)
-        {
+        if self.shading_normals.is_empty() || is_flat(el, &self.shading_normals) {
             return el.normal;
         }
         let n = self.interpolate_values(&self.shading_normals, e, p).normalize_or_zero();
@@ -642,33 +640,29 @@ fn inverse_bilinear(p: DVec2, a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> (f64, f
     (s.clamp(0.0, 1.0), t.clamp(0.0, 1.0))
 }
 
-/// Per vertex of `mesh`, the mean of its own surface's normal and those of the surfaces it
-/// pools with ([`Mesh::smoothing`], weighted as the radiosity is), normalised: a shading
-/// normal that turns smoothly across the facets of a curved model. Empty when no vertex's
-/// differs from its own surface's (flat scenes such as the Cornell box), so they render
-/// exactly as before.
+/// Per vertex of `mesh`, its own shading normal ([`Mesh::shading_normals`]: its surface's
+/// normal, a sphere's true normal) averaged with those of the vertices it pools with
+/// ([`Mesh::smoothing`], weighted as the radiosity is), normalised: a shading normal that
+/// turns smoothly across the facets of a curved model. Empty when every vertex's is its
+/// elements' own normal (flat scenes such as the Cornell box), so they render as with
+/// facet normals.
 fn shading_normals(mesh: &Mesh) -> Vec<DVec3> {
-    let mut own = vec![DVec3::ZERO; mesh.positions.len()];
-    for el in &mesh.elements {
-        for &v in el.vertex_indices() {
-            own[v as usize] = el.normal;
-        }
-    }
-    let mut turned = false;
+    let own = &mesh.shading_normals;
     let normals: Vec<DVec3> = (0..own.len())
         .map(|v| {
             let sum = mesh.smoothing.partners_of(v).fold(own[v], |n, (q, w)| n + own[q as usize] * w);
             let n = sum.normalize_or_zero();
-            // Coplanar partners (the Cornell ceiling's four polygons) leave it as it was.
-            if n == DVec3::ZERO || n.dot(own[v]) > 1.0 - 1e-12 {
-                own[v]
-            } else {
-                turned = true;
-                n
-            }
+            if n == DVec3::ZERO { own[v] } else { n }
         })
         .collect();
+    let turned = mesh.elements.iter().any(|el| !is_flat(el, &normals));
     if turned { normals } else { Vec::new() }
+}
+
+/// Whether every vertex normal of `el` is its own normal, within round-off of a normal
+/// computed from other corners of the same plane (3e-5 rad): there is nothing to interpolate.
+fn is_flat(el: &radiosity_core::Element, normals: &[DVec3]) -> bool {
+    el.vertex_indices().iter().all(|&v| normals[v as usize].dot(el.normal) > 1.0 - 5e-10)
 }
 
 #[cfg(test)]
