@@ -66,7 +66,7 @@ impl<'a> Contacts<'a> {
             };
             for (index, p) in polygons.iter().enumerate() {
                 let v = p.vertices();
-                let (lo, hi) = v.iter().fold((v[0], v[0]), |(lo, hi), &q| (lo.min(q), hi.max(q)));
+                let (lo, hi) = bounds(v);
                 candidates.push((PolygonId { object, index }, p, lo, hi));
             }
         }
@@ -99,7 +99,7 @@ impl<'a> Contacts<'a> {
     /// box's bottom on the floor): no light can reach it.
     pub(crate) fn is_pressed_flat(&self, id: PolygonId, poly: &Polygon) -> bool {
         let v = poly.vertices();
-        let (lo, hi) = v.iter().fold((v[0], v[0]), |(lo, hi), &q| (lo.min(q), hi.max(q)));
+        let (lo, hi) = bounds(v);
         self.near(lo, hi, tolerance(poly)).any(|&(other, p, _, _)| {
             other != id && p.normal().dot(poly.normal()) < -0.999 && {
                 let eps = tolerance(p);
@@ -160,7 +160,7 @@ impl<'a> Contacts<'a> {
     /// OBJ or glTF cuts the same way).
     fn footprints(&self, target: &Polygon, id: Option<PolygonId>) -> Vec<Vec<DVec3>> {
         let v = target.vertices();
-        let (lo, hi) = v.iter().fold((v[0], v[0]), |(lo, hi), &q| (lo.min(q), hi.max(q)));
+        let (lo, hi) = bounds(v);
         let eps = tolerance(target);
         let (n, d) = plane(target);
         let height = |q: DVec3| n.dot(q) - d;
@@ -211,7 +211,7 @@ impl<'a> Contacts<'a> {
             let t = pn.dot(poly.vertices()[0] - origin) / denominator;
             if t > 0.0
                 && first.is_none_or(|(best, _)| t < best)
-                && contains(poly.vertices(), pn, origin + n * t)
+                && contains_within(poly.vertices(), pn, origin + n * t, 0.0)
             {
                 first = Some((t, denominator > 0.0));
             }
@@ -220,11 +220,16 @@ impl<'a> Contacts<'a> {
     }
 }
 
+/// The bounding box of `v` (not empty).
+fn bounds(v: &[DVec3]) -> (DVec3, DVec3) {
+    v.iter().fold((v[0], v[0]), |(lo, hi), &q| (lo.min(q), hi.max(q)))
+}
+
 /// The tolerance for "on the plane": the planarity a [`Polygon`] is allowed (1e-4 of its
 /// bounding box's diagonal).
 fn tolerance(p: &Polygon) -> f64 {
     let v = p.vertices();
-    let (lo, hi) = v.iter().fold((v[0], v[0]), |(lo, hi), &q| (lo.min(q), hi.max(q)));
+    let (lo, hi) = bounds(v);
     1e-4 * lo.distance(hi)
 }
 
@@ -339,12 +344,6 @@ fn area_signed(pts: &[DVec3], n: DVec3) -> f64 {
 
 fn area(pts: &[DVec3], n: DVec3) -> f64 {
     if pts.len() < 3 { 0.0 } else { area_signed(pts, n).abs() }
-}
-
-/// Whether `p` (on the plane) lies inside the convex polygon `poly` whose normal is `n`.
-fn contains(poly: &[DVec3], n: DVec3, p: DVec3) -> bool {
-    let k = poly.len();
-    (0..k).all(|i| (poly[(i + 1) % k] - poly[i]).cross(p - poly[i]).dot(n) >= 0.0)
 }
 
 /// Whether `p` (on the plane) lies inside the convex polygon `poly` whose normal is `n`, or
@@ -466,7 +465,7 @@ mod tests {
         let footprint: Vec<DVec3> = block[bottom].vertices().iter().rev().copied().collect();
         for p in &cut.pieces {
             let c = p.vertices().iter().copied().sum::<DVec3>() / p.vertices().len() as f64;
-            assert!(!contains(&footprint, DVec3::Y, c), "{c}");
+            assert!(!contains_within(&footprint, DVec3::Y, c, 0.0), "{c}");
         }
         assert!(contacts.is_pressed_flat(PolygonId { object: 1, index: bottom }, &block[bottom]));
         // The floor is not pressed against the (smaller) bottom: only a face lying within
