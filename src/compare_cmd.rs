@@ -19,6 +19,12 @@ pub struct CompareArgs {
     pub picture: PathBuf,
     /// Picture taken as the truth (.exr or .pfm), e.g. from `render --reference --exr`.
     pub reference: PathBuf,
+    /// A second reference of the same view, rendered with another `--seed`. With it the
+    /// figures are taken against the mean of the two references, and `compare` adds the
+    /// picture's RMS relative error with the references' own noise taken out, so a picture
+    /// can be judged against a path-traced truth far noisier than its own error.
+    #[arg(long, value_name = "PICTURE")]
+    pub second_reference: Option<PathBuf>,
     /// Write a false-colour picture of the relative luminance difference (PNG): blue where the
     /// first picture is darker, red where it is brighter, white where they agree, black where
     /// the reference is dark.
@@ -56,15 +62,58 @@ struct ChannelFigures {
     relative_rmse: f64,
     /// Pixels counted in the relative figures.
     pixels: usize,
+    /// With two references: the RMS over the counted pixels of (a − t) / t against the
+    /// noiseless picture t, and the RMS relative noise of the references' mean.
+    noise_free: Option<NoiseFree>,
 }
 
-fn figures(a: &[f64], b: &[f64]) -> ChannelFigures {
+/// Figures against the noiseless truth, from two independent references.
+#[derive(Clone, Copy, Debug, Default)]
+struct NoiseFree {
+    /// √(mean of (a − r₁)(a − r₂) / r̄²): the picture's RMS relative error.
+    relative_rms_error: f64,
+    /// √(mean of ((r₁ − r₂) / 2)² / r̄²): the RMS relative noise left in r̄ (whose variance is
+    /// that of (r₁ − r₂) / 2).
+    reference_noise: f64,
+}
+
+/// The picture's error with the references' noise taken out. With r₁ = t + e₁ and
+/// r₂ = t + e₂, e₁ and e₂ independent, zero-mean and independent of a,
+/// E[(a − r₁)(a − r₂)] = E[(a − t)²]: the product is an unbiased estimate of the squared error
+/// against the truth, however noisy each reference is. Divided by r̄² it is relative, and the
+/// noise of r̄ correlates with e₁e₂: for a relative noise σ of each reference the relative
+/// squared error reads about 1.5·σ⁴ too high (Taylor expansion of 1/r̄² to second order).
+/// That errs on the safe side and is small: at σ = 6 % a 2.00 % error reads 2.06 %.
+/// Dividing by the picture's own value instead would be unbiased, but one dark pixel under a
+/// lit reference would outweigh the rest of the picture.
+fn noise_free(a: &[f64], r1: &[f64], r2: &[f64], counted: impl Fn(f64) -> bool) -> NoiseFree {
+    let (mut err, mut noise, mut n) = (0.0, 0.0, 0usize);
+    for ((&x, &y1), &y2) in a.iter().zip(r1).zip(r2) {
+        let mean = 0.5 * (y1 + y2);
+        if counted(mean) {
+            err += (x - y1) * (x - y2) / (mean * mean);
+            noise += (0.5 * (y1 - y2) / mean).powi(2);
+            n += 1;
+        }
+    }
+    let n = n.max(1) as f64;
+    // The mean can come out negative when the picture is closer to the truth than the
+    // references can tell: that reads as no error.
+    NoiseFree { relative_rms_error: (err / n).max(0.0).sqrt(), reference_noise: (noise / n).sqrt() }
+}
+
+/// Figures of `a` against the reference `r1`, or against the mean of `r1` and `r2` when there
+/// are two.
+fn figures(a: &[f64], r1: &[f64], r2: Option<&[f64]>) -> ChannelFigures {
+    let mean_of_two: Option<Vec<f64>> = r2.map(|r2| r1.iter().zip(r2).map(|(x, y)| 0.5 * (x + y)).collect());
+    let b = mean_of_two.as_deref().unwrap_or(r1);
     let n = b.len().max(1) as f64;
     let mean_b = b.iter().sum::<f64>() / n;
     let floor = DARK_SHARE * mean_b;
+    let counted = |y: f64| y > floor && y > 0.0;
     let (mut abs_rel, mut rel, mut count) = (0.0, 0.0, 0usize);
     for (&x, &y) in a.iter().zip(b) {
-        if y > floor && y > 0.0 {
+        if counted(y) {
             abs_rel += ((x - y) / y).abs();
             rel += (x - y) / y;
             count += 1;
@@ -78,6 +127,7 @@ fn figures(a: &[f64], b: &[f64]) -> ChannelFigures {
         rmse,
         relative_rmse: if mean_b > 0.0 { rmse / mean_b } else { 0.0 },
         pixels: count,
+        noise_free: r2.map(|r2| noise_free(a, r1, r2, counted)),
     }
 }
 
@@ -122,25 +172,40 @@ pub fn run(a: CompareArgs) -> Result<()> {
     }
     let pa = read_hdr(&a.picture).map_err(|e| input(e.to_string()))?;
     let pb = read_hdr(&a.reference).map_err(|e| input(e.to_string()))?;
-    if (pa.width(), pa.height()) != (pb.width(), pb.height()) {
-        return Err(input(format!(
-            "the pictures differ in size: {}×{} and {}×{}",
-            pa.width(),
-            pa.height(),
-            pb.width(),
-            pb.height()
-        )));
+    let pb2 =
+        a.second_reference.as_ref().map(|p| read_hdr(p).map_err(|e| input(e.to_string()))).transpose()?;
+    for (path, other) in std::iter::once((&a.reference, &pb)).chain(a.second_reference.iter().zip(&pb2)) {
+        if (pa.width(), pa.height()) != (other.width(), other.height()) {
+            return Err(input(format!(
+                "the pictures differ in size: {} is {}×{}, {} is {}×{}",
+                a.picture.display(),
+                pa.width(),
+                pa.height(),
+                path.display(),
+                other.width(),
+                other.height()
+            )));
+        }
     }
     let channel = |img: &HdrImage, f: Channel| img.pixels().iter().map(f).collect::<Vec<f64>>();
     let getters: [(&str, Channel); 4] =
         [("r", |p| p.r), ("g", |p| p.g), ("b", |p| p.b), ("Y", |p| p.luminance())];
-    let all: Vec<(&str, ChannelFigures)> =
-        getters.iter().map(|&(name, f)| (name, figures(&channel(&pa, f), &channel(&pb, f)))).collect();
+    let all: Vec<(&str, ChannelFigures)> = getters
+        .iter()
+        .map(|&(name, f)| {
+            let second = pb2.as_ref().map(|p| channel(p, f));
+            (name, figures(&channel(&pa, f), &channel(&pb, f), second.as_deref()))
+        })
+        .collect();
 
+    let against = match &a.second_reference {
+        Some(second) => format!("the mean of {} and {}", a.reference.display(), second.display()),
+        None => a.reference.display().to_string(),
+    };
     let mut text = format!(
-        "{} vs {} ({}×{}; relative figures over the pixels where the reference is above {} % of its mean)\n{:<8} {:>16} {:>18} {:>12} {:>11} {:>8}\n",
+        "{} vs {} ({}×{}; relative figures over the pixels where the reference is above {} % of its mean)\n{:<8} {:>16} {:>18} {:>12} {:>11} {:>8}",
         a.picture.display(),
-        a.reference.display(),
+        against,
         pa.width(),
         pa.height(),
         DARK_SHARE * 100.0,
@@ -151,9 +216,13 @@ pub fn run(a: CompareArgs) -> Result<()> {
         "RMSE/mean",
         "pixels"
     );
+    if pb2.is_some() {
+        text += &format!(" {:>22} {:>11}", "RMS rel. err, noise out", "ref. noise");
+    }
+    text.push('\n');
     for (name, f) in &all {
         text += &format!(
-            "{:<8} {:>15.2} % {:>+16.2} % {:>12.4e} {:>9.2} % {:>8}\n",
+            "{:<8} {:>15.2} % {:>+16.2} % {:>12.4e} {:>9.2} % {:>8}",
             name,
             f.mean_relative_error * 100.0,
             f.mean_relative_difference * 100.0,
@@ -161,6 +230,11 @@ pub fn run(a: CompareArgs) -> Result<()> {
             f.relative_rmse * 100.0,
             f.pixels
         );
+        if let Some(nf) = f.noise_free {
+            text +=
+                &format!(" {:>21.2} % {:>9.2} %", nf.relative_rms_error * 100.0, nf.reference_noise * 100.0);
+        }
+        text.push('\n');
     }
     if a.json.as_deref() != Some("-") {
         output::stdout(&text)?;
@@ -179,6 +253,7 @@ pub fn run(a: CompareArgs) -> Result<()> {
         let doc = json!({
             "picture": a.picture.display().to_string(),
             "reference": a.reference.display().to_string(),
+            "second_reference": a.second_reference.as_ref().map(|p| p.display().to_string()),
             "width": pa.width(),
             "height": pa.height(),
             "channels": all.iter().map(|(name, f)| json!({
@@ -188,6 +263,8 @@ pub fn run(a: CompareArgs) -> Result<()> {
                 "rmse": f.rmse,
                 "relative_rmse": f.relative_rmse,
                 "pixels": f.pixels,
+                "noise_free_relative_rms_error": f.noise_free.map(|n| n.relative_rms_error),
+                "reference_noise": f.noise_free.map(|n| n.reference_noise),
             })).collect::<Vec<_>>(),
         });
         write_report(path, a.force, &serde_json::to_string_pretty(&doc)?)?;
@@ -203,12 +280,46 @@ mod tests {
     fn figures_of_a_uniformly_brighter_picture() {
         let b = vec![1.0, 2.0, 0.0, 4.0];
         let a: Vec<f64> = b.iter().map(|x| x * 1.1).collect();
-        let f = figures(&a, &b);
+        let f = figures(&a, &b, None);
         assert_eq!(f.pixels, 3);
         assert!((f.mean_relative_error - 0.1).abs() < 1e-12);
         assert!((f.mean_relative_difference - 0.1).abs() < 1e-12);
         let expected_rmse = ((0.01 + 0.04 + 0.16) / 4.0_f64).sqrt();
         assert!((f.rmse - expected_rmse).abs() < 1e-12);
+    }
+
+    /// A picture 2 % off everywhere, judged against two references with 6 % noise each (as
+    /// much as 1024-path references of the Cornell box have): against one of them the error
+    /// reads about 5 %, with the noise taken out 2 % (plus the 1.5·σ⁴ the noisy denominator
+    /// adds: √(0.02² + 1.5·0.06⁴) = 2.05 %).
+    #[test]
+    fn noise_free_error_sees_through_noisy_references() {
+        let mut rng = radiosity_core::random::Rng::from_state(7);
+        let n = 400_000;
+        let truth: Vec<f64> = (0..n).map(|i| 1.0 + (i % 7) as f64).collect();
+        // Alternating signs: 2 % off in magnitude, no mean offset.
+        let a: Vec<f64> =
+            truth.iter().enumerate().map(|(i, t)| t * if i % 2 == 0 { 1.02 } else { 0.98 }).collect();
+        // Uniform noise of ±√3·σ: standard deviation σ of the truth.
+        let sigma = 0.06;
+        let mut noisy = || {
+            truth
+                .iter()
+                .map(|t| t * (1.0 + sigma * 3f64.sqrt() * (2.0 * rng.next_f64() - 1.0)))
+                .collect::<Vec<f64>>()
+        };
+        let (r1, r2) = (noisy(), noisy());
+        let one = figures(&a, &r1, None);
+        assert!(one.mean_relative_error > 0.04, "{one:?}");
+        let two = figures(&a, &r1, Some(&r2));
+        let nf = two.noise_free.unwrap();
+        assert!((nf.relative_rms_error - 0.0205).abs() < 0.001, "{nf:?}");
+        // The mean of two references has σ/√2 of noise.
+        assert!((nf.reference_noise - sigma / 2f64.sqrt()).abs() < 0.002, "{nf:?}");
+        // A picture equal to the truth reads close to no error: the mean of e₁e₂ over n pixels
+        // spreads by σ²/√n, whose root is 0.002, and the bias adds √1.5·σ² = 0.0044.
+        let exact = figures(&truth, &r1, Some(&r2)).noise_free.unwrap();
+        assert!(exact.relative_rms_error < 0.008, "{exact:?}");
     }
 
     #[test]

@@ -40,6 +40,11 @@ const MAX_FOOTPRINT_CORNERS: usize = 8;
 /// many large faces would otherwise cost targets × faces. Past it, surfaces are meshed uncut.
 const PAIR_BUDGET: u64 = 200_000_000;
 
+/// An inside corner needs the other polygon's front to turn at least this much towards the
+/// surface (the cosine between its normal and the direction into the surface): 0.1 leaves out
+/// faces within 6° of lying flat, whose corner with the surface is hardly a corner.
+const INSIDE_CORNER_COS: f64 = 0.1;
+
 /// Every polygon of a scene that can stand on another, with its bounding box.
 pub(crate) struct Contacts<'a> {
     candidates: Vec<(PolygonId, &'a Polygon, DVec3, DVec3)>,
@@ -107,6 +112,43 @@ impl<'a> Contacts<'a> {
                 v.iter().all(|&q| (n.dot(q) - d).abs() <= eps && contains_within(p.vertices(), n, q, eps))
             }
         })
+    }
+
+    /// The edges of convex `target` (polygon `id`, or one made of model faces when `None`)
+    /// along which another polygon stands on its front side and turns its own front towards
+    /// `target`'s: inside corners, where a wall meets the floor, a block's side the floor, two
+    /// walls each other, or a piece of a cut surface meets the solid standing on it. Light
+    /// changes steeply towards such an edge (each surface sees less of the room and more of
+    /// the other's dim corner), so the mesher grades its elements there. Each edge as its two
+    /// corners, in the polygon's order.
+    pub(crate) fn inside_corners(&self, target: &Polygon, id: Option<PolygonId>) -> Vec<(DVec3, DVec3)> {
+        let v = target.vertices();
+        let n = target.normal();
+        let mut found = Vec::new();
+        for i in 0..v.len() {
+            let (a, b) = (v[i], v[(i + 1) % v.len()]);
+            // Into the polygon from the edge, within its plane (its corners run
+            // counter-clockwise about its normal).
+            let inward = n.cross(b - a).normalize_or_zero();
+            let samples = [0.25, 0.5, 0.75].map(|t| a + (b - a) * t);
+            let (lo, hi) = bounds(&[a, b]);
+            let meets = self.near(lo, hi, tolerance(target)).any(|&(other, p, _, _)| {
+                if Some(other) == id || p.normal().dot(inward) <= INSIDE_CORNER_COS {
+                    return false;
+                }
+                let eps = tolerance(p);
+                let (m, d) = plane(p);
+                let on_plane = |q: DVec3| (m.dot(q) - d).abs() <= eps;
+                on_plane(a)
+                    && on_plane(b)
+                    && p.vertices().iter().any(|&q| n.dot(q - a) > eps)
+                    && samples.iter().any(|&q| contains_within(p.vertices(), m, q, eps))
+            });
+            if meets {
+                found.push((a, b));
+            }
+        }
+        found
     }
 
     /// `target` (polygon `id`, or a polygon made of model faces when `None`) cut along the

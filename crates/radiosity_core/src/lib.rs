@@ -12,6 +12,7 @@ mod canonical;
 mod color;
 mod contacts;
 mod film;
+mod grading;
 mod mesh;
 mod one_line;
 pub mod random;
@@ -25,8 +26,8 @@ pub use canonical::{
 pub use color::Rgb;
 pub use film::CameraRays;
 pub use mesh::{
-    DEFAULT_CREASE_ANGLE_DEG, Element, MAX_ELEMENTS, Mesh, MeshError, MeshParams, Patch, Smoothing, Surface,
-    estimate_elements, first_object_over_limit,
+    DEFAULT_CORNER_REFINEMENT, DEFAULT_CREASE_ANGLE_DEG, Element, MAX_CORNER_REFINEMENT, MAX_ELEMENTS, Mesh,
+    MeshError, MeshParams, Patch, Smoothing, Surface, estimate_elements, first_object_over_limit,
 };
 pub use one_line::{MAX_PART_CHARS, escape_controls, one_line};
 pub use scene::{

@@ -25,6 +25,7 @@ use thiserror::Error;
 
 use crate::Material;
 use crate::contacts::{Contacts, PolygonId};
+use crate::grading;
 use crate::scene::{Facing, Polygon, PolygonMesh, Scene, SceneError, Shape, Sides, Sphere};
 
 /// Subdivision of surfaces (the source document's "discrétisation", S10).
@@ -43,7 +44,18 @@ pub struct MeshParams {
     /// Cut surfaces along the footprints of solids standing on them and leave the covered
     /// part out (see the `contacts` module). Default true.
     pub contacts: bool,
+    /// How many times elements along inside corners (a wall meeting the floor, a block
+    /// standing on it) are halved towards the corner, in [0, [`MAX_CORNER_REFINEMENT`]]; 0
+    /// grades nothing (see the `grading` module). Default [`DEFAULT_CORNER_REFINEMENT`].
+    pub corner_refinement: u32,
 }
+
+/// The default [`MeshParams::corner_refinement`]: elements next to an inside corner a
+/// quarter as wide as the rest.
+pub const DEFAULT_CORNER_REFINEMENT: u32 = 2;
+
+/// The largest [`MeshParams::corner_refinement`]: elements 1/64 as wide as the rest.
+pub const MAX_CORNER_REFINEMENT: u32 = 6;
 
 /// The default crease angle: a tessellated curve (a sphere of 24 segments turns 15° per
 /// facet, a coarse cylinder 30°) shades smooth, while a box's 90° edges and a chamfer's 45°
@@ -66,12 +78,24 @@ impl MeshParams {
             element_size: element_size.min(patch_size),
             crease_angle_deg: DEFAULT_CREASE_ANGLE_DEG,
             contacts: true,
+            corner_refinement: DEFAULT_CORNER_REFINEMENT,
         })
     }
 
     /// The same parameters with contact cutting on or off.
     pub fn with_contacts(self, contacts: bool) -> Self {
         Self { contacts, ..self }
+    }
+
+    /// The same parameters with elements halved `levels` times towards inside corners.
+    ///
+    /// # Errors
+    /// [`SceneError::BadCornerRefinement`] when `levels` exceeds [`MAX_CORNER_REFINEMENT`].
+    pub fn with_corner_refinement(self, levels: u32) -> Result<Self, SceneError> {
+        if levels > MAX_CORNER_REFINEMENT {
+            return Err(SceneError::BadCornerRefinement { value: levels });
+        }
+        Ok(Self { corner_refinement: levels, ..self })
     }
 
     /// The same sizes with crease angle `degrees`.
@@ -94,6 +118,7 @@ impl MeshParams {
             element_size: d / 32.0,
             crease_angle_deg: DEFAULT_CREASE_ANGLE_DEG,
             contacts: true,
+            corner_refinement: DEFAULT_CORNER_REFINEMENT,
         }
     }
 
@@ -398,16 +423,17 @@ fn t_junctions(
 /// Geometry of one surface before it joins the mesh: local vertices, elements labelled by a
 /// local patch number, and patch corner lists.
 #[derive(Default)]
-struct SurfaceBuilder {
-    positions: Vec<DVec3>,
-    normals: Vec<DVec3>,
+pub(crate) struct SurfaceBuilder {
+    pub(crate) positions: Vec<DVec3>,
+    pub(crate) normals: Vec<DVec3>,
     index: HashMap<[u64; 3], u32>,
-    elements: Vec<(Vec<u32>, usize)>,
+    pub(crate) elements: Vec<(Vec<u32>, usize)>,
     patches: Vec<Vec<DVec3>>,
 }
 
 impl SurfaceBuilder {
-    fn vertex(&mut self, p: DVec3, n: DVec3) -> u32 {
+    /// The index of the vertex at exactly `p`, added with normal `n` if new.
+    pub(crate) fn vertex(&mut self, p: DVec3, n: DVec3) -> u32 {
         let key = [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
         *self.index.entry(key).or_insert_with(|| {
             self.positions.push(p);
@@ -415,6 +441,13 @@ impl SurfaceBuilder {
             (self.positions.len() - 1) as u32
         })
     }
+}
+
+/// Whether polygon `p` meshes into several elements. A face that meshes into a few gains
+/// nothing from a cut or a grading (the facets of a tessellated model): only larger ones are
+/// looked at for contacts and inside corners.
+fn is_large(p: &Polygon, params: &MeshParams) -> bool {
+    p.area() >= 4.0 * params.element_size * params.element_size
 }
 
 fn divisions(length: f64, size: f64) -> usize {
@@ -816,7 +849,7 @@ impl Mesh {
             hidden_area: vec![0.0; scene.objects.len()],
             ..Mesh::default()
         };
-        let contacts = params.contacts.then(|| Contacts::new(scene));
+        let contacts = (params.contacts || params.corner_refinement > 0).then(|| Contacts::new(scene));
         // The back face of an emitting material that emits from its front only: the same
         // reflectance, no emission (one per material, made when first needed).
         let mut dark_back = HashMap::new();
@@ -859,6 +892,17 @@ impl Mesh {
                         } else {
                             let mut b = SurfaceBuilder::default();
                             mesh_triangle_group(&mut b, m, &group, params);
+                            if let Some(c) = contacts.as_ref().filter(|_| params.corner_refinement > 0) {
+                                let edges: Vec<(DVec3, DVec3)> = group
+                                    .iter()
+                                    .map(|&f| (f as usize, &m.polygons()[f as usize]))
+                                    .filter(|(_, p)| is_large(p, params))
+                                    .flat_map(|(index, p)| {
+                                        c.inside_corners(p, Some(PolygonId { object: oi, index }))
+                                    })
+                                    .collect();
+                                grading::grade(&mut b, &edges, params.corner_refinement);
+                            }
                             mesh.push_surface(b, oi, o.material);
                         }
                     }
@@ -901,11 +945,10 @@ impl Mesh {
         material: usize,
         params: &MeshParams,
     ) {
-        // A face that meshes into a few elements gains nothing from a cut (the facets of a
-        // tessellated model): only surfaces of several elements are looked at.
-        let large = p.area() >= 4.0 * params.element_size * params.element_size;
-        let cut =
-            contacts.filter(|_| large).and_then(|c| c.cut(p, id, |q| estimate_polygon_elements(q, params)));
+        let large = is_large(p, params);
+        let cut = contacts
+            .filter(|_| large && params.contacts)
+            .and_then(|c| c.cut(p, id, |q| estimate_polygon_elements(q, params)));
         let pieces = match &cut {
             Some(cut) => {
                 self.hidden_area[object] += cut.hidden;
@@ -916,6 +959,10 @@ impl Mesh {
         for piece in pieces {
             let mut b = SurfaceBuilder::default();
             mesh_polygon(&mut b, piece, params);
+            if let Some(c) = contacts.filter(|_| large && params.corner_refinement > 0) {
+                let edges = c.inside_corners(piece, id);
+                grading::grade(&mut b, &edges, params.corner_refinement);
+            }
             self.push_surface(b, object, material);
         }
     }
@@ -1188,8 +1235,9 @@ mod tests {
     #[test]
     fn box_surfaces_do_not_share_vertices() {
         let faces = box_faces(DVec3::ZERO, DVec3::ONE, Facing::Inward, 0.0).unwrap();
-        let mesh =
-            Mesh::build(&scene_of(Shape::Polygons(faces)), &MeshParams::try_new(0.5, 0.25).unwrap()).unwrap();
+        // Ungraded: a 4 × 4 lattice of 25 vertices per face.
+        let params = MeshParams::try_new(0.5, 0.25).unwrap().with_corner_refinement(0).unwrap();
+        let mesh = Mesh::build(&scene_of(Shape::Polygons(faces)), &params).unwrap();
         assert_eq!(mesh.surfaces.len(), 6);
         assert_eq!(mesh.positions.len(), 6 * 25);
         assert_eq!(mesh.occluders.len(), 12);
@@ -1384,6 +1432,39 @@ mod tests {
             Mesh::build(&scene_of(Shape::Mesh(crate::uv_sphere_mesh(DVec3::ZERO, 1.0, 4))), &params).unwrap();
         assert_eq!(coarse.smoothing, Smoothing::default());
         assert!(params.with_crease_angle(180.0).is_err() && params.with_crease_angle(f64::NAN).is_err());
+    }
+
+    /// Graded towards its inside corners (every wall edge, the blocks' bottoms, the floor
+    /// around them), each surface of the Cornell box is still a disc without T-vertices:
+    /// V − E + F = 1 (a vertex inside a neighbour's side would add two sides and one vertex),
+    /// keeps its area, and has elements a quarter as wide as the rest along its corners.
+    #[test]
+    fn graded_cornell_surfaces_stay_conforming() {
+        let scene = crate::cornell_box();
+        let params = scene.mesh_params();
+        let graded = Mesh::build(&scene, &params).unwrap();
+        let plain = Mesh::build(&scene, &params.with_corner_refinement(0).unwrap()).unwrap();
+        assert!(graded.elements.len() > plain.elements.len() * 5 / 4, "{}", graded.elements.len());
+        assert_eq!(graded.patches.len(), plain.patches.len());
+        for (s, surface) in graded.surfaces.iter().enumerate() {
+            let patches = surface.patches.start as usize..surface.patches.end as usize;
+            let elements = graded.patches[patches.start].elements.start as usize
+                ..graded.patches[patches.end - 1].elements.end as usize;
+            let mut vertices = std::collections::HashSet::new();
+            let mut sides = std::collections::HashSet::new();
+            for e in elements.clone() {
+                let v = graded.elements[e].vertex_indices();
+                for k in 0..v.len() {
+                    vertices.insert(v[k]);
+                    sides.insert((v[k].min(v[(k + 1) % v.len()]), v[k].max(v[(k + 1) % v.len()])));
+                }
+            }
+            let euler = vertices.len() as i64 - sides.len() as i64 + elements.len() as i64;
+            assert_eq!(euler, 1, "surface {s} of '{}'", graded.object_names[surface.object as usize]);
+        }
+        assert!((graded.total_area() - plain.total_area()).abs() < 1e-9 * plain.total_area());
+        let thinnest = |m: &Mesh| m.elements.iter().map(|e| e.area).fold(f64::INFINITY, f64::min);
+        assert!(thinnest(&graded) < 0.3 * thinnest(&plain));
     }
 
     /// The Cornell box's blocks stand on its floor: the floor's mesh leaves out exactly their

@@ -122,6 +122,12 @@ pub enum SceneError {
         /// Value given.
         value: f64,
     },
+    /// A corner refinement beyond the largest allowed.
+    #[error("corner_refinement must be a whole number in [0, 6], got {value}")]
+    BadCornerRefinement {
+        /// Value given.
+        value: u32,
+    },
     /// A camera is degenerate.
     #[error("camera is degenerate: {reason}")]
     BadCamera {

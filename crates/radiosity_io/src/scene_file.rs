@@ -730,6 +730,12 @@ fn mesh_params(loc: &Locator, d: &MeshDesc) -> Result<MeshParams, LoadError> {
         loc.at(span, format!("mesh.{field}"), e.to_string())
     })?;
     let params = params.with_contacts(d.contacts.unwrap_or(true));
+    let params = match &d.corner_refinement {
+        Some(levels) => params
+            .with_corner_refinement(*levels.get_ref())
+            .map_err(|e| loc.at(levels.span(), "mesh.corner_refinement", e.to_string()))?,
+        None => params,
+    };
     match &d.crease_angle {
         Some(a) => params
             .with_crease_angle(*a.get_ref())

@@ -347,3 +347,20 @@ fn the_crease_angle_comes_from_the_mesh_table() {
     let err = parse_scene(&format!("{base}crease_angle = 180\n"), "e.toml").unwrap_err().to_string();
     assert!(err.starts_with("e.toml:14:") && err.contains("mesh.crease_angle"), "{err}");
 }
+
+/// `[mesh] corner_refinement` sets the grading towards inside corners; past 6 it is an error
+/// at its line.
+#[test]
+fn the_corner_refinement_comes_from_the_mesh_table() {
+    let base = "[[material]]\nname = \"l\"\nreflectance = [0, 0, 0]\nemission = [1, 1, 1]\n\
+                [[object]]\nname = \"o\"\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"l\"\n\
+                [mesh]\npatch_size = 1\nelement_size = 0.5\n";
+    let scene = parse_scene(&format!("{base}corner_refinement = 0\n"), "c.toml").unwrap().scene;
+    assert_eq!(scene.mesh.unwrap().corner_refinement, 0);
+    let default = parse_scene(base, "d.toml").unwrap().scene;
+    assert_eq!(default.mesh.unwrap().corner_refinement, radiosity_core::DEFAULT_CORNER_REFINEMENT);
+    let err = parse_scene(&format!("{base}corner_refinement = 7\n"), "e.toml").unwrap_err().to_string();
+    assert!(err.starts_with("e.toml:14:") && err.contains("mesh.corner_refinement"), "{err}");
+    let err = parse_scene(&format!("{base}corner_refinement = -1\n"), "n.toml").unwrap_err().to_string();
+    assert!(err.starts_with("n.toml:14:"), "{err}");
+}
