@@ -123,6 +123,10 @@ pub struct RenderArgs {
     /// Gathering rays per sample with `--gather full`.
     #[arg(long, default_value_t = RenderParams::default().gather_rays)]
     pub gather_rays: u32,
+    /// Pixels on an outline (their corners and centre do not all see the same object) take
+    /// this many times --spp samples, 1 to 64; 1: as many as any pixel.
+    #[arg(long, default_value_t = RenderParams::default().edge_factor, value_name = "N")]
+    pub edge_factor: u32,
     /// Eye position `x,y,z` (default: the scene's [camera], or one framing the scene).
     #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
     pub camera_position: Option<DVec3>,
@@ -243,8 +247,9 @@ pub fn run(a: RenderArgs) -> Result<()> {
         gather: a.gather.into(),
         shadow_rays: a.shadow_rays,
         gather_rays: a.gather_rays,
+        edge_factor: a.edge_factor,
     };
-    params.validate().map_err(|e| input(format!("--width, --height, --spp: {e}")))?;
+    params.validate().map_err(|e| input(format!("--width, --height, --spp, --edge-factor: {e}")))?;
     // Every target checked before the solve: folders, --force, and no file named twice.
     let mut targets = Targets::new(a.force);
     for (path, option) in [(&a.output, "-o"), (&a.exr, "--exr"), (&a.pfm, "--pfm")] {

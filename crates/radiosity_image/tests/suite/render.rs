@@ -324,3 +324,48 @@ fn a_tessellated_sphere_shades_without_facets() {
     let exact = large_step_of(40.0, Gather::Direct, true);
     assert!(exact < 0.5 * faceted, "a sphere under the direct gather: {exact}, faceted mesh {faceted}");
 }
+
+/// Pixels on an outline take `edge_factor` times the samples, decided by rays apart from the
+/// pixel's own samples, so the picture stays unbiased and its outlines get quieter. The
+/// Cornell box without a gather (the mesh alone, no other noise) at 96 × 72, 4 samples a
+/// pixel, seeds 1 and 2: the mean radiance of the whole picture agrees between factor 1 and 4
+/// within 0.5 % (measured 0.005 %), and the seed-to-seed RMS difference over the pixels that
+/// differ at all (most do a little, smooth shading varies within a pixel; the outlines make
+/// the RMS) falls by at least 1.5× (16 stratified samples instead of 4 on the outlines: ~2.8×
+/// less for a straight edge across a pixel; measured 2.6×).
+#[test]
+fn outline_pixels_take_more_samples_without_bias() {
+    let scene = radiosity_core::cornell_box();
+    let (mesh, solution) = crate::common::solve(&scene, radiosity_solver::SolverParams::default());
+    let camera = scene.camera_or_framing();
+    let renderer = Renderer::new(mesh);
+    let render = |edge_factor, seed| {
+        let params = RenderParams {
+            width: 96,
+            height: 72,
+            samples_per_pixel: 4,
+            seed,
+            edge_factor,
+            ..RenderParams::default()
+        };
+        renderer.render(&solution, &camera, &params).unwrap().radiance
+    };
+    let mean = |img: &radiosity_image::HdrImage| {
+        img.pixels().iter().map(|p| p.luminance()).sum::<f64>() / img.pixels().len() as f64
+    };
+    let (plain, plain2) = (render(1, 1), render(1, 2));
+    let (edged, edged2) = (render(4, 1), render(4, 2));
+    let (m1, m4) = (0.5 * (mean(&plain) + mean(&plain2)), 0.5 * (mean(&edged) + mean(&edged2)));
+    assert!((m4 / m1 - 1.0).abs() < 0.005, "picture means {m4} with edges sampled more, {m1} without");
+    let noisy: Vec<usize> = (0..plain.pixels().len())
+        .filter(|&i| (plain.pixels()[i].luminance() - plain2.pixels()[i].luminance()).abs() > 1e-9)
+        .collect();
+    assert!(noisy.len() > 100, "{} outline pixels", noisy.len());
+    let rms = |a: &radiosity_image::HdrImage, b: &radiosity_image::HdrImage| {
+        (noisy.iter().map(|&i| (a.pixels()[i].luminance() - b.pixels()[i].luminance()).powi(2)).sum::<f64>()
+            / noisy.len() as f64)
+            .sqrt()
+    };
+    let (before, after) = (rms(&plain, &plain2), rms(&edged, &edged2));
+    assert!(after < before / 1.5, "outline noise {after} with edges sampled more, {before} without");
+}
