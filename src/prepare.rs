@@ -87,6 +87,11 @@ pub struct MeshOpts {
     /// corner_refinement, else 2].
     #[arg(long, value_name = "LEVELS")]
     pub corner_refinement: Option<u32>,
+    /// Quarter the elements where the light changes steeply (shadow edges), found by a quick
+    /// probe solve, this many times, 0 to 4; 0: none [default: the scene's [mesh]
+    /// adaptive_levels, else 2].
+    #[arg(long, value_name = "LEVELS")]
+    pub adaptive_levels: Option<u32>,
 }
 
 /// Options shared by every command that solves; each overrides the scene file.
@@ -265,6 +270,7 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
         .and_then(|m| m.with_crease_angle(o.mesh.crease_angle.unwrap_or(base.crease_angle_deg)))
         .map(|m| m.with_contacts(o.mesh.contacts.unwrap_or(base.contacts)))
         .and_then(|m| m.with_corner_refinement(o.mesh.corner_refinement.unwrap_or(base.corner_refinement)))
+        .and_then(|m| m.with_adaptive_levels(o.mesh.adaptive_levels.unwrap_or(base.adaptive_levels)))
         .map_err(|e| input(format!("mesh options: {e}")))?;
     // The scene file's limit is checked (with its line) by the loader; this is the option's.
     let time_limit = match o.time_limit.or(scene.solver.time_limit) {
@@ -463,6 +469,7 @@ mod tests {
             sides: Some(1),
             contacts: None,
             corner_refinement: None,
+            adaptive_levels: None,
         };
         let o = SolveOpts::with_mesh(mesh, 2.0);
         assert_eq!((o.mesh.patch_size, o.mesh.crease_angle, o.mesh.sides), (Some(50.0), Some(0.0), Some(1)));

@@ -40,67 +40,113 @@ fn mean_normal(b: &SurfaceBuilder, vertices: &[u32]) -> DVec3 {
     vertices.iter().map(|&v| b.normals[v as usize]).sum::<DVec3>().normalize_or_zero()
 }
 
-/// Grades the elements of `b` towards `edges` (segments of its outline), `levels` times.
-pub(crate) fn grade(b: &mut SurfaceBuilder, edges: &[(DVec3, DVec3)], levels: u32) {
-    if edges.is_empty() || levels == 0 {
-        return;
+/// Element splits on one surface: grading towards inside corners, then quartering of marked
+/// elements (adaptive refinement), then [`Splits::conform`]. The splits share their record
+/// of the midpoints cut into element sides, which `conform` uses.
+#[derive(Default)]
+pub(crate) struct Splits {
+    /// The midpoint that splits each element side cut so far, by the side's vertex pair.
+    midpoints: HashMap<(u32, u32), u32>,
+}
+
+impl Splits {
+    /// The midpoint of side `i` of element `vs`, made (and recorded) if new.
+    fn midpoint(&mut self, b: &mut SurfaceBuilder, vs: &[u32], i: usize) -> u32 {
+        let (p, q) = (vs[i], vs[(i + 1) % vs.len()]);
+        let normal = mean_normal(b, &[p, q]);
+        let m = b.vertex((b.positions[p as usize] + b.positions[q as usize]) * 0.5, normal);
+        self.midpoints.insert((p.min(q), p.max(q)), m);
+        m
     }
-    let tol = edges.iter().map(|&(a, c)| a.distance(c)).fold(0.0, f64::max) * 1e-7;
-    // The midpoint that splits each element side cut so far, by the side's vertex pair.
-    let mut midpoints: HashMap<(u32, u32), u32> = HashMap::new();
-    let key = |a: u32, c: u32| (a.min(c), a.max(c));
-    for _ in 0..levels {
-        let elements = std::mem::take(&mut b.elements);
-        for (vs, patch) in elements {
-            let k = vs.len();
-            let touching: Vec<usize> = (0..k)
-                .filter(|&i| {
-                    let (p, q) = (b.positions[vs[i] as usize], b.positions[vs[(i + 1) % k] as usize]);
-                    edges.iter().any(|&e| on_segment(p, e, tol) && on_segment(q, e, tol))
-                })
-                .collect();
-            if touching.is_empty() {
-                b.elements.push((vs, patch));
-                continue;
-            }
-            let mut mid = |b: &mut SurfaceBuilder, i: usize| {
-                let (p, q) = (vs[i], vs[(i + 1) % k]);
-                let normal = mean_normal(b, &[p, q]);
-                let m = b.vertex((b.positions[p as usize] + b.positions[q as usize]) * 0.5, normal);
-                midpoints.insert(key(p, q), m);
-                m
-            };
-            let children: Vec<Vec<u32>> = match (k, touching.as_slice()) {
-                // One side on the edge, or two opposite sides of a quad: halve across the
-                // two sides that meet it.
-                (4, [s]) | (4, [s, _]) if touching.len() == 1 || touching[1] == s + 2 => {
-                    let s = *s;
-                    let (m1, m3) = (mid(b, (s + 1) % 4), mid(b, (s + 3) % 4));
-                    let c = |j: usize| vs[(s + j) % 4];
-                    vec![vec![c(0), c(1), m1, m3], vec![m3, m1, c(2), c(3)]]
-                }
-                (3, [s]) => {
-                    let s = *s;
-                    let (m1, m2) = (mid(b, (s + 1) % 3), mid(b, (s + 2) % 3));
-                    let c = |j: usize| vs[(s + j) % 3];
-                    vec![vec![c(0), c(1), m1, m2], vec![m2, m1, c(2)]]
-                }
-                // Sides on two edges (a corner of the surface): in four.
-                (4, _) => {
-                    let m: Vec<u32> = (0..4).map(|i| mid(b, i)).collect();
-                    let centre = (0..4).map(|i| b.positions[vs[i] as usize]).sum::<DVec3>() * 0.25;
-                    let o = b.vertex(centre, mean_normal(b, &vs));
-                    (0..4).map(|i| vec![vs[i], m[i], o, m[(i + 3) % 4]]).collect()
-                }
-                (_, _) => {
-                    let m: Vec<u32> = (0..3).map(|i| mid(b, i)).collect();
-                    vec![vec![vs[0], m[0], m[2]], vec![m[0], vs[1], m[1]], vec![m[2], m[1], vs[2]], m]
-                }
-            };
-            b.elements.extend(children.into_iter().map(|c| (c, patch)));
+
+    /// Element `vs` cut in four: at its sides' midpoints (and its centre, for a quad).
+    fn quarter(&mut self, b: &mut SurfaceBuilder, vs: &[u32]) -> Vec<Vec<u32>> {
+        let k = vs.len();
+        let m: Vec<u32> = (0..k).map(|i| self.midpoint(b, vs, i)).collect();
+        if k == 4 {
+            let centre = (0..4).map(|i| b.positions[vs[i] as usize]).sum::<DVec3>() * 0.25;
+            let o = b.vertex(centre, mean_normal(b, vs));
+            (0..4).map(|i| vec![vs[i], m[i], o, m[(i + 3) % 4]]).collect()
+        } else {
+            vec![vec![vs[0], m[0], m[2]], vec![m[0], vs[1], m[1]], vec![m[2], m[1], vs[2]], m]
         }
     }
-    conform(b, &midpoints);
+
+    /// Grades the elements of `b` towards `edges` (segments of its outline), `levels` times.
+    pub(crate) fn grade(&mut self, b: &mut SurfaceBuilder, edges: &[(DVec3, DVec3)], levels: u32) {
+        if edges.is_empty() || levels == 0 {
+            return;
+        }
+        let tol = edges.iter().map(|&(a, c)| a.distance(c)).fold(0.0, f64::max) * 1e-7;
+        for _ in 0..levels {
+            let elements = std::mem::take(&mut b.elements);
+            for (vs, patch) in elements {
+                let k = vs.len();
+                let touching: Vec<usize> = (0..k)
+                    .filter(|&i| {
+                        let (p, q) = (b.positions[vs[i] as usize], b.positions[vs[(i + 1) % k] as usize]);
+                        edges.iter().any(|&e| on_segment(p, e, tol) && on_segment(q, e, tol))
+                    })
+                    .collect();
+                let children: Vec<Vec<u32>> = match (k, touching.as_slice()) {
+                    (_, []) => vec![vs],
+                    // One side on the edge, or two opposite sides of a quad: halve across the
+                    // two sides that meet it.
+                    (4, [s]) | (4, [s, _]) if touching.len() == 1 || touching[1] == s + 2 => {
+                        let s = *s;
+                        let (m1, m3) =
+                            (self.midpoint(b, &vs, (s + 1) % 4), self.midpoint(b, &vs, (s + 3) % 4));
+                        let c = |j: usize| vs[(s + j) % 4];
+                        vec![vec![c(0), c(1), m1, m3], vec![m3, m1, c(2), c(3)]]
+                    }
+                    (3, [s]) => {
+                        let s = *s;
+                        let (m1, m2) =
+                            (self.midpoint(b, &vs, (s + 1) % 3), self.midpoint(b, &vs, (s + 2) % 3));
+                        let c = |j: usize| vs[(s + j) % 3];
+                        vec![vec![c(0), c(1), m1, m2], vec![m2, m1, c(2)]]
+                    }
+                    // Sides on two edges (a corner of the surface): in four.
+                    _ => self.quarter(b, &vs),
+                };
+                b.elements.extend(children.into_iter().map(|c| (c, patch)));
+            }
+        }
+    }
+
+    /// Cuts every element for which `marked` holds (given the builder and its vertices) in
+    /// four.
+    pub(crate) fn quarter_marked(
+        &mut self,
+        b: &mut SurfaceBuilder,
+        marked: &dyn Fn(&SurfaceBuilder, &[u32]) -> bool,
+    ) {
+        let elements = std::mem::take(&mut b.elements);
+        for (vs, patch) in elements {
+            if marked(b, &vs) {
+                let children = self.quarter(b, &vs);
+                b.elements.extend(children.into_iter().map(|c| (c, patch)));
+            } else {
+                b.elements.push((vs, patch));
+            }
+        }
+    }
+
+    /// Ends the splits: every element left with a split vertex inside one of its sides is cut
+    /// into triangles that use it (see [`conform`]).
+    pub(crate) fn conform(self, b: &mut SurfaceBuilder) {
+        if !self.midpoints.is_empty() {
+            conform(b, &self.midpoints);
+        }
+    }
+}
+
+/// Grades the elements of `b` towards `edges` (segments of its outline), `levels` times, and
+/// conforms the result.
+pub(crate) fn grade(b: &mut SurfaceBuilder, edges: &[(DVec3, DVec3)], levels: u32) {
+    let mut splits = Splits::default();
+    splits.grade(b, edges, levels);
+    splits.conform(b);
 }
 
 /// Cuts every element with a split vertex inside one of its sides into triangles that use

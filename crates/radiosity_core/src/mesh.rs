@@ -17,7 +17,7 @@
 //! differ in steps start a new surface: a shading seam there, the price of keeping every
 //! lattice exact without subdividing small triangles far below the element size.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::ops::Range;
 
 use glam::DVec3;
@@ -48,7 +48,20 @@ pub struct MeshParams {
     /// standing on it) are halved towards the corner, in [0, [`MAX_CORNER_REFINEMENT`]]; 0
     /// grades nothing (see the `grading` module). Default [`DEFAULT_CORNER_REFINEMENT`].
     pub corner_refinement: u32,
+    /// Levels of adaptive subdivision, in [0, [`MAX_ADAPTIVE_LEVELS`]]: elements where the
+    /// light changes steeply between neighbours (shadow edges) are quartered, each level after
+    /// a quick probe solve of the mesh so far. `Mesh::build` alone does not do it:
+    /// `radiosity_solver::Problem` does, with [`Mesh::build_refined`]. Default
+    /// [`DEFAULT_ADAPTIVE_LEVELS`].
+    pub adaptive_levels: u32,
 }
+
+/// The default [`MeshParams::adaptive_levels`]: shadow edges' elements down to a quarter of
+/// the element size.
+pub const DEFAULT_ADAPTIVE_LEVELS: u32 = 2;
+
+/// The largest [`MeshParams::adaptive_levels`].
+pub const MAX_ADAPTIVE_LEVELS: u32 = 4;
 
 /// The default [`MeshParams::corner_refinement`]: elements next to an inside corner a
 /// quarter as wide as the rest.
@@ -79,6 +92,7 @@ impl MeshParams {
             crease_angle_deg: DEFAULT_CREASE_ANGLE_DEG,
             contacts: true,
             corner_refinement: DEFAULT_CORNER_REFINEMENT,
+            adaptive_levels: DEFAULT_ADAPTIVE_LEVELS,
         })
     }
 
@@ -96,6 +110,17 @@ impl MeshParams {
             return Err(SceneError::BadCornerRefinement { value: levels });
         }
         Ok(Self { corner_refinement: levels, ..self })
+    }
+
+    /// The same parameters with `levels` of adaptive subdivision.
+    ///
+    /// # Errors
+    /// [`SceneError::BadAdaptiveLevels`] when `levels` exceeds [`MAX_ADAPTIVE_LEVELS`].
+    pub fn with_adaptive_levels(self, levels: u32) -> Result<Self, SceneError> {
+        if levels > MAX_ADAPTIVE_LEVELS {
+            return Err(SceneError::BadAdaptiveLevels { value: levels });
+        }
+        Ok(Self { adaptive_levels: levels, ..self })
     }
 
     /// The same sizes with crease angle `degrees`.
@@ -119,6 +144,7 @@ impl MeshParams {
             crease_angle_deg: DEFAULT_CREASE_ANGLE_DEG,
             contacts: true,
             corner_refinement: DEFAULT_CORNER_REFINEMENT,
+            adaptive_levels: DEFAULT_ADAPTIVE_LEVELS,
         }
     }
 
@@ -126,6 +152,50 @@ impl MeshParams {
     pub fn scaled(self, factor: f64) -> Self {
         Self { patch_size: self.patch_size * factor, element_size: self.element_size * factor, ..self }
     }
+}
+
+/// Elements to quarter when a scene is meshed again, level after level (see
+/// [`Mesh::build_refined`]): adaptive subdivision (Cohen, Greenberg, Immel & Brock 1986)
+/// decided outside the mesher, e.g. where a solution's radiosity changes steeply.
+///
+/// An element is named by its surface and the exact bits of its centre, which the same scene,
+/// parameters and earlier levels reproduce.
+#[derive(Clone, Debug, Default)]
+pub struct Refinement {
+    levels: Vec<HashMap<u32, HashSet<[u64; 3]>>>,
+}
+
+impl Refinement {
+    /// Adds a level: the `elements` of `mesh` (built with this refinement's levels so far).
+    /// An element on the back of a two-sided surface names its front twin (the back is
+    /// a copy of the front's mesh). Returns how many elements the level names.
+    pub fn add_level(&mut self, mesh: &Mesh, elements: impl IntoIterator<Item = usize>) -> usize {
+        let mut level: HashMap<u32, HashSet<[u64; 3]>> = HashMap::new();
+        let mut count = 0;
+        for e in elements {
+            let e = if mesh.element_is_back(e) { mesh.element_twin(e).unwrap_or(e) } else { e };
+            let surface = mesh.patches[mesh.elements[e].patch as usize].surface;
+            let c = mesh.elements[e].centre;
+            count += usize::from(level.entry(surface).or_default().insert([c.x, c.y, c.z].map(f64::to_bits)));
+        }
+        if count > 0 {
+            self.levels.push(level);
+        }
+        count
+    }
+
+    /// How many levels.
+    pub fn levels(&self) -> usize {
+        self.levels.len()
+    }
+}
+
+/// The key of the element with vertices `vs` in `b`: its centre's bits, computed as
+/// [`Mesh`]'s element centres are.
+fn centre_key(b: &SurfaceBuilder, vs: &[u32]) -> [u64; 3] {
+    let pts: Vec<DVec3> = vs.iter().map(|&i| b.positions[i as usize]).collect();
+    let c = polygon_area_normal(&pts).2;
+    [c.x, c.y, c.z].map(f64::to_bits)
 }
 
 /// Why a scene could not be meshed.
@@ -834,6 +904,20 @@ impl Mesh {
     /// # Errors
     /// [`MeshError::TooManyElements`] when the subdivision would exceed [`MAX_ELEMENTS`].
     pub fn build(scene: &Scene, params: &MeshParams) -> Result<Mesh, MeshError> {
+        Self::build_refined(scene, params, &Refinement::default())
+    }
+
+    /// Meshes `scene` with `params`, then quarters the elements `refinement` names, level
+    /// after level (each level names elements of the mesh the levels before it give), with
+    /// the neighbours that gain a vertex on a side cut into triangles that use it.
+    ///
+    /// # Errors
+    /// [`MeshError::TooManyElements`] when the subdivision would exceed [`MAX_ELEMENTS`].
+    pub fn build_refined(
+        scene: &Scene,
+        params: &MeshParams,
+        refinement: &Refinement,
+    ) -> Result<Mesh, MeshError> {
         let too_many = |object: &str| MeshError::TooManyElements {
             object: object.chars().take(80).collect(),
             limit: MAX_ELEMENTS,
@@ -865,7 +949,15 @@ impl Mesh {
                             mesh.hidden_area[oi] += p.area();
                             continue;
                         }
-                        mesh.mesh_cut_polygon(contacts.as_ref(), p, Some(id), oi, o.material, params);
+                        mesh.mesh_cut_polygon(
+                            contacts.as_ref(),
+                            p,
+                            Some(id),
+                            oi,
+                            o.material,
+                            params,
+                            refinement,
+                        );
                     }
                 }
                 Shape::Sphere(s) => {
@@ -874,7 +966,7 @@ impl Mesh {
                     for pts in &b.patches {
                         mesh.occluders.extend((1..pts.len() - 1).map(|i| [pts[0], pts[i], pts[i + 1]]));
                     }
-                    mesh.push_surface(b, oi, o.material);
+                    mesh.push_surface(b, oi, o.material, refinement);
                 }
                 Shape::Mesh(m) => {
                     for group in group_mesh_faces(m, params) {
@@ -882,13 +974,29 @@ impl Mesh {
                         if m.faces()[first].len() > 3 {
                             let id = PolygonId { object: oi, index: first };
                             let p = &m.polygons()[first];
-                            mesh.mesh_cut_polygon(contacts.as_ref(), p, Some(id), oi, o.material, params);
+                            mesh.mesh_cut_polygon(
+                                contacts.as_ref(),
+                                p,
+                                Some(id),
+                                oi,
+                                o.material,
+                                params,
+                                refinement,
+                            );
                         } else if let [a, c] = group[..]
                             && let Some(quad) = pair_as_quad(m, a as usize, c as usize)
                         {
                             // Two triangles that make a convex quad (how exporters write one
                             // quad) are meshed as that quad, exactly as a quad polygon would be.
-                            mesh.mesh_cut_polygon(contacts.as_ref(), &quad, None, oi, o.material, params);
+                            mesh.mesh_cut_polygon(
+                                contacts.as_ref(),
+                                &quad,
+                                None,
+                                oi,
+                                o.material,
+                                params,
+                                refinement,
+                            );
                         } else {
                             let mut b = SurfaceBuilder::default();
                             mesh_triangle_group(&mut b, m, &group, params);
@@ -903,7 +1011,7 @@ impl Mesh {
                                     .collect();
                                 grading::grade(&mut b, &edges, params.corner_refinement);
                             }
-                            mesh.push_surface(b, oi, o.material);
+                            mesh.push_surface(b, oi, o.material, refinement);
                         }
                     }
                     for p in m.polygons() {
@@ -935,7 +1043,9 @@ impl Mesh {
 
     /// Meshes polygon `p` of object `object` as one surface, or, where solids stand on it,
     /// as one surface per piece of it around their footprints (the covered area counted in
-    /// [`Mesh::hidden_area`]).
+    /// [`Mesh::hidden_area`]); each surface graded and refined as `params` and `refinement`
+    /// say.
+    #[allow(clippy::too_many_arguments)]
     fn mesh_cut_polygon(
         &mut self,
         contacts: Option<&Contacts>,
@@ -944,6 +1054,7 @@ impl Mesh {
         object: usize,
         material: usize,
         params: &MeshParams,
+        refinement: &Refinement,
     ) {
         let large = is_large(p, params);
         let cut = contacts
@@ -963,12 +1074,26 @@ impl Mesh {
                 let edges = c.inside_corners(piece, id);
                 grading::grade(&mut b, &edges, params.corner_refinement);
             }
-            self.push_surface(b, object, material);
+            self.push_surface(b, object, material, refinement);
         }
     }
 
-    fn push_surface(&mut self, b: SurfaceBuilder, object: usize, material: usize) {
+    fn push_surface(
+        &mut self,
+        mut b: SurfaceBuilder,
+        object: usize,
+        material: usize,
+        refinement: &Refinement,
+    ) {
         let surface = self.surfaces.len() as u32;
+        for level in &refinement.levels {
+            if level.contains_key(&surface) {
+                let marked = &level[&surface];
+                let mut splits = grading::Splits::default();
+                splits.quarter_marked(&mut b, &|b, vs| marked.contains(&centre_key(b, vs)));
+                splits.conform(&mut b);
+            }
+        }
         let vbase = self.positions.len() as u32;
         self.positions.extend(&b.positions);
         self.shading_normals.extend(&b.normals);
@@ -1465,6 +1590,52 @@ mod tests {
         assert!((graded.total_area() - plain.total_area()).abs() < 1e-9 * plain.total_area());
         let thinnest = |m: &Mesh| m.elements.iter().map(|e| e.area).fold(f64::INFINITY, f64::min);
         assert!(thinnest(&graded) < 0.3 * thinnest(&plain));
+    }
+
+    /// A refinement names elements by surface and centre: meshing again quarters exactly
+    /// those (the floor's, here: about four times as many elements, the rest unchanged but for
+    /// the fans that take the floor pieces' split sides), keeps the area, and every surface
+    /// stays a disc without T-vertices. A second level quarters the first level's elements.
+    #[test]
+    fn a_refinement_quarters_the_elements_it_names() {
+        let scene = crate::cornell_box();
+        let params = scene.mesh_params();
+        let mesh = Mesh::build(&scene, &params).unwrap();
+        let floor = mesh.object_names.iter().position(|n| n == "floor").unwrap();
+        let on_floor =
+            |m: &Mesh| (0..m.elements.len()).filter(|&e| m.element_object(e) == floor).collect::<Vec<_>>();
+        let mut refinement = Refinement::default();
+        let named = refinement.add_level(&mesh, on_floor(&mesh));
+        assert_eq!(named, on_floor(&mesh).len());
+        let refined = Mesh::build_refined(&scene, &params, &refinement).unwrap();
+        let (before, after) = (on_floor(&mesh).len(), on_floor(&refined).len());
+        assert!(after >= 4 * before && after < 5 * before, "{before} → {after}");
+        assert_eq!(refined.elements.len() - after, mesh.elements.len() - before, "only the floor changes");
+        assert!((refined.total_area() - mesh.total_area()).abs() < 1e-9 * mesh.total_area());
+        let euler = |m: &Mesh, s: usize| {
+            let surface = &m.surfaces[s];
+            let patches = surface.patches.start as usize..surface.patches.end as usize;
+            let elements = m.patches[patches.start].elements.start as usize
+                ..m.patches[patches.end - 1].elements.end as usize;
+            let mut vertices = HashSet::new();
+            let mut sides = HashSet::new();
+            for e in elements.clone() {
+                let v = m.elements[e].vertex_indices();
+                for k in 0..v.len() {
+                    vertices.insert(v[k]);
+                    let w = v[(k + 1) % v.len()];
+                    sides.insert((v[k].min(w), v[k].max(w)));
+                }
+            }
+            vertices.len() as i64 - sides.len() as i64 + elements.len() as i64
+        };
+        for s in 0..refined.surfaces.len() {
+            assert_eq!(euler(&refined, s), 1, "surface {s}");
+        }
+        let again = refinement.add_level(&refined, on_floor(&refined).into_iter().take(10));
+        assert_eq!(again, 10);
+        let twice = Mesh::build_refined(&scene, &params, &refinement).unwrap();
+        assert!(on_floor(&twice).len() >= after + 30);
     }
 
     /// The Cornell box's blocks stand on its floor: the floor's mesh leaves out exactly their

@@ -128,6 +128,12 @@ pub enum SceneError {
         /// Value given.
         value: u32,
     },
+    /// Adaptive subdivision levels beyond the largest allowed.
+    #[error("adaptive_levels must be a whole number in [0, 4], got {value}")]
+    BadAdaptiveLevels {
+        /// Value given.
+        value: u32,
+    },
     /// A camera is degenerate.
     #[error("camera is degenerate: {reason}")]
     BadCamera {

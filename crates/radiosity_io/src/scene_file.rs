@@ -736,6 +736,12 @@ fn mesh_params(loc: &Locator, d: &MeshDesc) -> Result<MeshParams, LoadError> {
             .map_err(|e| loc.at(levels.span(), "mesh.corner_refinement", e.to_string()))?,
         None => params,
     };
+    let params = match &d.adaptive_levels {
+        Some(levels) => params
+            .with_adaptive_levels(*levels.get_ref())
+            .map_err(|e| loc.at(levels.span(), "mesh.adaptive_levels", e.to_string()))?,
+        None => params,
+    };
     match &d.crease_angle {
         Some(a) => params
             .with_crease_angle(*a.get_ref())

@@ -8,9 +8,61 @@
 use std::sync::Arc;
 
 use radiosity_accel::{Bvh, RayQuery};
-use radiosity_core::{Mesh, MeshError, MeshParams, Scene};
+use radiosity_core::{MAX_ELEMENTS, Mesh, MeshError, MeshParams, Refinement, Rgb, Scene};
 
 use crate::{Solver, SolverError, SolverParams, occluder_triangles};
+
+/// Unshot share at which [`Problem::new`]'s probe solves stop: the shadows and the light's
+/// falloff are in place long before convergence.
+pub const PROBE_UNSHOT: f64 = 0.2;
+
+/// Relative difference between neighbouring elements' radiosity above which adaptive
+/// subdivision quarters them: a shadow's edge, not the few percent of a smooth gradient or of
+/// the probe's visibility noise.
+pub const STEEP: f64 = 0.3;
+
+/// Meshes of more elements than this are not refined: each level's probe solve costs about
+/// what the solve does, and on a large model the first light would wait for them.
+pub const ADAPTIVE_MAX_ELEMENTS: usize = 50_000;
+
+/// Adaptive subdivision adds at most this many times the unrefined mesh's elements.
+pub const REFINE_GROWTH: usize = 3;
+
+/// The elements of `mesh` larger than `min_area` whose luminance differs from a neighbour's
+/// (same surface, a shared vertex) by more than [`STEEP`] of the larger, steepest first (ties
+/// by index), each with its largest relative difference. Elements darker than 1 % of the
+/// mean are left alone: their differences are the probe's noise.
+fn steep_elements(mesh: &Mesh, radiosity: &[Rgb], min_area: f64) -> Vec<(usize, f64)> {
+    let y: Vec<f64> = radiosity.iter().map(|c| c.luminance()).collect();
+    let mean = y.iter().sum::<f64>() / y.len().max(1) as f64;
+    let floor = 0.01 * mean;
+    let mut at_vertex: Vec<Vec<u32>> = vec![Vec::new(); mesh.positions.len()];
+    for (e, el) in mesh.elements.iter().enumerate() {
+        for &v in el.vertex_indices() {
+            at_vertex[v as usize].push(e as u32);
+        }
+    }
+    let mut out: Vec<(usize, f64)> = Vec::new();
+    for (e, el) in mesh.elements.iter().enumerate() {
+        if el.area < min_area || mesh.element_material(e).emission.max_channel() > 0.0 {
+            continue;
+        }
+        let worst = el
+            .vertex_indices()
+            .iter()
+            .flat_map(|&v| at_vertex[v as usize].iter())
+            .map(|&n| {
+                let larger = y[e].max(y[n as usize]);
+                if larger <= floor { 0.0 } else { (y[e] - y[n as usize]).abs() / larger }
+            })
+            .fold(0.0, f64::max);
+        if worst > STEEP {
+            out.push((e, worst));
+        }
+    }
+    out.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+    out
+}
 
 /// A meshed scene with its ray queries: everything [`Solver::new`] needs besides its params.
 ///
@@ -42,8 +94,52 @@ impl Problem {
     ///
     /// # Errors
     /// [`MeshError`] when the scene cannot be meshed with these sizes (too many elements, …).
+    ///
+    /// With [`MeshParams::adaptive_levels`] > 0 the mesh is then refined where the light
+    /// changes steeply (see [`Problem::refined`]).
     pub fn new(scene: &Scene, mesh_params: &MeshParams) -> Result<Self, MeshError> {
-        Ok(Self::from_mesh(Arc::new(Mesh::build(scene, mesh_params)?)))
+        let problem = Self::from_mesh(Arc::new(Mesh::build(scene, mesh_params)?));
+        Ok(problem.refined(scene, mesh_params))
+    }
+
+    /// Adaptive subdivision (Cohen, Greenberg, Immel & Brock 1986), `adaptive_levels` times:
+    /// a quick probe solve of the mesh so far (to [`PROBE_UNSHOT`] unshot, the solver's
+    /// default seed, so the mesh does not depend on the caller's seed or threads), then every
+    /// element whose radiosity differs from a neighbour's (an element of its surface sharing
+    /// a vertex) by more than [`STEEP`] of the larger is quartered, if it is larger than the
+    /// element size / 2^levels — shadow edges, the light's own falloff near it — and the
+    /// scene meshed again with those quartered. The final solve starts from scratch on the
+    /// last mesh, so nothing shot is lost or counted twice. Steepest first, the elements
+    /// added stay under [`REFINE_GROWTH`] times the unrefined count (and [`MAX_ELEMENTS`]);
+    /// meshes of more than [`ADAPTIVE_MAX_ELEMENTS`] are left as they are.
+    /// The occluders are the scene's polygons whatever the mesh, so the ray queries are kept.
+    fn refined(self, scene: &Scene, params: &MeshParams) -> Self {
+        let base = self.mesh.elements.len();
+        if base > ADAPTIVE_MAX_ELEMENTS {
+            return self;
+        }
+        let budget = (base * REFINE_GROWTH).min(MAX_ELEMENTS);
+        let min_area = (params.element_size / f64::from(1u32 << params.adaptive_levels)).powi(2);
+        let mut refinement = Refinement::default();
+        let mut problem = self;
+        for _ in 0..params.adaptive_levels {
+            let probe_params = SolverParams { unshot_threshold: PROBE_UNSHOT, ..SolverParams::default() };
+            let Ok(mut probe) = problem.solver(probe_params) else { break };
+            probe.solve();
+            let mesh = &problem.mesh;
+            let mut steep = steep_elements(mesh, &probe.solution().element_radiosity, min_area);
+            // Each quartered element adds three, and its neighbours' fans about two more.
+            let room = budget.saturating_sub(mesh.elements.len()) / 5;
+            steep.truncate(room);
+            if refinement.add_level(mesh, steep.into_iter().map(|(e, _)| e)) == 0 {
+                break;
+            }
+            match Mesh::build_refined(scene, params, &refinement) {
+                Ok(m) => problem = Self::with_ray_queries(Arc::new(m), problem.ray_queries.clone()),
+                Err(_) => break,
+            }
+        }
+        problem
     }
 
     /// A problem over a mesh built elsewhere: builds the [`Bvh`] over its blocking occluder

@@ -390,7 +390,13 @@ fn graded_elements_resolve_the_light_at_an_inside_corner() {
     let corner = exact(1e-9);
     assert!((corner - 0.25).abs() < 1e-6, "{corner}");
     let read = |levels: u32| {
-        let params = MeshParams::try_new(0.25, 0.125).unwrap().with_corner_refinement(levels).unwrap();
+        // The grading alone: no adaptive subdivision, which would also quarter the floor's far
+        // elements, where its light falls by more than a third from one to the next.
+        let params = MeshParams::try_new(0.25, 0.125)
+            .unwrap()
+            .with_corner_refinement(levels)
+            .and_then(|p| p.with_adaptive_levels(0))
+            .unwrap();
         let problem = Problem::new(&scene, &params).unwrap();
         let mut s =
             problem.solver(SolverParams { unshot_threshold: 1e-6, ..SolverParams::default() }).unwrap();
@@ -413,4 +419,59 @@ fn graded_elements_resolve_the_light_at_an_inside_corner() {
     for middle in [plain_middle, graded_middle] {
         assert!(rel(middle, exact(0.5)) < 0.01, "middle {middle} vs {}", exact(0.5));
     }
+}
+
+/// Adaptive subdivision quarters the elements where the light changes steeply and nowhere
+/// else. A small lamp (0.2 square at height 1) over a floor, a black plate at height 0.5
+/// covering x < 0.5: the floor's penumbra runs over x ∈ [0.4, 0.6] (the lamp's width
+/// projected through the plate's edge), and its 1/8-wide elements there are quartered (twice
+/// at the default two levels; their neighbours fan into triangles), while the umbra's inside
+/// and the lit floor beyond keep theirs (the lamp's falloff changes less than a third from one element to the next).
+/// In a furnace (even light everywhere) nothing is refined.
+#[test]
+fn adaptive_subdivision_refines_the_shadow_edge_only() {
+    use glam::DVec3;
+    use radiosity_core::{Material, Object, Polygon, Shape};
+    let poly =
+        |v: [[f64; 3]; 4]| Polygon::try_new(v.iter().map(|&p| DVec3::from_array(p)).collect()).unwrap();
+    let mut scene = two_plates(1.0, 1.0, 0.5, 1.0);
+    scene.objects[0].shape =
+        Shape::Polygons(vec![poly([[0.4, 1.0, 0.4], [0.6, 1.0, 0.4], [0.6, 1.0, 0.6], [0.4, 1.0, 0.6]])]);
+    scene.objects[1].shape =
+        Shape::Polygons(vec![poly([[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [1.0, 0.0, 0.0]])]);
+    scene.materials.push(Material::try_new("black", Rgb::ZERO, Rgb::ZERO).unwrap());
+    scene.objects.push(Object::new(
+        "plate",
+        2,
+        Shape::Polygons(vec![poly([[-0.5, 0.5, -0.5], [-0.5, 0.5, 1.5], [0.5, 0.5, 1.5], [0.5, 0.5, -0.5]])]),
+    ));
+    let params = MeshParams::try_new(0.25, 0.125).unwrap();
+    assert_eq!(params.adaptive_levels, radiosity_core::DEFAULT_ADAPTIVE_LEVELS);
+    let problem = Problem::new(&scene, &params).unwrap();
+    let mesh = problem.mesh();
+    let base = 0.125 * 0.125;
+    let floor: Vec<usize> = (0..mesh.elements.len()).filter(|&e| mesh.element_object(e) == 1).collect();
+    // Quartered quads stay quads; the triangles are the fans of their neighbours' sides.
+    let small: Vec<usize> = floor
+        .iter()
+        .copied()
+        .filter(|&e| mesh.elements[e].vertex_count == 4 && mesh.elements[e].area < 0.3 * base)
+        .collect();
+    assert!(small.len() >= 16, "{} small floor elements", small.len());
+    for &e in &small {
+        let x = mesh.elements[e].centre.x;
+        assert!((0.25..=0.75).contains(&x), "a small element at x = {x}, off the penumbra");
+    }
+    let quartered_twice = small.iter().filter(|&&e| mesh.elements[e].area < base / 12.0).count();
+    assert!(quartered_twice > 0, "no element quartered twice");
+    for &e in &floor {
+        let x = mesh.elements[e].centre.x;
+        if !(0.125..=0.875).contains(&x) {
+            assert!(mesh.elements[e].area > 0.9 * base, "element at x = {x} refined");
+        }
+    }
+    let furnace = furnace_box(0.5, 1.0);
+    let plain = Mesh::build(&furnace, &furnace.mesh_params()).unwrap();
+    let solved = Problem::new(&furnace, &furnace.mesh_params()).unwrap();
+    assert_eq!(solved.mesh().elements.len(), plain.elements.len(), "the furnace was refined");
 }

@@ -348,8 +348,8 @@ fn the_crease_angle_comes_from_the_mesh_table() {
     assert!(err.starts_with("e.toml:14:") && err.contains("mesh.crease_angle"), "{err}");
 }
 
-/// `[mesh] corner_refinement` sets the grading towards inside corners; past 6 it is an error
-/// at its line.
+/// `[mesh] corner_refinement` sets the grading towards inside corners, `adaptive_levels` the
+/// adaptive subdivision; past 6 and 4 they are errors at their lines.
 #[test]
 fn the_corner_refinement_comes_from_the_mesh_table() {
     let base = "[[material]]\nname = \"l\"\nreflectance = [0, 0, 0]\nemission = [1, 1, 1]\n\
@@ -363,4 +363,9 @@ fn the_corner_refinement_comes_from_the_mesh_table() {
     assert!(err.starts_with("e.toml:14:") && err.contains("mesh.corner_refinement"), "{err}");
     let err = parse_scene(&format!("{base}corner_refinement = -1\n"), "n.toml").unwrap_err().to_string();
     assert!(err.starts_with("n.toml:14:"), "{err}");
+    let scene = parse_scene(&format!("{base}adaptive_levels = 1\n"), "a.toml").unwrap().scene;
+    assert_eq!(scene.mesh.unwrap().adaptive_levels, 1);
+    assert_eq!(default.mesh.unwrap().adaptive_levels, radiosity_core::DEFAULT_ADAPTIVE_LEVELS);
+    let err = parse_scene(&format!("{base}adaptive_levels = 5\n"), "b.toml").unwrap_err().to_string();
+    assert!(err.starts_with("b.toml:14:") && err.contains("mesh.adaptive_levels"), "{err}");
 }
