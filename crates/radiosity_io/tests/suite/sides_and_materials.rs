@@ -334,12 +334,15 @@ fn duplicate_faces_are_dropped_with_a_warning() {
     assert!(clean.warnings.iter().all(|w| !w.contains("duplicate")), "{:?}", clean.warnings);
 }
 
+/// A lit sphere and a `[mesh]` table that ends on line 13, for keys appended on line 14.
+const SPHERE_WITH_MESH: &str = "[[material]]\nname = \"l\"\nreflectance = [0, 0, 0]\nemission = [1, 1, 1]\n\
+    [[object]]\nname = \"o\"\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"l\"\n\
+    [mesh]\npatch_size = 1\nelement_size = 0.5\n";
+
 /// `[mesh] crease_angle` sets the smoothing limit; outside [0, 180) it is an error at its line.
 #[test]
 fn the_crease_angle_comes_from_the_mesh_table() {
-    let base = "[[material]]\nname = \"l\"\nreflectance = [0, 0, 0]\nemission = [1, 1, 1]\n\
-                [[object]]\nname = \"o\"\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"l\"\n\
-                [mesh]\npatch_size = 1\nelement_size = 0.5\n";
+    let base = SPHERE_WITH_MESH;
     let scene = parse_scene(&format!("{base}crease_angle = 15\n"), "c.toml").unwrap().scene;
     assert_eq!(scene.mesh.unwrap().crease_angle_deg, 15.0);
     let default = parse_scene(base, "d.toml").unwrap().scene;
@@ -352,9 +355,7 @@ fn the_crease_angle_comes_from_the_mesh_table() {
 /// adaptive subdivision; past 6 and 4 they are errors at their lines.
 #[test]
 fn the_corner_refinement_comes_from_the_mesh_table() {
-    let base = "[[material]]\nname = \"l\"\nreflectance = [0, 0, 0]\nemission = [1, 1, 1]\n\
-                [[object]]\nname = \"o\"\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"l\"\n\
-                [mesh]\npatch_size = 1\nelement_size = 0.5\n";
+    let base = SPHERE_WITH_MESH;
     let scene = parse_scene(&format!("{base}corner_refinement = 0\n"), "c.toml").unwrap().scene;
     assert_eq!(scene.mesh.unwrap().corner_refinement, 0);
     let default = parse_scene(base, "d.toml").unwrap().scene;
