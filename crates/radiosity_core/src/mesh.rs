@@ -1087,8 +1087,7 @@ impl Mesh {
     ) {
         let surface = self.surfaces.len() as u32;
         for level in &refinement.levels {
-            if level.contains_key(&surface) {
-                let marked = &level[&surface];
+            if let Some(marked) = level.get(&surface) {
                 let mut splits = grading::Splits::default();
                 splits.quarter_marked(&mut b, &|b, vs| marked.contains(&centre_key(b, vs)));
                 splits.conform(&mut b);

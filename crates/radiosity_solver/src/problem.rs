@@ -25,17 +25,19 @@ pub const STEEP: f64 = 0.3;
 /// what the solve does, and on a large model the first light would wait for them.
 pub const ADAPTIVE_MAX_ELEMENTS: usize = 50_000;
 
-/// Adaptive subdivision adds at most this many times the unrefined mesh's elements.
+/// Adaptive subdivision stops before the mesh has this many times the unrefined mesh's
+/// elements.
 pub const REFINE_GROWTH: usize = 3;
 
 /// The elements of `mesh` larger than `min_area` whose luminance differs from a neighbour's
 /// (same surface, a shared vertex) by more than [`STEEP`] of the larger, steepest first (ties
-/// by index), each with its largest relative difference. Elements darker than 1 % of the
-/// mean are left alone: their differences are the probe's noise.
+/// by index), each with its largest relative difference. Pairs darker than 1 % of the mean
+/// of the elements that do not emit are left alone: their differences are the probe's noise.
 fn steep_elements(mesh: &Mesh, radiosity: &[Rgb], min_area: f64) -> Vec<(usize, f64)> {
     let y: Vec<f64> = radiosity.iter().map(|c| c.luminance()).collect();
-    let mean = y.iter().sum::<f64>() / y.len().max(1) as f64;
-    let floor = 0.01 * mean;
+    let emits = |e: usize| mesh.element_material(e).emission.max_channel() > 0.0;
+    let lit: Vec<f64> = (0..y.len()).filter(|&e| !emits(e)).map(|e| y[e]).collect();
+    let floor = 0.01 * lit.iter().sum::<f64>() / lit.len().max(1) as f64;
     let mut at_vertex: Vec<Vec<u32>> = vec![Vec::new(); mesh.positions.len()];
     for (e, el) in mesh.elements.iter().enumerate() {
         for &v in el.vertex_indices() {
@@ -44,7 +46,7 @@ fn steep_elements(mesh: &Mesh, radiosity: &[Rgb], min_area: f64) -> Vec<(usize, 
     }
     let mut out: Vec<(usize, f64)> = Vec::new();
     for (e, el) in mesh.elements.iter().enumerate() {
-        if el.area < min_area || mesh.element_material(e).emission.max_channel() > 0.0 {
+        if el.area < min_area || emits(e) {
             continue;
         }
         let worst = el
@@ -92,11 +94,13 @@ impl Problem {
     /// Emission is taken from the scene as it is: a caller that scales the lights does so on
     /// the scene before calling this.
     ///
+    /// With [`MeshParams::adaptive_levels`] > 0 the mesh is then refined where the light
+    /// changes steeply: probe solves find the elements whose radiosity differs from a
+    /// neighbour's by more than [`STEEP`], and the scene is meshed again with those quartered
+    /// (adaptive subdivision, see `refined` in the source).
+    ///
     /// # Errors
     /// [`MeshError`] when the scene cannot be meshed with these sizes (too many elements, …).
-    ///
-    /// With [`MeshParams::adaptive_levels`] > 0 the mesh is then refined where the light
-    /// changes steeply (see [`Problem::refined`]).
     pub fn new(scene: &Scene, mesh_params: &MeshParams) -> Result<Self, MeshError> {
         let problem = Self::from_mesh(Arc::new(Mesh::build(scene, mesh_params)?));
         Ok(problem.refined(scene, mesh_params))
@@ -109,9 +113,9 @@ impl Problem {
     /// a vertex) by more than [`STEEP`] of the larger is quartered, if it is larger than the
     /// element size / 2^levels — shadow edges, the light's own falloff near it — and the
     /// scene meshed again with those quartered. The final solve starts from scratch on the
-    /// last mesh, so nothing shot is lost or counted twice. Steepest first, the elements
-    /// added stay under [`REFINE_GROWTH`] times the unrefined count (and [`MAX_ELEMENTS`]);
-    /// meshes of more than [`ADAPTIVE_MAX_ELEMENTS`] are left as they are.
+    /// last mesh, so nothing shot is lost or counted twice. Steepest first, as many as keep
+    /// the refined mesh under [`REFINE_GROWTH`] times the unrefined count (and
+    /// [`MAX_ELEMENTS`]); meshes of more than [`ADAPTIVE_MAX_ELEMENTS`] are left as they are.
     /// The occluders are the scene's polygons whatever the mesh, so the ray queries are kept.
     fn refined(self, scene: &Scene, params: &MeshParams) -> Self {
         let base = self.mesh.elements.len();
