@@ -37,6 +37,13 @@ pub fn run(a: InfoArgs) -> Result<()> {
     let _ = writeln!(out, "surfaces   {}", mesh.surfaces.len());
     let _ = writeln!(out, "patches    {}", mesh.patches.len());
     let _ = writeln!(out, "elements   {}", mesh.elements.len());
+    let unrefined = p.problem.unrefined_elements();
+    if unrefined != mesh.elements.len() {
+        let _ = writeln!(
+            out,
+            "adaptive   {unrefined} elements before adaptive subdivision quartered those where the light changes steeply"
+        );
+    }
     let _ = writeln!(out, "occluders  {} triangles", mesh.occluders.len());
     // Contact cuts: what each object lost under the solids standing on it.
     for (name, hidden) in mesh.object_names.iter().zip(&mesh.hidden_area) {

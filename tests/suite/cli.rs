@@ -128,6 +128,21 @@ fn info_prints_counts_and_power() {
     for key in ["patches", "elements", "emitted", "area"] {
         assert!(out.contains(key), "{out}");
     }
+    // Adaptive subdivision is reported with the count it started from, and off, not at all.
+    let before: usize = out
+        .lines()
+        .find_map(|l| l.strip_prefix("adaptive"))
+        .and_then(|l| l.split_whitespace().next())
+        .unwrap_or_else(|| panic!("{out}"))
+        .parse()
+        .unwrap();
+    let elements: usize =
+        out.lines().find_map(|l| l.strip_prefix("elements")).unwrap().trim().parse().unwrap();
+    assert!(before < elements, "{out}");
+    let plain = radiosity(&["info", "cornell", "--adaptive-levels", "0"]);
+    let plain = String::from_utf8_lossy(&plain.stdout).into_owned();
+    assert!(!plain.contains("adaptive"), "{plain}");
+    assert!(plain.contains(&format!("elements   {before}\n")), "{plain}");
 }
 
 /// `info` counts and does not solve: it takes the mesh options and the light scale, which

@@ -85,6 +85,8 @@ fn steep_elements(mesh: &Mesh, radiosity: &[Rgb], min_area: f64) -> Vec<(usize, 
 pub struct Problem {
     mesh: Arc<Mesh>,
     ray_queries: Arc<dyn RayQuery>,
+    /// Elements before adaptive subdivision.
+    unrefined_elements: usize,
 }
 
 impl Problem {
@@ -143,6 +145,7 @@ impl Problem {
                 Err(_) => break,
             }
         }
+        problem.unrefined_elements = base;
         problem
     }
 
@@ -150,14 +153,22 @@ impl Problem {
     /// triangles, exactly as [`Problem::new`] does.
     pub fn from_mesh(mesh: Arc<Mesh>) -> Self {
         let ray_queries = Arc::new(Bvh::new(&occluder_triangles(&mesh)));
-        Self { mesh, ray_queries }
+        let unrefined_elements = mesh.elements.len();
+        Self { mesh, ray_queries, unrefined_elements }
     }
 
     /// A problem with a ray-query backend of the caller's choice (for example
     /// [`radiosity_accel::BruteForce`] over every occluder, to test the production path
     /// against it). The backend must answer for the occluders of `mesh`.
     pub fn with_ray_queries(mesh: Arc<Mesh>, ray_queries: Arc<dyn RayQuery>) -> Self {
-        Self { mesh, ray_queries }
+        let unrefined_elements = mesh.elements.len();
+        Self { mesh, ray_queries, unrefined_elements }
+    }
+
+    /// How many elements the mesh had before adaptive subdivision (its own count when it was
+    /// not refined).
+    pub fn unrefined_elements(&self) -> usize {
+        self.unrefined_elements
     }
 
     /// The meshed scene: patches, elements, occluders.
