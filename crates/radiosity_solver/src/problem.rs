@@ -25,6 +25,11 @@ pub const STEEP: f64 = 0.3;
 /// what the solve does, and on a large model the first light would wait for them.
 pub const ADAPTIVE_MAX_ELEMENTS: usize = 50_000;
 
+/// Meshes of more patches than this are not refined either: a probe's cost is mostly its
+/// shooters' first rows (a tessellated model of 7 000 facets, each its own patch, solves in
+/// about 10 s; two probes would hold its first picture back by several seconds).
+pub const ADAPTIVE_MAX_PATCHES: usize = 2_000;
+
 /// Adaptive subdivision stops before the mesh has this many times the unrefined mesh's
 /// elements.
 pub const REFINE_GROWTH: usize = 3;
@@ -117,11 +122,12 @@ impl Problem {
     /// scene meshed again with those quartered. The final solve starts from scratch on the
     /// last mesh, so nothing shot is lost or counted twice. Steepest first, as many as keep
     /// the refined mesh under [`REFINE_GROWTH`] times the unrefined count (and
-    /// [`MAX_ELEMENTS`]); meshes of more than [`ADAPTIVE_MAX_ELEMENTS`] are left as they are.
+    /// [`MAX_ELEMENTS`]); meshes of more than [`ADAPTIVE_MAX_ELEMENTS`] elements or
+    /// [`ADAPTIVE_MAX_PATCHES`] patches are left as they are.
     /// The occluders are the scene's polygons whatever the mesh, so the ray queries are kept.
     fn refined(self, scene: &Scene, params: &MeshParams) -> Self {
         let base = self.mesh.elements.len();
-        if base > ADAPTIVE_MAX_ELEMENTS {
+        if base > ADAPTIVE_MAX_ELEMENTS || self.mesh.patches.len() > ADAPTIVE_MAX_PATCHES {
             return self;
         }
         let budget = (base * REFINE_GROWTH).min(MAX_ELEMENTS);
