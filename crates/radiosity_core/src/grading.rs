@@ -1,12 +1,15 @@
-//! Elements graded towards inside corners. Where a wall meets the floor or a block stands on
-//! it, radiosity falls steeply in the last few centimetres before the corner (each surface
-//! sees less of the room there, and more of the other's dim corner), and an element as wide
-//! as the rest of the surface averages that fall away: smooth shading then shows the corner
-//! as bright as the open surface, and a final gather that looks the solution up near a
-//! corner inherits the error. A geometric grading of the mesh towards such edges (the
-//! a-priori half of Cohen, Greenberg, Immel & Brock 1986's adaptive subdivision, as
-//! discontinuity meshing does for value discontinuities: Heckbert 1992, D1 edges) puts thin
-//! elements where the fall is.
+//! Elements graded towards inside corners, and quartered where the light asks. Where a wall
+//! meets the floor or a block stands on it, radiosity falls steeply in the last few
+//! centimetres before the corner (each surface sees less of the room there, and more of the
+//! other's dim corner), and an element as wide as the rest of the surface averages that fall
+//! away: smooth shading then shows the corner as bright as the open surface, and a final
+//! gather that looks the solution up near a corner inherits the error. A geometric grading of
+//! the mesh towards such edges (the a-priori half of Cohen, Greenberg, Immel & Brock 1986's
+//! adaptive subdivision, as discontinuity meshing does for value discontinuities: Heckbert
+//! 1992, D1 edges) puts thin elements where the fall is.
+//!
+//! The same splits serve adaptive subdivision ([`Splits::quarter_marked`], driven by
+//! `radiosity_solver::Problem`): elements named by a refinement are cut in four.
 //!
 //! Each level halves the elements that have a side on a graded edge, parallel to that edge:
 //! a quad into two quads, a triangle into a trapezoid on the edge and a triangle above it. An
