@@ -96,6 +96,8 @@ struct Subdivision {
     light_scale: f64,
     patch_size: f64,
     element_size: f64,
+    /// Levels of adaptive subdivision (see `MeshParams::adaptive_levels`).
+    adaptive_levels: u32,
 }
 
 /// Outcome of a scripted run, read by [`crate::run`] after the window closes.
@@ -210,6 +212,7 @@ impl ViewerApp {
                 light_scale: job.light_scale,
                 patch_size: job.mesh_params.patch_size,
                 element_size: job.mesh_params.element_size,
+                adaptive_levels: job.mesh_params.adaptive_levels,
             },
             open_text: String::new(),
             job,
@@ -244,7 +247,14 @@ impl ViewerApp {
 
     fn apply_subdivision(&mut self) {
         let s = self.subdivision;
-        match MeshParams::try_new(s.patch_size, s.element_size) {
+        // The sliders' sizes and levels over the job's other mesh settings (contacts, crease
+        // angle, corner grading), which the command line or the scene file chose.
+        let sized = MeshParams::try_new(s.patch_size, s.element_size).map(|m| MeshParams {
+            patch_size: m.patch_size,
+            element_size: m.element_size,
+            ..self.job.mesh_params
+        });
+        match sized.and_then(|m| m.with_adaptive_levels(s.adaptive_levels)) {
             Ok(mesh_params) => {
                 // Elements are never larger than their patches: show what will be used.
                 self.subdivision.element_size = mesh_params.element_size;
@@ -286,6 +296,7 @@ impl ViewerApp {
                     light_scale: 1.0,
                     patch_size: mesh_params.patch_size,
                     element_size: mesh_params.element_size,
+                    adaptive_levels: mesh_params.adaptive_levels,
                 };
                 let mut solver_params = self.job.solver_params.clone();
                 // The new scene's own stop settings replace the old scene's.
@@ -720,6 +731,15 @@ impl ViewerApp {
                 "longest element edge, scene units: elements receive; smaller gives sharper shadows",
             );
         apply |= released(&r);
+        let r = ui
+            .add(
+                egui::Slider::new(&mut self.subdivision.adaptive_levels, 0..=radiosity_core::MAX_ADAPTIVE_LEVELS)
+                    .text("adaptive levels"),
+            )
+            .on_hover_text(
+                "how many times elements on shadow edges are quartered (found by quick probe solves); 0: none",
+            );
+        apply |= released(&r);
         if apply {
             self.apply_subdivision();
         }
@@ -1115,6 +1135,37 @@ mod tests {
         assert_eq!(h.state().status.state, WorkerState::Paused, "restart keeps the pause");
         h.get_by_label("Resume").click();
         step_until(&mut h, "shots again", |a| a.status.progress.shots > 0);
+        let _ = std::fs::remove_dir_all(dir);
+    }
+
+    /// The subdivision sliders change sizes and adaptive levels only: the contacts and crease
+    /// angle the command line chose stay.
+    #[test]
+    fn subdivision_sliders_keep_the_other_mesh_settings() {
+        let dir = temp_dir("sliders");
+        let mut options =
+            ViewerOptions::new(radiosity_io::resolve_scene("cornell").unwrap().scene, "cornell");
+        options.threads = Some(1);
+        options.screenshot_dir = dir.clone();
+        options.solver_params = SolverParams { max_shots: Some(2), ..SolverParams::preview() };
+        let chosen = MeshParams::try_new(140.0, 70.0)
+            .unwrap()
+            .with_contacts(false)
+            .with_crease_angle(10.0)
+            .and_then(|m| m.with_adaptive_levels(1))
+            .unwrap();
+        options.mesh_params = Some(chosen);
+        let mut h = Harness::builder()
+            .with_size(Vec2::new(1000.0, 640.0))
+            .wgpu()
+            .build_eframe(|cc| ViewerApp::new(cc, options, Arc::default()).unwrap());
+        assert_eq!(h.state().subdivision.adaptive_levels, 1);
+        h.state_mut().subdivision.element_size = 35.0;
+        h.state_mut().subdivision.adaptive_levels = 0;
+        h.state_mut().apply_subdivision();
+        let m = h.state().job.mesh_params;
+        assert_eq!((m.patch_size, m.element_size, m.adaptive_levels), (140.0, 35.0, 0));
+        assert!(!m.contacts && m.crease_angle_deg == 10.0, "{m:?}");
         let _ = std::fs::remove_dir_all(dir);
     }
 
