@@ -124,31 +124,35 @@ impl<'a> Contacts<'a> {
     pub(crate) fn inside_corners(&self, target: &Polygon, id: Option<PolygonId>) -> Vec<(DVec3, DVec3)> {
         let v = target.vertices();
         let n = target.normal();
-        let mut found = Vec::new();
-        for i in 0..v.len() {
-            let (a, b) = (v[i], v[(i + 1) % v.len()]);
-            // Into the polygon from the edge, within its plane (its corners run
-            // counter-clockwise about its normal).
-            let inward = n.cross(b - a).normalize_or_zero();
-            let samples = [0.25, 0.5, 0.75].map(|t| a + (b - a) * t);
-            let (lo, hi) = bounds(&[a, b]);
-            let meets = self.near(lo, hi, tolerance(target)).any(|&(other, p, _, _)| {
-                if Some(other) == id || p.normal().dot(inward) <= INSIDE_CORNER_COS {
-                    return false;
-                }
-                let eps = tolerance(p);
-                let (m, d) = plane(p);
-                let on_plane = |q: DVec3| (m.dot(q) - d).abs() <= eps;
-                on_plane(a)
-                    && on_plane(b)
-                    && p.vertices().iter().any(|&q| n.dot(q - a) > eps)
-                    && samples.iter().any(|&q| contains_within(p.vertices(), m, q, eps))
-            });
-            if meets {
-                found.push((a, b));
+        let edges: Vec<(DVec3, DVec3)> = (0..v.len()).map(|i| (v[i], v[(i + 1) % v.len()])).collect();
+        let mut met = vec![false; edges.len()];
+        // One pass over the polygons near the target (one share of the pair budget), each
+        // tried against every edge still unmet.
+        let (lo, hi) = bounds(v);
+        for &(other, p, _, _) in self.near(lo, hi, tolerance(target)) {
+            if Some(other) == id {
+                continue;
+            }
+            let eps = tolerance(p);
+            let (m, d) = plane(p);
+            let on_plane = |q: DVec3| (m.dot(q) - d).abs() <= eps;
+            if !p.vertices().iter().any(|&q| n.dot(q - v[0]) > eps) {
+                continue; // nothing of it on the target's front side
+            }
+            for (k, &(a, b)) in edges.iter().enumerate() {
+                // Into the polygon from the edge, within its plane (its corners run
+                // counter-clockwise about its normal).
+                let inward = n.cross(b - a).normalize_or_zero();
+                met[k] = met[k]
+                    || (m.dot(inward) > INSIDE_CORNER_COS
+                        && on_plane(a)
+                        && on_plane(b)
+                        && [0.25, 0.5, 0.75]
+                            .iter()
+                            .any(|&t| contains_within(p.vertices(), m, a + (b - a) * t, eps)));
             }
         }
-        found
+        edges.into_iter().zip(met).filter(|&(_, m)| m).map(|(e, _)| e).collect()
     }
 
     /// `target` (polygon `id`, or a polygon made of model faces when `None`) cut along the

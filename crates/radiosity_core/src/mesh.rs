@@ -183,11 +183,6 @@ impl Refinement {
         }
         count
     }
-
-    /// How many levels.
-    pub fn levels(&self) -> usize {
-        self.levels.len()
-    }
 }
 
 /// The key of the element with vertices `vs` in `b`: its centre's bits, computed as
