@@ -8,7 +8,9 @@
 //! two spheres), incoherent surface-to-surface segments, 1 thread and all threads;
 //! (b) the source document's case, ≥ 100 facets × 1000 shots; (c) the Cornell box at ~10 k
 //! elements (fast and reference path), ~15 k on one thread and ~100 k elements to unshot
-//! 1e-3; (d) the peak heap of every solve case and the bytes per element.
+//! 1e-3; (d) the peak heap of every solve case and the bytes per element; (e) with `--big`,
+//! models from files (load, mesh and solve to 1 % unshot, peak heap per triangle), and with
+//! `--big-baseline` the same without clustering.
 
 use std::f64::consts::PI;
 use std::io::Write;
@@ -44,6 +46,14 @@ pub struct BenchArgs {
     /// `scripts/embree_bench.py`, which traces the same rays with Embree).
     #[arg(long)]
     pub dump_rays: Option<String>,
+    /// Also load, mesh and solve this scene to 1 % unshot (a big model, e.g. one written by
+    /// `scripts/make_big_room.py`): time, peak heap and bytes per triangle. Repeatable.
+    #[arg(long, value_name = "SCENE")]
+    pub big: Vec<String>,
+    /// With --big: solve each once more with every facet shooting on its own (no
+    /// clustering), and print the ratio. Slow on big models: that is the point.
+    #[arg(long)]
+    pub big_baseline: bool,
 }
 
 /// Triangles of a UV sphere with `stacks × slices` cells.
@@ -215,6 +225,39 @@ fn solve_case(
         "peak_heap_bytes": peak, "bytes_per_element": peak as f64 / elements as f64}))
 }
 
+/// (e) A big model from a file: load, mesh (with the scene's or default mesh settings, as
+/// `solve` does), solve to 1 % unshot; the peak heap of the whole case per input triangle.
+fn big_case(scene_arg: &str, clustering: bool) -> Result<serde_json::Value> {
+    alloc::reset_peak();
+    let before = alloc::live();
+    let start = Instant::now();
+    let scene = radiosity_io::resolve_scene(scene_arg)?.scene;
+    let loaded = start.elapsed().as_secs_f64();
+    let problem = Problem::new(&scene, &scene.mesh_params())?;
+    let meshed = start.elapsed().as_secs_f64() - loaded;
+    let triangles = problem.mesh().occluders.len();
+    let (patches, elements) = (problem.mesh().patches.len(), problem.mesh().elements.len());
+    let params = SolverParams { unshot_threshold: 0.01, clustering, ..SolverParams::default() };
+    let mut solver = problem.solver(params)?;
+    let groups = solver.shooter_groups();
+    let r = solver.solve();
+    let secs = r.elapsed.as_secs_f64();
+    let peak = alloc::peak().saturating_sub(before);
+    let how = if clustering { format!("{groups} groups") } else { "facets alone".into() };
+    output::stdout(&format!(
+        "(e) {scene_arg} ({how})\n    {triangles} triangles {patches} patches {elements} elements: load {loaded:.2} s, mesh {meshed:.2} s, solve {secs:.2} s ({} shots, unshot {:.2e}), peak heap {:.0} MB ({:.0} B/triangle)\n",
+        r.total_shots,
+        r.unshot_fraction,
+        peak as f64 / 1e6,
+        peak as f64 / triangles.max(1) as f64,
+    ))?;
+    Ok(json!({"case": "big", "scene": scene_arg, "clustering": clustering, "groups": groups,
+        "triangles": triangles, "patches": patches, "elements": elements, "load_seconds": loaded,
+        "mesh_seconds": meshed, "solve_seconds": secs, "shots": r.total_shots,
+        "unshot_fraction": r.unshot_fraction, "peak_heap_bytes": peak,
+        "bytes_per_triangle": peak as f64 / triangles.max(1) as f64}))
+}
+
 /// The Cornell box meshed with its own patch size and elements of `element_size` mm.
 fn cornell_mesh(cornell: &Scene, element_size: f64) -> Result<Mesh> {
     let patch = cornell.mesh_params().patch_size.max(element_size);
@@ -289,6 +332,22 @@ pub fn run(a: BenchArgs) -> Result<()> {
             || cornell_mesh(&cornell, 5.7),
             SolverParams::default(),
         )?);
+    }
+
+    for scene in &a.big {
+        let clustered = big_case(scene, true)?;
+        if a.big_baseline {
+            let alone = big_case(scene, false)?;
+            let ratio = alone["solve_seconds"].as_f64().unwrap_or(f64::NAN)
+                / clustered["solve_seconds"].as_f64().unwrap_or(f64::NAN);
+            output::stdout(&format!(
+                "    clustered facets solve {ratio:.1}× faster than facets shooting alone\n"
+            ))?;
+            cases.push(json!({"case": "big_clustered_vs_alone", "clustered": clustered, "alone": alone,
+                "speedup": ratio}));
+        } else {
+            cases.push(clustered);
+        }
     }
 
     if let Some(path) = &a.json {

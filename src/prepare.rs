@@ -135,6 +135,11 @@ pub struct SolveOpts {
     /// (largest) shot's power; 0: every shooter is.
     #[arg(long, allow_negative_numbers = true, default_value_t = SolverParams::default().bright_share, value_name = "SHARE")]
     pub bright_share: f64,
+    /// Let the small facets of a tessellated model shoot in groups of one cell (1/24 of the
+    /// scene's diagonal) each, so that a model's shots follow its size and not its triangle
+    /// count; false: every facet shoots on its own.
+    #[arg(long, value_name = "true|false", default_value_t = SolverParams::default().clustering, action = clap::ArgAction::Set)]
+    pub clusters: bool,
     /// Memory for keeping each shooter's form factors for its next shots, in MiB (0: keep
     /// none; the answer is the same, only slower).
     #[arg(long, default_value_t = SolverParams::default().row_cache_bytes >> 20, value_name = "MIB")]
@@ -317,6 +322,7 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
         ambient: if o.ambient { Ambient::On } else { Ambient::Off },
         overshoot: if o.overshoot == 1.0 { Overshoot::Off } else { Overshoot::Relaxation(o.overshoot) },
         row_cache_bytes: o.row_cache_mib.saturating_mul(1 << 20),
+        clustering: o.clusters,
         ..defaults
     };
     Ok((Settings { scene, mesh_params, solver_params }, no_light))

@@ -475,3 +475,107 @@ fn adaptive_subdivision_refines_the_shadow_edge_only() {
     let solved = Problem::new(&furnace, &furnace.mesh_params()).unwrap();
     assert_eq!(solved.mesh().elements.len(), plain.elements.len(), "the furnace was refined");
 }
+
+/// A unit icosphere subdivided `levels` times as a polygon mesh whose faces look inwards
+/// (every triangle its own surface: no two are coplanar).
+fn icosphere_inward(levels: u32) -> radiosity_core::PolygonMesh {
+    use glam::DVec3;
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut v: Vec<DVec3> = [
+        (-1.0, t, 0.0),
+        (1.0, t, 0.0),
+        (-1.0, -t, 0.0),
+        (1.0, -t, 0.0),
+        (0.0, -1.0, t),
+        (0.0, 1.0, t),
+        (0.0, -1.0, -t),
+        (0.0, 1.0, -t),
+        (t, 0.0, -1.0),
+        (t, 0.0, 1.0),
+        (-t, 0.0, -1.0),
+        (-t, 0.0, 1.0),
+    ]
+    .iter()
+    .map(|&(x, y, z)| DVec3::new(x, y, z).normalize())
+    .collect();
+    let mut f: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..levels {
+        let mut mid = std::collections::HashMap::new();
+        let mut middle = |a: u32, b: u32, v: &mut Vec<DVec3>| {
+            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                v.push(((v[a as usize] + v[b as usize]) / 2.0).normalize());
+                v.len() as u32 - 1
+            })
+        };
+        f = f
+            .iter()
+            .flat_map(|&[a, b, c]| {
+                let (ab, bc, ca) = (middle(a, b, &mut v), middle(b, c, &mut v), middle(c, a, &mut v));
+                [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]
+            })
+            .collect();
+    }
+    // Outward-wound as built; reversed to face the inside.
+    let faces = f.iter().map(|&[a, b, c]| vec![a, c, b]).collect();
+    radiosity_core::PolygonMesh::try_new(v, faces).unwrap()
+}
+
+/// Furnace of a tessellated sphere with its facets shooting in groups (`clustering`): every
+/// facet of the closed sphere still reaches B = E/(1 − ρ). The groups' far field (one summed
+/// normal per bin of similar normals) and near field (discs at points drawn over the group)
+/// are approximations of the members' exact form factors, and nothing forces a group's row to
+/// sum to 1 as a closed scene's must: any error there is doubled by 1/(1 − ρ). Measured:
+/// 1280 facets at ρ = 0.5 in 433 groups, worst facet 0.10 % off (0.03 % shooting alone);
+/// 0.5 % is asserted for both.
+#[test]
+fn a_tessellated_furnace_sphere_with_clustered_facets_reaches_e_over_one_minus_rho() {
+    use radiosity_core::{Material, Object, Shape};
+    let rho = 0.5;
+    let mut scene = Scene::try_new(
+        "tessellated furnace",
+        None,
+        vec![Material::try_new("furnace", Rgb::splat(rho), Rgb::splat(1.0)).unwrap()],
+        vec![Object {
+            name: "dome".into(),
+            material: 0,
+            shape: Shape::Mesh(icosphere_inward(3)),
+            sides: Sides::One,
+        }],
+    )
+    .unwrap();
+    scene.mesh = Some(MeshParams::try_new(0.4, 0.4).unwrap());
+    let expected = 1.0 / (1.0 - rho);
+    for (clustering, tolerance) in [(true, 0.005), (false, 0.005)] {
+        let mut s = solver_for(
+            &scene,
+            SolverParams { unshot_threshold: 1e-4, clustering, ..SolverParams::default() },
+        );
+        assert_eq!(s.solve().stop_reason, Some(StopReason::Converged));
+        let groups = s.shooter_groups();
+        assert_eq!(groups > 10, clustering, "{groups} groups");
+        let worst = (s.solution().element_radiosity.iter()).map(|b| rel(b.r, expected)).fold(0.0, f64::max);
+        println!("clustering {clustering}: {groups} groups, {} shots, worst {worst:.2e}", s.shots());
+        assert!(worst < tolerance, "clustering {clustering}: worst facet {worst:.4} off E/(1 − ρ)");
+    }
+}

@@ -26,7 +26,7 @@ pub(super) struct FirstShots {
     /// Per patch, whether its first shot was bright (see `SolverParams::bright_share`).
     bright: Vec<bool>,
     /// Power of the solve's first shot, the largest.
-    first_shot_power: f64,
+    pub(super) first_shot_power: f64,
 }
 
 impl FirstShots {

@@ -34,6 +34,7 @@ use std::time::Duration;
 use radiosity_accel::RayQuery;
 use radiosity_core::{Mesh, Rgb};
 
+mod clusters;
 mod error;
 mod first_shots;
 mod mesh_tables;
@@ -59,6 +60,7 @@ pub use stop::{StepBudget, StepReport, StopReason};
 pub use tally::EnergyBalance;
 
 use crate::solution::{Solution, vertex_average};
+use clusters::Clusters;
 use first_shots::FirstShots;
 use mesh_tables::MeshTables;
 use row_cache::RowCache;
@@ -77,6 +79,8 @@ pub struct Solver {
     first_shots: FirstShots,
     /// Per shooter: its kept row of form factors, or its kept plans.
     rows: RowCache,
+    /// The model facets that shoot in groups.
+    clusters: Clusters,
     /// Per shot: scratch memory, kept to avoid allocating in the loop.
     scratch: ShotScratch,
     /// The physics: B, ΔB, power.
@@ -95,10 +99,12 @@ impl Solver {
         params.validate()?;
         mesh_tables::check_patch_runs(&mesh)?;
         let tally = Tally::new(&mesh)?;
+        let clusters = Clusters::new(&mesh, params.clustering);
         Ok(Self {
             tables: MeshTables::new(&mesh),
             first_shots: FirstShots::new(&mesh),
-            rows: RowCache::new(mesh.patches.len()),
+            rows: RowCache::new(mesh.patches.len() + clusters.len()),
+            clusters,
             scratch: ShotScratch::new(&mesh),
             tally,
             progress: Progress::new(mesh.patches.len()),
@@ -126,6 +132,12 @@ impl Solver {
     /// Shots done.
     pub fn shots(&self) -> u64 {
         self.progress.shots
+    }
+
+    /// How many groups of small model facets shoot as one (see
+    /// [`SolverParams::clustering`]); 0 when none.
+    pub fn shooter_groups(&self) -> usize {
+        self.clusters.len()
     }
 
     /// Unshot power / emitted power.

@@ -100,6 +100,10 @@ pub struct SolverParams {
     /// 4 bytes per receiving element; past the budget rows are recomputed, which gives the
     /// same numbers, only slower. Default 256 MiB.
     pub row_cache_bytes: usize,
+    /// Group the small facets of tessellated models into shooters of one cell each (see the
+    /// solver's `clusters` module): the shots then follow the scene's extent, not its
+    /// triangle count. Scenes of polygons and spheres have no such facets. Default true.
+    pub clustering: bool,
 }
 
 impl Default for SolverParams {
@@ -119,6 +123,7 @@ impl Default for SolverParams {
             overshoot: Overshoot::Off,
             reference_path: false,
             row_cache_bytes: 256 << 20,
+            clustering: true,
         }
     }
 }

@@ -55,12 +55,14 @@ impl Packet {
 pub(super) fn draw(shot: &Shot, plan: &PatchPlan, e: usize, rays: Rays, ray: impl FnMut(Vec3, Vec3)) {
     let (seed, key) = (shot.params.seed, e as u64);
     match rays {
-        Rays::Pilot if shot.pilot.count() == 1 => {
+        Rays::Pilot if shot.pilot_for(e).count() == 1 => {
             let [u, v, a, b] = four_units(shot.single_key, key);
             let mut redraws = Rng::from_state(shot.single_key ^ key);
             draw_rays_from(shot, plan, e, 1, &mut redraws, ray, |_| ((u, v), (a, b)));
         }
-        Rays::Pilot => draw_rays(shot, plan, e, shot.pilot, &mut Rng::for_task(seed, shot.stream, key), ray),
+        Rays::Pilot => {
+            draw_rays(shot, plan, e, shot.pilot_for(e), &mut Rng::for_task(seed, shot.stream, key), ray)
+        }
         Rays::Penumbra => {
             let mut rng = Rng::for_task(seed, shot.stream, key | PENUMBRA_STREAM);
             draw_rays(shot, plan, e, shot.penumbra, &mut rng, ray);

@@ -138,7 +138,7 @@ pub(super) fn receive_patch(shot: &Shot, plan: &PatchPlan, first: usize, out: &m
     if plan.visibility == Visibility::Clear {
         return;
     }
-    if shot.pilot.count() == 1 && plan.visibility == Visibility::Few {
+    if shot.pilot_for(first).count() == 1 && plan.visibility == Visibility::Few {
         single_rays_in_packets(shot, plan, first, out);
         return;
     }

@@ -10,6 +10,7 @@
 
 use std::time::Instant;
 
+use super::clusters::Shooter;
 use super::{Solver, StepBudget, StepReport};
 
 impl Solver {
@@ -38,19 +39,45 @@ impl Solver {
 
     /// One shot.
     fn shoot(&mut self) {
-        // 1. The shooter.
-        let shooter = self.tally.brightest_patch();
+        // 1. The shooter: a patch, or a group of a model's facets (`clusters.rs`).
+        let (key, members, area) = match self.clusters.brightest(&self.tally.patch_unshot_power) {
+            Shooter::Patch(p) => (p, vec![p as u32], self.mesh.patches[p].area),
+            Shooter::Group(g) => {
+                let group = self.clusters.group(g);
+                (self.mesh.patches.len() + g, group.patches.clone(), group.area)
+            }
+        };
         // 2. Its row of form factors.
-        let kept = self.rows.take(shooter);
+        let kept = self.rows.take(key);
         let was_kept = kept.is_some();
-        let row = kept.unwrap_or_else(|| self.compute_row(shooter));
+        let row = kept.unwrap_or_else(|| self.compute_any_row(key));
         // 3. Shoot ω ΔB_i through it (ω = 1 unless over-relaxing).
-        self.tally.shoot(&self.mesh, &self.tables, shooter, &row, self.params.overshoot.omega());
+        let omega = self.params.overshoot.omega();
+        self.tally.shoot(&self.mesh, &self.tables, &members, area, &row, omega);
         // 4. Keep the row (or the plans it was computed with).
-        self.rows.keep(shooter, row, was_kept, &self.scratch.plans, &self.params);
+        let plans = if key < self.mesh.patches.len() { &self.scratch.plans[..] } else { &[] };
+        self.rows.keep(key, row, was_kept, plans, &self.params);
         // 5. Progress.
         self.progress.shots += 1;
         self.tally.update_unshot_fraction();
         self.progress.stagnation.record(self.tally.unshot_fraction);
+    }
+
+    /// The row of shooter `key`: a patch's index, or the patch count plus a group's.
+    fn compute_any_row(&mut self, key: usize) -> super::row::Row {
+        let Some(g) = key.checked_sub(self.mesh.patches.len()) else {
+            return self.compute_row(key);
+        };
+        if self.progress.shots == 0 {
+            self.first_shots.first_shot_power =
+                self.tally.patch_unshot_power.iter().map(|p| p.abs().sum()).sum();
+        }
+        let (mesh, tables, params) = (&*self.mesh, &self.tables, &self.params);
+        let first_power = self.first_shots.first_shot_power;
+        self.clusters.freeze(g, mesh, &self.tally.unshot, tables, params, first_power);
+        let (row, rays) =
+            self.clusters.row(g, mesh, tables, &*self.accel, params, &mut self.scratch.group_factors);
+        self.progress.rays += rays;
+        row
     }
 }

@@ -87,7 +87,25 @@ pub(super) struct Shot<'a> {
     pub(super) shooter_radius: f64,
     /// Strata of the pilot and of the penumbra rays.
     pub(super) pilot: Strata,
+    /// Strata of the pilot rays of a model's small facets (members of a shooter group, see
+    /// `facets`): fewer than `pilot` from a bright shooter, since a facet is a small part
+    /// of what the eye sees and its noise is pooled with its neighbours' at their shared
+    /// vertices.
+    pub(super) facet_pilot: Strata,
+    /// Per patch, whether it is such a facet.
+    pub(super) facets: &'a [bool],
     pub(super) penumbra: Strata,
+}
+
+impl Shot<'_> {
+    /// The pilot-ray strata of element `e`'s patch.
+    pub(super) fn pilot_for(&self, e: usize) -> Strata {
+        if self.facets.get(self.mesh.elements[e].patch as usize).copied().unwrap_or(false) {
+            self.facet_pilot
+        } else {
+            self.pilot
+        }
+    }
 }
 
 /// Memory one shot fills and its receivers read, kept between shots to avoid allocating in
@@ -108,6 +126,8 @@ pub(super) struct ShotScratch {
     /// Clusters of an uneven shooter's elements (see [`super::uneven`]).
     pub(super) clusters: Vec<Cluster>,
     pub(super) cluster_order: Vec<u32>,
+    /// Per element, its form factor to the shooting group of facets (see [`super::clusters`]).
+    pub(super) group_factors: Vec<f32>,
 }
 
 impl ShotScratch {
@@ -123,6 +143,7 @@ impl ShotScratch {
             lifted_targets: Vec::new(),
             clusters: Vec::new(),
             cluster_order: Vec::new(),
+            group_factors: Vec::new(),
         }
     }
 

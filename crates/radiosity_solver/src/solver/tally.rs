@@ -46,8 +46,15 @@ pub(super) struct Tally {
 /// Below this many elements a shot is applied on one thread (a parallel pass costs more).
 const APPLY_PARALLEL_MIN: usize = 32_768;
 
-/// Receiving spans per parallel task when a shot is applied.
-const APPLY_SPANS_PER_TASK: usize = 16;
+/// Consecutive receiving spans of one shot with their factors and their elements' radiosity,
+/// unshot radiosity and Σ F·A per span.
+type Chunk<'a> = (&'a [(u32, u32)], &'a [f32], &'a mut [Rgb], &'a mut [Rgb], &'a mut [f64]);
+
+/// A shot is applied in about this many chunks of consecutive receiving spans...
+const CHUNKS: usize = 256;
+
+/// ... of at least this many spans each.
+const MIN_SPANS_PER_CHUNK: usize = 16;
 
 impl Tally {
     /// Shot 0: B = E and ΔB = E on every element.
@@ -90,90 +97,111 @@ impl Tally {
         self.unshot_fraction = total / self.emitted.sum();
     }
 
-    /// The patch with the largest |unshot power| (summed over channels); ties go to the lower
-    /// index so the choice is deterministic.
-    pub(super) fn brightest_patch(&self) -> usize {
-        let mut best = (0, f64::NEG_INFINITY);
-        for (p, power) in self.patch_unshot_power.iter().enumerate() {
-            let v = power.abs().sum();
-            if v > best.1 {
-                best = (p, v);
-            }
-        }
-        best.0
-    }
-
     /// Shoots ω times the shooter's unshot radiosity through its row of form factors: every
     /// receiving element j gains ρ_j · ω ΔB_i · F_{j→i} in B_j and ΔB_j (Cohen et al. 1988,
-    /// with F_{j→i} already the reciprocal form), and the shooter keeps (1 − ω) ΔB_i.
-    pub(super) fn shoot(&mut self, mesh: &Mesh, tables: &MeshTables, shooter: usize, row: &Row, omega: f64) {
-        let patch = &mesh.patches[shooter];
-        let shot_b = self.patch_unshot_power[shooter] * (omega / patch.area);
+    /// with F_{j→i} already the reciprocal form), and the shooter keeps (1 − ω) ΔB_i. The
+    /// shooter is one patch or a group of them (`shooters`, of total area `area`), whose ΔB_i
+    /// is then their unshot power over their area.
+    pub(super) fn shoot(
+        &mut self,
+        mesh: &Mesh,
+        tables: &MeshTables,
+        shooters: &[u32],
+        area: f64,
+        row: &Row,
+        omega: f64,
+    ) {
+        let power: Rgb = shooters.iter().map(|&q| self.patch_unshot_power[q as usize]).sum();
+        let shot_b = power * (omega / area);
+        // The shooters keep (1 − ω) of their unshot radiosity before the receivers gain:
+        // a group's facets also receive from each other.
+        for &q in shooters {
+            let patch = &mesh.patches[q as usize];
+            for e in patch.elements.start..patch.elements.end {
+                self.unshot[e as usize] *= 1.0 - omega;
+            }
+            self.patch_unshot_power[q as usize] *= 1.0 - omega;
+        }
         // Each receiving span (one patch, of one reflectance) takes ρ × the shot's radiosity
         // times F per element, and its Σ F·A; spans own disjoint elements, so they may run
-        // in parallel. The sums over spans then run in span order: the same numbers for any
-        // thread count.
-        let mut spans = Vec::with_capacity(row.spans.len());
-        let (mut radiosity, mut unshot) = (&mut self.radiosity[..], &mut self.unshot[..]);
+        // in parallel, in chunks of consecutive spans (a model's facets are a span each: one
+        // task per span cost more than the arithmetic). The sums over spans then run in span
+        // order: the same numbers for any thread count.
+        let mut seen = vec![0.0; row.spans.len()];
+        let per_chunk = (row.spans.len() / CHUNKS).max(MIN_SPANS_PER_CHUNK);
+        let mut chunks = Vec::with_capacity(row.spans.len().div_ceil(per_chunk));
+        let (mut radiosity, mut unshot, mut seen_rest) =
+            (&mut self.radiosity[..], &mut self.unshot[..], &mut seen[..]);
         let (mut at, mut offset) = (0, 0);
-        for &(first, count) in &row.spans {
-            let (first, count) = (first as usize, count as usize);
-            let (r, rest_r) = std::mem::take(&mut radiosity)[first - at..].split_at_mut(count);
-            let (u, rest_u) = std::mem::take(&mut unshot)[first - at..].split_at_mut(count);
-            (radiosity, unshot, at) = (rest_r, rest_u, first + count);
-            let rho = tables.patch_reflectance[mesh.elements[first].patch as usize];
-            let area = &tables.element_area[first..first + count];
-            spans.push((rho * shot_b, &row.factors[offset..offset + count], area, r, u));
-            offset += count;
+        for spans in row.spans.chunks(per_chunk) {
+            let first = spans[0].0 as usize;
+            let (last, count) = spans[spans.len() - 1];
+            let end = last as usize + count as usize;
+            let (r, rest_r) = std::mem::take(&mut radiosity)[first - at..].split_at_mut(end - first);
+            let (u, rest_u) = std::mem::take(&mut unshot)[first - at..].split_at_mut(end - first);
+            let (s, rest_s) = std::mem::take(&mut seen_rest).split_at_mut(spans.len());
+            (radiosity, unshot, seen_rest, at) = (rest_r, rest_u, rest_s, end);
+            let factors: usize = spans.iter().map(|&(_, c)| c as usize).sum();
+            chunks.push((spans, &row.factors[offset..offset + factors], r, u, s));
+            offset += factors;
         }
-        let receive = |(per_factor, factors, area, radiosity, unshot): &mut (
-            Rgb,
-            &[f32],
-            &[f64],
-            &mut [Rgb],
-            &mut [Rgb],
-        )| {
-            let mut seen = 0.0;
-            for k in 0..factors.len() {
-                let f = f64::from(factors[k]);
-                let reflected = *per_factor * f; // ρ × irradiance from this shot, W/unit²
-                radiosity[k] += reflected;
-                unshot[k] += reflected;
-                seen += f * area[k];
+        let receive = |(spans, factors, radiosity, unshot, seen): &mut Chunk| {
+            let base = spans[0].0 as usize;
+            let mut offset = 0;
+            for (&(first, count), seen) in spans.iter().zip(seen.iter_mut()) {
+                let (first, count) = (first as usize, count as usize);
+                let per_factor = tables.patch_reflectance[mesh.elements[first].patch as usize] * shot_b;
+                let area = &tables.element_area[first..first + count];
+                let local = first - base;
+                let mut sum = 0.0;
+                for k in 0..count {
+                    let f = f64::from(factors[offset + k]);
+                    let reflected = per_factor * f; // ρ × irradiance from this shot, W/unit²
+                    radiosity[local + k] += reflected;
+                    unshot[local + k] += reflected;
+                    sum += f * area[k];
+                }
+                *seen = sum;
+                offset += count;
             }
-            seen
         };
-        let seen: Vec<f64> = if mesh.elements.len() < APPLY_PARALLEL_MIN || rayon::current_num_threads() == 1
-        {
-            spans.iter_mut().map(receive).collect()
+        if mesh.elements.len() < APPLY_PARALLEL_MIN || rayon::current_num_threads() == 1 {
+            chunks.iter_mut().for_each(receive);
         } else {
-            spans.par_iter_mut().with_min_len(APPLY_SPANS_PER_TASK).map(receive).collect()
-        };
+            chunks.par_iter_mut().for_each(receive);
+        }
         let mut received = Rgb::ZERO;
-        for (&(first, _), (span, seen)) in row.spans.iter().zip(spans.iter().zip(seen)) {
-            let gained = span.0 * seen;
+        for (&(first, _), seen) in row.spans.iter().zip(seen) {
+            let patch = mesh.elements[first as usize].patch as usize;
+            let gained = tables.patch_reflectance[patch] * shot_b * seen;
             let span_received = shot_b * seen;
             received += span_received;
             self.absorbed += span_received - gained;
-            self.patch_unshot_power[mesh.elements[first as usize].patch as usize] += gained;
+            self.patch_unshot_power[patch] += gained;
         }
-        self.escaped += shot_b * patch.area - received;
-        self.tally_direct(mesh, tables, shooter, row, omega);
-        for e in patch.elements.start..patch.elements.end {
-            self.unshot[e as usize] *= 1.0 - omega;
-        }
-        self.patch_unshot_power[shooter] *= 1.0 - omega;
+        self.escaped += shot_b * area - received;
+        self.tally_direct(mesh, tables, shooters, area, row, omega);
     }
 
     /// Adds to each receiver the part of this shot that is the shooter's own emission (its
     /// direct light). Only emitters' shots carry any, so the extra pass is rare.
-    fn tally_direct(&mut self, mesh: &Mesh, tables: &MeshTables, shooter: usize, row: &Row, omega: f64) {
-        let emission = self.patch_unshot_emission[shooter];
+    fn tally_direct(
+        &mut self,
+        mesh: &Mesh,
+        tables: &MeshTables,
+        shooters: &[u32],
+        area: f64,
+        row: &Row,
+        omega: f64,
+    ) {
+        let emission: Rgb = shooters.iter().map(|&q| self.patch_unshot_emission[q as usize]).sum();
         if emission.max_channel() <= 0.0 {
             return;
         }
-        let shot_e = emission * (omega / mesh.patches[shooter].area);
-        self.patch_unshot_emission[shooter] *= 1.0 - omega;
+        let shot_e = emission * (omega / area);
+        for &q in shooters {
+            self.patch_unshot_emission[q as usize] *= 1.0 - omega;
+        }
         let mut offset = 0;
         for &(first, count) in &row.spans {
             let (first, count) = (first as usize, count as usize);
