@@ -51,6 +51,10 @@ const FAR: f64 = 2.5;
 /// Points drawn over a group for its near field and its rays' ends.
 const POINTS: usize = 256;
 
+/// Draws of a far receiver's ray end before its ray is given up (no point of the group
+/// faces it: a grazing receiver).
+const FAR_TRIES: usize = 16;
+
 /// No group.
 const NONE: u32 = u32::MAX;
 
@@ -275,20 +279,42 @@ impl Clusters {
         factors.resize(mesh.elements.len(), 0.0);
         let receive = |e: usize| -> (f32, u64) {
             let el = &mesh.elements[e];
-            let f = unoccluded(group, frozen, tables.vertex_means[e], el.normal, el.patch);
+            let p = tables.vertex_means[e];
+            let mut shares = [0.0; POINTS];
+            let (f, near) = unoccluded(group, frozen, p, el.normal, el.patch, &mut shares);
             if f <= 0.0 {
                 return (0.0, 0);
             }
-            let el = &tables.lifted_corners[e][..mesh.elements[e].vertex_count as usize];
+            let corners = &tables.lifted_corners[e][..el.vertex_count as usize];
             let mut rng = Rng::for_task(params.seed, GROUP_STREAM ^ g as u64, e as u64);
-            let mut visible = 0;
-            for _ in 0..rays {
+            let (mut visible, mut traced) = (0u32, 0u32);
+            // Rays end at points that give the receiver light: a ray to a point on a facet
+            // turned away would cross the model and count as blocked (the model then came
+            // out 2 % dark). Near the group, points by their share of the form factor,
+            // stratified; far, any point facing the receiver.
+            let (mut walked, mut at) = (0.0, 0);
+            for j in 0..rays {
+                let target = if near {
+                    let t = (f64::from(j) + rng.next_f64()) / f64::from(rays) * f;
+                    while at + 1 < POINTS && walked + shares[at] < t {
+                        walked += shares[at];
+                        at += 1;
+                    }
+                    Some(at)
+                } else {
+                    (0..FAR_TRIES).map(|_| (rng.next_u64() % POINTS as u64) as usize).find(|&i| {
+                        let (q, nq, _) = frozen.points[i];
+                        nq.dot(p - q) > 0.0 && el.normal.dot(q - p) > 0.0
+                    })
+                };
+                let Some(i) = target else { continue };
                 let (u, v) = (rng.next_f64() as f32, rng.next_f64() as f32);
-                let from = Vec3::from(point_on_f32(el, u, v));
-                let to = frozen.lifted[(rng.next_u64() % POINTS as u64) as usize];
-                visible += u32::from(!accel.occluded(from, to));
+                let from = Vec3::from(point_on_f32(corners, u, v));
+                visible += u32::from(!accel.occluded(from, frozen.lifted[i]));
+                traced += 1;
             }
-            ((f * f64::from(visible) / f64::from(rays)) as f32, u64::from(rays))
+            let visibility = if traced == 0 { 1.0 } else { f64::from(visible) / f64::from(traced) };
+            ((f * visibility) as f32, u64::from(traced))
         };
         let traced: u64 = if mesh.elements.len() < 256 || rayon::current_num_threads() == 1 {
             factors
@@ -374,13 +400,21 @@ fn normal_bin(n: DVec3) -> usize {
 
 /// The form factor from a receiver at `p` (normal `n`, on patch `patch`) to the group,
 /// without visibility, such that the receiver's irradiance is the group's mean unshot
-/// radiosity ΔΦ/A times it. A member receives from the group's other facets (a fold of the
-/// model), not from its own.
-fn unoccluded(group: &Group, frozen: &Frozen, p: DVec3, n: DVec3, patch: u32) -> f64 {
+/// radiosity ΔΦ/A times it, and whether it is near (then `shares` holds each point's part of
+/// it). A member receives from the group's other facets (a fold of the model), not from its
+/// own.
+fn unoccluded(
+    group: &Group,
+    frozen: &Frozen,
+    p: DVec3,
+    n: DVec3,
+    patch: u32,
+    shares: &mut [f64; POINTS],
+) -> (f64, bool) {
     let to_centre = group.centre - p;
     // All of the group behind the receiver's plane.
     if n.dot(to_centre) <= -group.radius {
-        return 0.0;
+        return (0.0, false);
     }
     let r2 = to_centre.length_squared();
     if r2 > (FAR * group.radius).powi(2) {
@@ -388,24 +422,24 @@ fn unoccluded(group: &Group, frozen: &Frozen, p: DVec3, n: DVec3, patch: u32) ->
         let d = -to_centre / r; // from the group towards the receiver
         let cos_r = -n.dot(d);
         if cos_r <= 0.0 {
-            return 0.0;
+            return (0.0, false);
         }
         let out: f64 = frozen.axes.iter().map(|a| a.dot(d).max(0.0)).sum();
-        return group.area * out * cos_r / (std::f64::consts::PI * r2);
+        return (group.area * out * cos_r / (std::f64::consts::PI * r2), false);
     }
     let disc = group.area / frozen.points.len() as f64;
     let mut f = 0.0;
-    for (q, nq, own) in &frozen.points {
-        if *own == patch {
-            continue;
-        }
+    for ((q, nq, own), share) in frozen.points.iter().zip(shares.iter_mut()) {
         let d = p - *q;
         let r2 = d.length_squared();
         let (out, cos_r) = (nq.dot(d), -n.dot(d));
-        if out > 0.0 && cos_r > 0.0 {
+        *share = if *own != patch && out > 0.0 && cos_r > 0.0 {
             // cos θ cos θ' a / (π r² + a), with both cosines times r.
-            f += disc * out * cos_r / (r2 * (std::f64::consts::PI * r2 + disc));
-        }
+            disc * out * cos_r / (r2 * (std::f64::consts::PI * r2 + disc))
+        } else {
+            0.0
+        };
+        f += *share;
     }
-    f
+    (f, true)
 }
