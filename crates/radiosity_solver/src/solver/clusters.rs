@@ -291,7 +291,7 @@ impl Clusters {
             // Rays end at points that give the receiver light: a ray to a point on a facet
             // turned away would cross the model and count as blocked (the model then came
             // out 2 % dark). Near the group, points by their share of the form factor,
-            // stratified; far, any point facing the receiver.
+            // stratified; far, points by the cosine at them (rejection).
             let (mut walked, mut at) = (0.0, 0);
             for j in 0..rays {
                 let target = if near {
@@ -302,10 +302,19 @@ impl Clusters {
                     }
                     Some(at)
                 } else {
-                    (0..FAR_TRIES).map(|_| (rng.next_u64() % POINTS as u64) as usize).find(|&i| {
+                    let mut found = None;
+                    for _ in 0..FAR_TRIES {
+                        // Kept with probability cos θ at the point: its share of the far
+                        // field (one distance for all).
+                        let i = (rng.next_u64() % POINTS as u64) as usize;
                         let (q, nq, _) = frozen.points[i];
-                        nq.dot(p - q) > 0.0 && el.normal.dot(q - p) > 0.0
-                    })
+                        let d = p - q;
+                        if el.normal.dot(q - p) > 0.0 && rng.next_f64() * d.length() < nq.dot(d) {
+                            found = Some(i);
+                            break;
+                        }
+                    }
+                    found
                 };
                 let Some(i) = target else { continue };
                 let (u, v) = (rng.next_f64() as f32, rng.next_f64() as f32);
