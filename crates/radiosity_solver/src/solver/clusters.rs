@@ -49,7 +49,7 @@ const MIN_FACETS: usize = 32;
 const FAR: f64 = 2.5;
 
 /// Points drawn over a group for its near field and its rays' ends.
-const POINTS: usize = 256;
+const POINTS: usize = 64;
 
 /// Draws of a far receiver's ray end before its ray is given up (no point of the group
 /// faces it: a grazing receiver).
@@ -66,8 +66,14 @@ pub(super) struct Clusters {
     members: Vec<bool>,
     /// The groups, in order of their first member.
     groups: Vec<Group>,
-    /// Per group, scratch for the unshot power summed over its members.
+    /// Per group, Σ |unshot power| over its members, kept up to date by [`Clusters::update`].
     power: Vec<f64>,
+    /// Per patch, its |unshot power| as `power` last counted it.
+    counted: Vec<f64>,
+    /// The patches in no group, in index order.
+    singles: Vec<u32>,
+    /// Updates since `power` was summed afresh.
+    since_sum: u32,
 }
 
 /// One group of facets that shoots as one.
@@ -159,7 +165,9 @@ impl Clusters {
             }
         }
         let members = of_patch.iter().map(|&g| g != NONE).collect();
-        Self { of_patch, members, power: vec![0.0; groups.len()], groups }
+        let singles = (0..of_patch.len() as u32).filter(|&q| of_patch[q as usize] == NONE).collect();
+        let counted = vec![0.0; of_patch.len()];
+        Self { of_patch, members, power: vec![0.0; groups.len()], counted, singles, since_sum: 0, groups }
     }
 
     /// Per patch, whether it is in a group.
@@ -177,17 +185,43 @@ impl Clusters {
         &self.groups[g]
     }
 
-    /// The shooter with the largest |unshot power| (summed over channels): a patch on its own
-    /// or a group, by the sum over its patches. Ties go to the patch, then to the lower index.
-    pub(super) fn brightest(&mut self, patch_power: &[Rgb]) -> Shooter {
+    /// Counts the patches' |unshot power| (`patch_abs`) afresh into the groups' sums.
+    pub(super) fn sum(&mut self, patch_abs: &[f64]) {
         self.power.fill(0.0);
+        for (q, &g) in self.of_patch.iter().enumerate() {
+            if g != NONE {
+                self.power[g as usize] += patch_abs[q];
+            }
+        }
+        self.counted.copy_from_slice(patch_abs);
+        self.since_sum = 0;
+    }
+
+    /// Brings the groups' sums up to date with the patches a shot `changed`, and sums them
+    /// afresh every [`super::tally::RESUM`] shots, so rounding cannot pile up.
+    pub(super) fn update(&mut self, changed: &[u32], patch_abs: &[f64]) {
+        self.since_sum += 1;
+        if self.since_sum >= super::tally::RESUM {
+            self.sum(patch_abs);
+            return;
+        }
+        for &q in changed {
+            let q = q as usize;
+            if self.of_patch[q] != NONE {
+                self.power[self.of_patch[q] as usize] += patch_abs[q] - self.counted[q];
+            }
+            self.counted[q] = patch_abs[q];
+        }
+    }
+
+    /// The shooter with the largest |unshot power| (summed over channels, `patch_abs`): a
+    /// patch on its own or a group, by the sum over its patches. Ties go to the patch, then
+    /// to the lower index.
+    pub(super) fn brightest(&self, patch_abs: &[f64]) -> Shooter {
         let mut best = (Shooter::Patch(0), f64::NEG_INFINITY);
-        for (q, power) in patch_power.iter().enumerate() {
-            let v = power.abs().sum();
-            match self.of_patch[q] {
-                NONE if v > best.1 => best = (Shooter::Patch(q), v),
-                NONE => {}
-                g => self.power[g as usize] += v,
+        for &q in &self.singles {
+            if patch_abs[q as usize] > best.1 {
+                best = (Shooter::Patch(q as usize), patch_abs[q as usize]);
             }
         }
         for (g, &v) in self.power.iter().enumerate() {
@@ -238,7 +272,7 @@ impl Clusters {
             acc += share(e) / total;
             cdf.push(acc);
         }
-        // A jittered 16 × 16 grid mapped by the shares: u picks the element, v and the rest of
+        // A jittered 8 × 8 grid mapped by the shares: u picks the element, v and the rest of
         // u place the point in it (as a patch's ray ends, `ray_ends.rs`).
         let side = (POINTS as f64).sqrt() as usize;
         let mut rng = Rng::for_task(params.seed, GROUP_STREAM ^ g as u64, u64::MAX);
@@ -348,10 +382,10 @@ impl Clusters {
                 .sum()
         };
         let mut row = Row { spans: Vec::new(), factors: Vec::new() };
-        for p in &mesh.patches {
-            let span = &factors[p.elements.start as usize..p.elements.end as usize];
+        for range in &tables.patch_elements {
+            let span = &factors[range.clone()];
             if span.iter().any(|&f| f > 0.0) {
-                row.spans.push((p.elements.start, p.elements.end - p.elements.start));
+                row.spans.push((range.start as u32, range.len() as u32));
                 row.factors.extend_from_slice(span);
             }
         }

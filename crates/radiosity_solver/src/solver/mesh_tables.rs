@@ -21,6 +21,9 @@ pub(super) struct MeshTables {
     pub(super) element_radii: Vec<f64>,
     /// Per element, its corners lifted off it by the ray offset (see [`lift_corners`]).
     pub(super) lifted_corners: Vec<[Vec3A; 4]>,
+    /// Per patch, its elements' range, packed (the loops over every patch of a row touch
+    /// these and not the patches' corners: a model's rows span 200 k patches).
+    pub(super) patch_elements: Vec<std::ops::Range<usize>>,
     /// Per patch, its reflectance (a patch's elements share its surface's material).
     pub(super) patch_reflectance: Vec<Rgb>,
     /// Per patch, the largest circumradius of its elements (about their centres).
@@ -81,6 +84,11 @@ impl MeshTables {
                 .collect(),
             element_radii,
             lifted_corners: lift_corners(mesh, ray_offset),
+            patch_elements: mesh
+                .patches
+                .iter()
+                .map(|p| p.elements.start as usize..p.elements.end as usize)
+                .collect(),
             patch_reflectance: mesh
                 .patches
                 .iter()

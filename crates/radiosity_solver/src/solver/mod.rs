@@ -99,7 +99,8 @@ impl Solver {
         params.validate()?;
         mesh_tables::check_patch_runs(&mesh)?;
         let tally = Tally::new(&mesh)?;
-        let clusters = Clusters::new(&mesh, params.clustering);
+        let mut clusters = Clusters::new(&mesh, params.clustering);
+        clusters.sum(&tally.patch_abs);
         Ok(Self {
             tables: MeshTables::new(&mesh),
             first_shots: FirstShots::new(&mesh),

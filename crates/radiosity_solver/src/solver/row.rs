@@ -104,9 +104,9 @@ impl Solver {
             penumbra_pass(&shot, plans, tables, &mut scratch.penumbra, &mut scratch.factors);
         }
         if shot.uneven.is_some() {
-            keep_uneven_power(&mesh, plans, &mut scratch.factors);
+            keep_uneven_power(&mesh, &tables.patch_elements, plans, &mut scratch.factors);
         }
-        let (row, rays) = gather(&mesh, plans, &scratch.factors);
+        let (row, rays) = gather(&tables.patch_elements, plans, &scratch.factors);
         self.progress.rays += rays;
         row
     }
@@ -120,8 +120,13 @@ impl Solver {
 /// row's total Σ_j A_j F_j what it is without the weighting (by reciprocity A_j F_j is
 /// the shooter's power share going to j). Without this the Cornell ceiling, lit only by
 /// such transfers, came out 1.2 % dark.
-fn keep_uneven_power(mesh: &Mesh, plans: &[PatchPlan], factors: &mut [Received]) {
-    let elements = |q: usize| mesh.patches[q].elements.start as usize..mesh.patches[q].elements.end as usize;
+fn keep_uneven_power(
+    mesh: &Mesh,
+    patch_elements: &[std::ops::Range<usize>],
+    plans: &[PatchPlan],
+    factors: &mut [Received],
+) {
+    let elements = |q: usize| patch_elements[q].clone();
     let (mut moved, mut rest) = (0.0, 0.0);
     for (q, plan) in plans.iter().enumerate().filter(|(_, p)| p.live) {
         for e in elements(q) {
@@ -193,19 +198,30 @@ fn penumbra_pass(
     });
 }
 
-/// The row of the live patches' factors, and the rays traced for them.
-fn gather(mesh: &Mesh, plans: &[PatchPlan], factors: &[Received]) -> (Row, u64) {
+/// The row of the live patches' factors (those that receive anything), and the rays traced
+/// for them.
+fn gather(
+    patch_elements: &[std::ops::Range<usize>],
+    plans: &[PatchPlan],
+    factors: &[Received],
+) -> (Row, u64) {
     let mut row = Row { spans: Vec::new(), factors: Vec::new() };
     let mut rays = 0;
     for (q, plan) in plans.iter().enumerate() {
         if !plan.live {
             continue;
         }
-        let range = mesh.patches[q].elements.clone();
-        row.spans.push((range.start, range.end - range.start));
-        let factors = &factors[range.start as usize..range.end as usize];
-        row.factors.extend(factors.iter().map(|r| r.factor() as f32));
+        let range = patch_elements[q].clone();
+        let factors = &factors[range.clone()];
         rays += factors.iter().map(|r| u64::from(r.traced)).sum::<u64>();
+        // A patch that receives nothing (facing, but every ray blocked: the inside of a
+        // model, a face in shadow) is left out: applying zeros changes no sum, and a model's
+        // rows shrink by about half.
+        if factors.iter().all(|r| r.factor() as f32 == 0.0) {
+            continue;
+        }
+        row.spans.push((range.start as u32, range.len() as u32));
+        row.factors.extend(factors.iter().map(|r| r.factor() as f32));
     }
     (row, rays)
 }

@@ -40,7 +40,7 @@ impl Solver {
     /// One shot.
     fn shoot(&mut self) {
         // 1. The shooter: a patch, or a group of a model's facets (`clusters.rs`).
-        let (key, members, area) = match self.clusters.brightest(&self.tally.patch_unshot_power) {
+        let (key, members, area) = match self.clusters.brightest(&self.tally.patch_abs) {
             Shooter::Patch(p) => (p, vec![p as u32], self.mesh.patches[p].area),
             Shooter::Group(g) => {
                 let group = self.clusters.group(g);
@@ -60,6 +60,7 @@ impl Solver {
         // 5. Progress.
         self.progress.shots += 1;
         self.tally.update_unshot_fraction();
+        self.clusters.update(&self.tally.changed, &self.tally.patch_abs);
         self.progress.stagnation.record(self.tally.unshot_fraction);
     }
 

@@ -41,7 +41,19 @@ pub(super) struct Tally {
     escaped: Rgb,
     /// Σ |unshot power| / Σ emitted power, summed over channels.
     pub(super) unshot_fraction: f64,
+    /// Per patch, its |unshot power| summed over channels, as last tallied.
+    pub(super) patch_abs: Vec<f64>,
+    /// Σ `patch_abs`, kept up to date patch by patch (a model's 200 k patches summed after
+    /// every shot cost more than the shot), and summed afresh every [`RESUM`] shots.
+    abs_total: f64,
+    /// Shots since `abs_total` was summed afresh.
+    since_sum: u32,
+    /// The patches whose unshot power the last shot changed.
+    pub(super) changed: Vec<u32>,
 }
+
+/// Shots between fresh sums of the unshot power, so rounding cannot pile up.
+pub(super) const RESUM: u32 = 256;
 
 /// Below this many elements a shot is applied on one thread (a parallel pass costs more).
 const APPLY_PARALLEL_MIN: usize = 32_768;
@@ -81,11 +93,18 @@ impl Tally {
             absorbed: Rgb::ZERO,
             escaped: Rgb::ZERO,
             unshot_fraction: 1.0,
+            patch_abs: vec![0.0; mesh.patches.len()],
+            abs_total: 0.0,
+            since_sum: RESUM,
+            changed: Vec::new(),
         };
         for (p, patch) in mesh.patches.iter().enumerate() {
             tally.patch_unshot_power[p] = (patch.elements.start..patch.elements.end)
                 .map(|e| tally.unshot[e as usize] * mesh.elements[e as usize].area)
                 .sum();
+        }
+        for (abs, power) in tally.patch_abs.iter_mut().zip(&tally.patch_unshot_power) {
+            *abs = power.abs().sum();
         }
         tally.update_unshot_fraction();
         Ok(tally)
@@ -93,8 +112,20 @@ impl Tally {
 
     /// Recomputes the unshot fraction from the patches' unshot power.
     pub(super) fn update_unshot_fraction(&mut self) {
-        let total: f64 = self.patch_unshot_power.iter().map(|p| p.abs().sum()).sum();
-        self.unshot_fraction = total / self.emitted.sum();
+        self.since_sum += 1;
+        if self.since_sum >= RESUM {
+            self.since_sum = 0;
+            self.abs_total = self.patch_abs.iter().sum();
+        }
+        self.unshot_fraction = self.abs_total / self.emitted.sum();
+    }
+
+    /// Patch `q`'s unshot power changed: its |power|, the total, and the changed list follow.
+    fn changed(&mut self, q: usize) {
+        let new = self.patch_unshot_power[q].abs().sum();
+        self.abs_total += new - self.patch_abs[q];
+        self.patch_abs[q] = new;
+        self.changed.push(q as u32);
     }
 
     /// Shoots ω times the shooter's unshot radiosity through its row of form factors: every
@@ -113,6 +144,7 @@ impl Tally {
     ) {
         let power: Rgb = shooters.iter().map(|&q| self.patch_unshot_power[q as usize]).sum();
         let shot_b = power * (omega / area);
+        self.changed.clear();
         // The shooters keep (1 − ω) of their unshot radiosity before the receivers gain:
         // a group's facets also receive from each other.
         for &q in shooters {
@@ -121,6 +153,7 @@ impl Tally {
                 self.unshot[e as usize] *= 1.0 - omega;
             }
             self.patch_unshot_power[q as usize] *= 1.0 - omega;
+            self.changed(q as usize);
         }
         // Each receiving span (one patch, of one reflectance) takes ρ × the shot's radiosity
         // times F per element, and its Σ F·A; spans own disjoint elements, so they may run
@@ -178,6 +211,7 @@ impl Tally {
             received += span_received;
             self.absorbed += span_received - gained;
             self.patch_unshot_power[patch] += gained;
+            self.changed(patch);
         }
         self.escaped += shot_b * area - received;
         self.tally_direct(mesh, tables, shooters, area, row, omega);
