@@ -486,3 +486,123 @@ fn unoccluded(
     }
     (f, true)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use radiosity_core::{Material, MeshParams, Object, PolygonMesh, Scene, Shape, Sides, cornell_box};
+
+    /// A latitude–longitude sphere of `rings × segments` planar quads (triangles at the
+    /// poles), facing outwards: every facet its own surface.
+    fn globe(rings: u32, segments: u32) -> Mesh {
+        use std::f64::consts::{PI, TAU};
+        let mut positions = Vec::new();
+        for i in 0..=rings {
+            let theta = PI * f64::from(i) / f64::from(rings);
+            for j in 0..segments {
+                let phi = TAU * f64::from(j) / f64::from(segments);
+                positions.push(DVec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin()));
+            }
+        }
+        let at = |i: u32, j: u32| i * segments + j % segments;
+        let mut faces = Vec::new();
+        for i in 0..rings {
+            for j in 0..segments {
+                let quad = [at(i, j), at(i, j + 1), at(i + 1, j + 1), at(i + 1, j)];
+                match i {
+                    0 => faces.push(vec![quad[0], quad[2], quad[3]]),
+                    _ if i == rings - 1 => faces.push(vec![quad[0], quad[1], quad[2]]),
+                    _ => faces.push(quad.to_vec()),
+                }
+            }
+        }
+        let white = Material::try_new("white", Rgb::splat(0.5), Rgb::splat(1.0)).unwrap();
+        let globe = PolygonMesh::try_new(positions, faces).unwrap();
+        let object =
+            Object { name: "globe".into(), material: 0, shape: Shape::Mesh(globe), sides: Sides::One };
+        let scene = Scene::try_new("globe", None, vec![white], vec![object]).unwrap();
+        Mesh::build(&scene, &MeshParams::try_new(1.0, 1.0).unwrap()).unwrap()
+    }
+
+    /// Polygon scenes have no facets to group; a tessellated sphere's facets fall into groups
+    /// of one facing each, every facet in at most one, the groups' areas those of their members.
+    #[test]
+    fn facets_group_by_facing_and_cell_and_polygons_stay_alone() {
+        let cornell = Mesh::build(&cornell_box(), &cornell_box().mesh_params()).unwrap();
+        assert_eq!(Clusters::new(&cornell, true).len(), 0);
+        let mesh = globe(24, 48);
+        assert_eq!(Clusters::new(&mesh, false).len(), 0);
+        let clusters = Clusters::new(&mesh, true);
+        assert!(clusters.len() > 20, "{} groups", clusters.len());
+        let mut seen = vec![0; mesh.patches.len()];
+        for g in 0..clusters.len() {
+            let group = clusters.group(g);
+            assert!(group.patches.len() > 1);
+            let facings: Vec<u8> =
+                group.patches.iter().map(|&q| facing(mesh.patches[q as usize].normal)).collect();
+            assert!(facings.iter().all(|&f| f == facings[0]), "group {g}: {facings:?}");
+            let area: f64 = group.patches.iter().map(|&q| mesh.patches[q as usize].area).sum();
+            assert!((area - group.area).abs() < 1e-12 * area);
+            for &q in &group.patches {
+                seen[q as usize] += 1;
+                assert!(clusters.members()[q as usize]);
+            }
+        }
+        assert!(seen.iter().all(|&n| n <= 1));
+        assert!(seen.iter().filter(|&&n| n == 1).count() > mesh.patches.len() / 2);
+    }
+
+    /// The brightest shooter is the patch or group of largest |unshot power|, and the
+    /// groups' sums follow the patches that change.
+    #[test]
+    fn the_brightest_shooter_follows_changed_patches() {
+        let mesh = globe(24, 48);
+        let mut clusters = Clusters::new(&mesh, true);
+        let mut abs = vec![0.0; mesh.patches.len()];
+        let single = (0..mesh.patches.len()).find(|&q| !clusters.members()[q]).unwrap();
+        abs[single] = 1.0;
+        clusters.sum(&abs);
+        assert_eq!(clusters.brightest(&abs), Shooter::Patch(single));
+        // Two members of one group, each dimmer than the single patch, together brighter.
+        let group = clusters.group(3).patches.clone();
+        abs[group[0] as usize] = 0.6;
+        abs[group[1] as usize] = 0.6;
+        clusters.update(&[group[0], group[1]], &abs);
+        assert_eq!(clusters.brightest(&abs), Shooter::Group(3));
+        abs[group[0] as usize] = 0.0;
+        clusters.update(&[group[0]], &abs);
+        assert_eq!(clusters.brightest(&abs), Shooter::Patch(single));
+    }
+
+    /// Far from a group, its binned normals give the members' own point-to-point sum: a
+    /// receiver ten radii away along each axis agrees within 2 % (the spread of distances
+    /// across the group, ±10 %, mostly cancels).
+    #[test]
+    fn the_far_field_is_the_members_sum() {
+        let mesh = globe(24, 48);
+        let mut clusters = Clusters::new(&mesh, true);
+        let unshot = vec![Rgb::splat(1.0); mesh.elements.len()];
+        let tables = MeshTables::new(&mesh);
+        let params = SolverParams::default();
+        for g in [0, clusters.len() / 2] {
+            clusters.freeze(g, &mesh, &unshot, &tables, &params, 1.0);
+            let (group, frozen) = (clusters.group(g), clusters.groups[g].frozen.as_ref().unwrap());
+            let axis = frozen.axes.iter().sum::<DVec3>().normalize();
+            for tilt in [DVec3::ZERO, DVec3::X * 0.5, DVec3::Z * 0.5] {
+                let dir = (axis + tilt).normalize();
+                let p = group.centre + dir * 10.0 * group.radius;
+                let n = -dir;
+                let mut shares = [0.0; POINTS];
+                let (far, near) = unoccluded(group, frozen, p, n, u32::MAX, &mut shares);
+                assert!(!near);
+                let exact: f64 = (group.patches.iter())
+                    .map(|&q| {
+                        let patch = &mesh.patches[q as usize];
+                        crate::form_factor::point_to_point(p, n, patch.centre, patch.normal, patch.area)
+                    })
+                    .sum();
+                assert!((far / exact - 1.0).abs() < 0.02, "group {g}, tilt {tilt}: {far} vs {exact}");
+            }
+        }
+    }
+}
