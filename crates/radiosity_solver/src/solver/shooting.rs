@@ -11,6 +11,7 @@
 use std::time::Instant;
 
 use super::clusters::Shooter;
+use super::tally::Shooters;
 use super::{Solver, StepBudget, StepReport};
 
 impl Solver {
@@ -53,7 +54,8 @@ impl Solver {
         let row = kept.unwrap_or_else(|| self.compute_any_row(key));
         // 3. Shoot ω ΔB_i through it (ω = 1 unless over-relaxing).
         let omega = self.params.overshoot.omega();
-        self.tally.shoot(&self.mesh, &self.tables, &members, area, &row, omega);
+        let by = Shooters { patches: &members, area };
+        self.tally.shoot(&self.mesh, &self.tables, by, &row, omega);
         // 4. Keep the row (or the plans it was computed with).
         let plans = if key < self.mesh.patches.len() { &self.scratch.plans[..] } else { &[] };
         self.rows.keep(key, row, was_kept, plans, &self.params);

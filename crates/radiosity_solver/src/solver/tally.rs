@@ -21,6 +21,15 @@ pub struct EnergyBalance {
     pub escaped: Rgb,
 }
 
+/// Who shoots: one patch, or a group of a model's facets (see `clusters`).
+#[derive(Clone, Copy)]
+pub(super) struct Shooters<'a> {
+    /// The patches.
+    pub(super) patches: &'a [u32],
+    /// Their total area.
+    pub(super) area: f64,
+}
+
 /// Radiosity, unshot radiosity and power tallies.
 pub(super) struct Tally {
     /// B per element, W/unit².
@@ -133,15 +142,8 @@ impl Tally {
     /// with F_{j→i} already the reciprocal form), and the shooter keeps (1 − ω) ΔB_i. The
     /// shooter is one patch or a group of them (`shooters`, of total area `area`), whose ΔB_i
     /// is then their unshot power over their area.
-    pub(super) fn shoot(
-        &mut self,
-        mesh: &Mesh,
-        tables: &MeshTables,
-        shooters: &[u32],
-        area: f64,
-        row: &Row,
-        omega: f64,
-    ) {
+    pub(super) fn shoot(&mut self, mesh: &Mesh, tables: &MeshTables, by: Shooters, row: &Row, omega: f64) {
+        let Shooters { patches: shooters, area } = by;
         let power: Rgb = shooters.iter().map(|&q| self.patch_unshot_power[q as usize]).sum();
         let shot_b = power * (omega / area);
         self.changed.clear();
@@ -214,20 +216,13 @@ impl Tally {
             self.changed(patch);
         }
         self.escaped += shot_b * area - received;
-        self.tally_direct(mesh, tables, shooters, area, row, omega);
+        self.tally_direct(mesh, tables, by, row, omega);
     }
 
     /// Adds to each receiver the part of this shot that is the shooter's own emission (its
     /// direct light). Only emitters' shots carry any, so the extra pass is rare.
-    fn tally_direct(
-        &mut self,
-        mesh: &Mesh,
-        tables: &MeshTables,
-        shooters: &[u32],
-        area: f64,
-        row: &Row,
-        omega: f64,
-    ) {
+    fn tally_direct(&mut self, mesh: &Mesh, tables: &MeshTables, by: Shooters, row: &Row, omega: f64) {
+        let Shooters { patches: shooters, area } = by;
         let emission: Rgb = shooters.iter().map(|&q| self.patch_unshot_emission[q as usize]).sum();
         if emission.max_channel() <= 0.0 {
             return;
