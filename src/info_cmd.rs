@@ -44,6 +44,13 @@ pub fn run(a: InfoArgs) -> Result<()> {
             "adaptive   {unrefined} elements before adaptive subdivision quartered those where the light changes steeply"
         );
     }
+    let groups = radiosity_solver::shooter_groups(mesh);
+    if groups > 0 {
+        let _ = writeln!(
+            out,
+            "groups     {groups} groups of a model's small facets shoot as one (solve --clusters false: each alone)"
+        );
+    }
     let _ = writeln!(out, "occluders  {} triangles", mesh.occluders.len());
     // Contact cuts: what each object lost under the solids standing on it.
     for (name, hidden) in mesh.object_names.iter().zip(&mesh.hidden_area) {

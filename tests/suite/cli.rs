@@ -470,3 +470,78 @@ fn dark_by_construction_scenes_are_explained() {
     let solve = radiosity(&["solve", "cornell", "--max-shots", "20"]);
     assert!(!stderr(&solve).contains("no light reached"), "{}", stderr(&solve));
 }
+
+/// A latitude–longitude ball of 16 × 32 facets over a lit floor, as an OBJ: `info` says how
+/// many groups its facets shoot in, and `solve --clusters false` (every facet alone) and the
+/// default (grouped) agree on the ball's mean (measured: within 0.1 %, in 176 shots against
+/// 430; asserted: 2 %, and fewer shots).
+#[test]
+fn a_tessellated_model_shoots_in_groups() {
+    use std::fmt::Write;
+    let dir = tempfile::tempdir().unwrap();
+    let (rings, segments) = (16, 32);
+    let mut obj = String::from(
+        "mtllib ball.mtl\no floor\nusemtl grey\nv -3 0 -3\nv -3 0 3\nv 3 0 3\nv 3 0 -3\nf 1 2 3 4\n",
+    );
+    obj.push_str("o lamp\nusemtl lamp\nv -0.5 3 -0.5\nv 0.5 3 -0.5\nv 0.5 3 0.5\nv -0.5 3 0.5\nf 5 6 7 8\no ball\nusemtl grey\n");
+    for i in 0..=rings {
+        let theta = std::f64::consts::PI * f64::from(i) / f64::from(rings);
+        for j in 0..segments {
+            let phi = std::f64::consts::TAU * f64::from(j) / f64::from(segments);
+            let (x, y, z) = (theta.sin() * phi.cos(), 1.2 + theta.cos(), theta.sin() * phi.sin());
+            writeln!(obj, "v {x} {y} {z}").unwrap();
+        }
+    }
+    let at = |i: u32, j: u32| 9 + i * segments + j % segments;
+    for i in 0..rings {
+        for j in 0..segments {
+            let (a, b, c, d) = (at(i, j), at(i, j + 1), at(i + 1, j + 1), at(i + 1, j));
+            match i {
+                0 => writeln!(obj, "f {a} {c} {d}").unwrap(),
+                _ if i == rings - 1 => writeln!(obj, "f {a} {b} {c}").unwrap(),
+                _ => writeln!(obj, "f {a} {b} {c} {d}").unwrap(),
+            }
+        }
+    }
+    std::fs::write(dir.path().join("ball.obj"), obj).unwrap();
+    std::fs::write(
+        dir.path().join("ball.mtl"),
+        "newmtl grey\nKd 0.5 0.5 0.5\nnewmtl lamp\nKd 0 0 0\nKe 20 20 20\n",
+    )
+    .unwrap();
+    let scene = dir.path().join("ball.obj");
+    let scene = scene.to_str().unwrap();
+    let o = radiosity(&["info", scene]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    let groups: usize = out
+        .lines()
+        .find_map(|l| l.strip_prefix("groups"))
+        .and_then(|l| l.split_whitespace().next())
+        .unwrap_or_else(|| panic!("{out}"))
+        .parse()
+        .unwrap();
+    assert!(groups > 4, "{out}");
+    let ball = |clusters: &str| {
+        let json = dir.path().join(format!("{clusters}.json"));
+        let json = json.to_str().unwrap();
+        let o = radiosity(&[
+            "solve",
+            scene,
+            "--clusters",
+            clusters,
+            "--unshot-threshold",
+            "1e-3",
+            "--json",
+            json,
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let r = report(Path::new(json));
+        let ball = r["objects"].as_array().unwrap().iter().find(|o| o["name"] == "ball").unwrap().clone();
+        (ball["radiosity"][0].as_f64().unwrap(), r["shots"].as_u64().unwrap())
+    };
+    let ((grouped, grouped_shots), (alone, alone_shots)) = (ball("true"), ball("false"));
+    println!("grouped {grouped} in {grouped_shots} shots, alone {alone} in {alone_shots}");
+    assert!((grouped / alone - 1.0).abs() < 0.02, "grouped {grouped} vs alone {alone}");
+    assert!(grouped_shots < alone_shots, "{grouped_shots} vs {alone_shots} shots");
+}

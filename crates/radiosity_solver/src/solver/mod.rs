@@ -89,6 +89,12 @@ pub struct Solver {
     progress: Progress,
 }
 
+/// How many groups of small model facets would shoot as one in a solve of `mesh` with
+/// [`SolverParams::clustering`] on (the default); 0 when it has no such facets.
+pub fn shooter_groups(mesh: &Mesh) -> usize {
+    Clusters::new(mesh, true).len()
+}
+
 impl Solver {
     /// A solver at shot 0: B = E and ΔB = E on every element.
     ///
