@@ -660,4 +660,14 @@ fn a_furnace_box_holding_a_clustered_torus_reaches_e_over_one_minus_rho() {
             );
         }
     }
+    // Groups' rows run in parallel over receivers: same seed, 1 or 2 threads, same bits.
+    let run = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            let mut s = solver_for(&scene, SolverParams { max_shots: Some(300), ..SolverParams::default() });
+            s.solve();
+            s.solution().element_radiosity
+        })
+    };
+    assert!(run(1) == run(2), "1 and 2 threads differ");
 }
