@@ -5,7 +5,6 @@
 
 use std::sync::Arc;
 
-use radiosity_core::Mesh;
 use rayon::prelude::*;
 
 use super::Solver;
@@ -96,6 +95,7 @@ impl Solver {
             pilot: Strata::new(if bright { params.visibility_rays } else { params.dim_rays }),
             facet_pilot: Strata::new(if bright { facet_rays(params) } else { params.dim_rays }),
             facets: self.clusters.members(),
+            patch_elements: &tables.patch_elements,
             penumbra: Strata::new(params.penumbra_rays),
         };
         let plans: &[PatchPlan] = self.rows.plans(shooter).unwrap_or(&scratch.plans);
@@ -104,7 +104,7 @@ impl Solver {
             penumbra_pass(&shot, plans, tables, &mut scratch.penumbra, &mut scratch.factors);
         }
         if shot.uneven.is_some() {
-            keep_uneven_power(&mesh, &tables.patch_elements, plans, &mut scratch.factors);
+            keep_uneven_power(&tables.element_area, &tables.patch_elements, plans, &mut scratch.factors);
         }
         let (row, rays) = gather(&tables.patch_elements, plans, &scratch.factors);
         self.progress.rays += rays;
@@ -121,7 +121,7 @@ impl Solver {
 /// the shooter's power share going to j). Without this the Cornell ceiling, lit only by
 /// such transfers, came out 1.2 % dark.
 fn keep_uneven_power(
-    mesh: &Mesh,
+    element_area: &[f64],
     patch_elements: &[std::ops::Range<usize>],
     plans: &[PatchPlan],
     factors: &mut [Received],
@@ -130,7 +130,7 @@ fn keep_uneven_power(
     let (mut moved, mut rest) = (0.0, 0.0);
     for (q, plan) in plans.iter().enumerate().filter(|(_, p)| p.live) {
         for e in elements(q) {
-            let (r, area) = (&factors[e], mesh.elements[e].area);
+            let (r, area) = (&factors[e], element_area[e]);
             if plan.touching {
                 moved += area * (r.unweighted_factor() - r.factor());
             } else {
@@ -157,13 +157,13 @@ fn first_pass(shot: &Shot, plans: &[PatchPlan], factors: &mut [Received]) {
     let mesh = shot.mesh;
     let mut slices: Vec<&mut [Received]> = Vec::with_capacity(mesh.patches.len());
     let mut rest = factors;
-    for p in &mesh.patches {
-        let (own, after) = rest.split_at_mut(p.elements.len());
+    for range in shot.patch_elements {
+        let (own, after) = rest.split_at_mut(range.len());
         slices.push(own);
         rest = after;
     }
     let receive_one = |q: usize, out: &mut &mut [Received]| {
-        receive_patch(shot, &plans[q], mesh.patches[q].elements.start as usize, out)
+        receive_patch(shot, &plans[q], shot.patch_elements[q].start, out)
     };
     if mesh.elements.len() < PARALLEL_MIN || rayon::current_num_threads() == 1 {
         slices.iter_mut().enumerate().for_each(|(q, out)| receive_one(q, out));

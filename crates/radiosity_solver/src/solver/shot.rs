@@ -94,6 +94,8 @@ pub(super) struct Shot<'a> {
     pub(super) facet_pilot: Strata,
     /// Per patch, whether it is such a facet.
     pub(super) facets: &'a [bool],
+    /// Per patch, its elements' range (see `MeshTables::patch_elements`).
+    pub(super) patch_elements: &'a [std::ops::Range<usize>],
     pub(super) penumbra: Strata,
 }
 
