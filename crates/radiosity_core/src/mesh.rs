@@ -992,6 +992,10 @@ impl Mesh {
         let mut dark_back = HashMap::new();
         for (oi, o) in scene.objects.iter().enumerate() {
             let first_surface = mesh.surfaces.len() as u32;
+            // A polygon of this object, cut around what stands on it, graded and refined.
+            let cut = |mesh: &mut Mesh, p: &Polygon, id: Option<PolygonId>| {
+                mesh.mesh_cut_polygon(contacts.as_ref(), p, id, oi, o.material, params, refinement);
+            };
             match &o.shape {
                 Shape::Polygons(ps) => {
                     for (index, p) in ps.iter().enumerate() {
@@ -1002,15 +1006,7 @@ impl Mesh {
                             mesh.hidden_area[oi] += p.area();
                             continue;
                         }
-                        mesh.mesh_cut_polygon(
-                            contacts.as_ref(),
-                            p,
-                            Some(id),
-                            oi,
-                            o.material,
-                            params,
-                            refinement,
-                        );
+                        cut(&mut mesh, p, Some(id));
                     }
                 }
                 Shape::Sphere(s) => {
@@ -1027,29 +1023,13 @@ impl Mesh {
                         if m.faces()[first].len() > 3 {
                             let id = PolygonId { object: oi, index: first };
                             let p = &m.polygons()[first];
-                            mesh.mesh_cut_polygon(
-                                contacts.as_ref(),
-                                p,
-                                Some(id),
-                                oi,
-                                o.material,
-                                params,
-                                refinement,
-                            );
+                            cut(&mut mesh, p, Some(id));
                         } else if let [a, c] = group[..]
                             && let Some(quad) = pair_as_quad(m, a as usize, c as usize)
                         {
                             // Two triangles that make a convex quad (how exporters write one
                             // quad) are meshed as that quad, exactly as a quad polygon would be.
-                            mesh.mesh_cut_polygon(
-                                contacts.as_ref(),
-                                &quad,
-                                None,
-                                oi,
-                                o.material,
-                                params,
-                                refinement,
-                            );
+                            cut(&mut mesh, &quad, None);
                         } else {
                             let mut b = SurfaceBuilder::default();
                             mesh_triangle_group(&mut b, m, &group, params);
