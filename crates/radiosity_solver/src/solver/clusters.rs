@@ -28,14 +28,16 @@
 //! by the near field.
 
 use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::{DVec3, Vec3};
 use radiosity_accel::RayQuery;
 use radiosity_core::{Mesh, Rgb};
-use rayon::prelude::*;
 
 use super::SolverParams;
 use super::mesh_tables::MeshTables;
+use super::parallel::for_each_maybe_parallel;
+use super::receive::corners_of;
 use super::row::Row;
 use crate::sampling::{Rng, point_on, point_on_f32};
 
@@ -68,8 +70,6 @@ pub(super) struct Clusters {
     groups: Vec<Group>,
     /// Per group, Σ |unshot power| over its members, kept up to date by [`Clusters::update`].
     power: Vec<f64>,
-    /// Per patch, its |unshot power| as `power` last counted it.
-    counted: Vec<f64>,
     /// The patches in no group, in index order.
     singles: Vec<u32>,
     /// Updates since `power` was summed afresh.
@@ -166,8 +166,7 @@ impl Clusters {
         }
         let members = of_patch.iter().map(|&g| g != NONE).collect();
         let singles = (0..of_patch.len() as u32).filter(|&q| of_patch[q as usize] == NONE).collect();
-        let counted = vec![0.0; of_patch.len()];
-        Self { of_patch, members, power: vec![0.0; groups.len()], counted, singles, since_sum: 0, groups }
+        Self { of_patch, members, power: vec![0.0; groups.len()], singles, since_sum: 0, groups }
     }
 
     /// Per patch, whether it is in a group.
@@ -193,24 +192,23 @@ impl Clusters {
                 self.power[g as usize] += patch_abs[q];
             }
         }
-        self.counted.copy_from_slice(patch_abs);
         self.since_sum = 0;
     }
 
-    /// Brings the groups' sums up to date with the patches a shot `changed`, and sums them
-    /// afresh every [`super::tally::RESUM`] shots, so rounding cannot pile up.
-    pub(super) fn update(&mut self, changed: &[u32], patch_abs: &[f64]) {
+    /// Brings the groups' sums up to date with the patches a shot `changed` (patch, change
+    /// of its |unshot power|), and sums them afresh from `patch_abs` every
+    /// [`super::tally::RESUM`] shots, so rounding cannot pile up.
+    pub(super) fn update(&mut self, changed: &[(u32, f64)], patch_abs: &[f64]) {
         self.since_sum += 1;
         if self.since_sum >= super::tally::RESUM {
             self.sum(patch_abs);
             return;
         }
-        for &q in changed {
-            let q = q as usize;
-            if self.of_patch[q] != NONE {
-                self.power[self.of_patch[q] as usize] += patch_abs[q] - self.counted[q];
+        for &(q, delta) in changed {
+            let g = self.of_patch[q as usize];
+            if g != NONE {
+                self.power[g as usize] += delta;
             }
-            self.counted[q] = patch_abs[q];
         }
     }
 
@@ -286,8 +284,9 @@ impl Clusters {
                 let width = cdf[k] - below;
                 let u = if width > 0.0 { ((u - below) / width).clamp(0.0, 1.0 - f64::EPSILON) } else { 0.5 };
                 let e = elements[k];
-                let corners: Vec<DVec3> = mesh.element_corners(e).collect();
-                points.push((point_on(&corners, u, v), mesh.elements[e].normal, mesh.elements[e].patch));
+                let corners = corners_of(mesh, e);
+                let corners = &corners[..mesh.elements[e].vertex_count as usize];
+                points.push((point_on(corners, u, v), mesh.elements[e].normal, mesh.elements[e].patch));
             }
         }
         let lifted = points.iter().map(|(p, n, _)| (*p + *n * tables.ray_offset).as_vec3()).collect();
@@ -359,28 +358,14 @@ impl Clusters {
             let visibility = if traced == 0 { 1.0 } else { f64::from(visible) / f64::from(traced) };
             ((f * visibility) as f32, u64::from(traced))
         };
-        let traced: u64 = if mesh.elements.len() < 256 || rayon::current_num_threads() == 1 {
-            factors
-                .iter_mut()
-                .enumerate()
-                .map(|(e, f)| {
-                    let (value, rays) = receive(e);
-                    *f = value;
-                    rays
-                })
-                .sum()
-        } else {
-            factors
-                .par_iter_mut()
-                .enumerate()
-                .with_min_len(256)
-                .map(|(e, f)| {
-                    let (value, rays) = receive(e);
-                    *f = value;
-                    rays
-                })
-                .sum()
-        };
+        // Rays traced, for the progress figures (an integer sum: the same in any order).
+        let traced = AtomicU64::new(0);
+        for_each_maybe_parallel(factors, |e, f| {
+            let (value, rays) = receive(e);
+            *f = value;
+            traced.fetch_add(rays, Ordering::Relaxed);
+        });
+        let traced = traced.into_inner();
         let mut row = Row { spans: Vec::new(), factors: Vec::new() };
         for range in &tables.patch_elements {
             let span = &factors[range.clone()];
@@ -567,10 +552,10 @@ mod tests {
         let group = clusters.group(3).patches.clone();
         abs[group[0] as usize] = 0.6;
         abs[group[1] as usize] = 0.6;
-        clusters.update(&[group[0], group[1]], &abs);
+        clusters.update(&[(group[0], 0.6), (group[1], 0.6)], &abs);
         assert_eq!(clusters.brightest(&abs), Shooter::Group(3));
         abs[group[0] as usize] = 0.0;
-        clusters.update(&[group[0]], &abs);
+        clusters.update(&[(group[0], -0.6)], &abs);
         assert_eq!(clusters.brightest(&abs), Shooter::Patch(single));
     }
 

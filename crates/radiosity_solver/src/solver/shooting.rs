@@ -41,12 +41,10 @@ impl Solver {
     /// One shot.
     fn shoot(&mut self) {
         // 1. The shooter: a patch, or a group of a model's facets (`clusters.rs`).
-        let (key, members, area) = match self.clusters.brightest(&self.tally.patch_abs) {
-            Shooter::Patch(p) => (p, vec![p as u32], self.mesh.patches[p].area),
-            Shooter::Group(g) => {
-                let group = self.clusters.group(g);
-                (self.mesh.patches.len() + g, group.patches.clone(), group.area)
-            }
+        let shooter = self.clusters.brightest(&self.tally.patch_abs);
+        let key = match shooter {
+            Shooter::Patch(p) => p,
+            Shooter::Group(g) => self.mesh.patches.len() + g,
         };
         // 2. Its row of form factors.
         let kept = self.rows.take(key);
@@ -54,7 +52,16 @@ impl Solver {
         let row = kept.unwrap_or_else(|| self.compute_any_row(key));
         // 3. Shoot ω ΔB_i through it (ω = 1 unless over-relaxing).
         let omega = self.params.overshoot.omega();
-        let by = Shooters { patches: &members, area };
+        let patch = key as u32;
+        let by = match shooter {
+            Shooter::Patch(p) => {
+                Shooters { patches: std::slice::from_ref(&patch), area: self.mesh.patches[p].area }
+            }
+            Shooter::Group(g) => {
+                let group = self.clusters.group(g);
+                Shooters { patches: &group.patches, area: group.area }
+            }
+        };
         self.tally.shoot(&self.mesh, &self.tables, by, &row, omega);
         // 4. Keep the row (or the plans it was computed with).
         let plans = if key < self.mesh.patches.len() { &self.scratch.plans[..] } else { &[] };

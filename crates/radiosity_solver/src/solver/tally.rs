@@ -57,8 +57,9 @@ pub(super) struct Tally {
     abs_total: f64,
     /// Shots since `abs_total` was summed afresh.
     since_sum: u32,
-    /// The patches whose unshot power the last shot changed.
-    pub(super) changed: Vec<u32>,
+    /// The patches whose unshot power the last shot changed, with the change of their
+    /// |unshot power|.
+    pub(super) changed: Vec<(u32, f64)>,
 }
 
 /// Shots between fresh sums of the unshot power, so rounding cannot pile up.
@@ -132,9 +133,10 @@ impl Tally {
     /// Patch `q`'s unshot power changed: its |power|, the total, and the changed list follow.
     fn changed(&mut self, q: usize) {
         let new = self.patch_unshot_power[q].abs().sum();
-        self.abs_total += new - self.patch_abs[q];
+        let delta = new - self.patch_abs[q];
+        self.abs_total += delta;
         self.patch_abs[q] = new;
-        self.changed.push(q as u32);
+        self.changed.push((q as u32, delta));
     }
 
     /// Shoots ω times the shooter's unshot radiosity through its row of form factors: every
