@@ -11,6 +11,14 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
+/// The number that starts the line of `info` output `out` keyed `key`.
+fn leading_count(out: &str, key: &str) -> usize {
+    (out.lines().find_map(|l| l.strip_prefix(key)))
+        .and_then(|l| l.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no '{key}' count in:\n{out}"))
+}
+
 fn report(path: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
@@ -129,13 +137,7 @@ fn info_prints_counts_and_power() {
         assert!(out.contains(key), "{out}");
     }
     // Adaptive subdivision is reported with the count it started from, and off, not at all.
-    let before: usize = out
-        .lines()
-        .find_map(|l| l.strip_prefix("adaptive"))
-        .and_then(|l| l.split_whitespace().next())
-        .unwrap_or_else(|| panic!("{out}"))
-        .parse()
-        .unwrap();
+    let before = leading_count(&out, "adaptive");
     let elements: usize =
         out.lines().find_map(|l| l.strip_prefix("elements")).unwrap().trim().parse().unwrap();
     assert!(before < elements, "{out}");
@@ -514,13 +516,7 @@ fn a_tessellated_model_shoots_in_groups() {
     let o = radiosity(&["info", scene]);
     assert!(o.status.success(), "{}", stderr(&o));
     let out = String::from_utf8_lossy(&o.stdout);
-    let groups: usize = out
-        .lines()
-        .find_map(|l| l.strip_prefix("groups"))
-        .and_then(|l| l.split_whitespace().next())
-        .unwrap_or_else(|| panic!("{out}"))
-        .parse()
-        .unwrap();
+    let groups = leading_count(&out, "groups");
     assert!(groups > 4, "{out}");
     let ball = |clusters: &str| {
         let json = dir.path().join(format!("{clusters}.json"));

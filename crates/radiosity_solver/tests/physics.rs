@@ -130,19 +130,21 @@ fn energy_is_conserved_after_every_shot() {
     }
 }
 
+/// The element radiosity after `shots` shots (default parameters) on a pool of `threads`.
+fn radiosity_on_threads(scene: &Scene, shots: u64, threads: usize) -> Vec<Rgb> {
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+    pool.install(|| {
+        let mut s = solver_for(scene, SolverParams { max_shots: Some(shots), ..SolverParams::default() });
+        s.solve();
+        s.solution().element_radiosity
+    })
+}
+
 /// Same seed, 1 or 2 threads: bit-identical solutions.
 #[test]
 fn one_and_two_threads_agree_exactly() {
     let scene = two_plates(1.0, 0.3, 0.6, 1.0);
-    let run = |threads| {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-        pool.install(|| {
-            let mut s = solver_for(&scene, SolverParams { max_shots: Some(40), ..SolverParams::default() });
-            s.solve();
-            s.solution().element_radiosity
-        })
-    };
-    assert_eq!(run(1), run(2));
+    assert_eq!(radiosity_on_threads(&scene, 40, 1), radiosity_on_threads(&scene, 40, 2));
 }
 
 /// Overshooting converges to the same answer, in fewer shots.
@@ -661,13 +663,8 @@ fn a_furnace_box_holding_a_clustered_torus_reaches_e_over_one_minus_rho() {
         }
     }
     // Groups' rows run in parallel over receivers: same seed, 1 or 2 threads, same bits.
-    let run = |threads| {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-        pool.install(|| {
-            let mut s = solver_for(&scene, SolverParams { max_shots: Some(300), ..SolverParams::default() });
-            s.solve();
-            s.solution().element_radiosity
-        })
-    };
-    assert!(run(1) == run(2), "1 and 2 threads differ");
+    assert!(
+        radiosity_on_threads(&scene, 300, 1) == radiosity_on_threads(&scene, 300, 2),
+        "1 and 2 threads differ"
+    );
 }
