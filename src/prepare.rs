@@ -140,6 +140,10 @@ pub struct SolveOpts {
     /// count; false: every facet shoots on its own.
     #[arg(long, value_name = "true|false", default_value_t = SolverParams::default().clustering, action = clap::ArgAction::Set)]
     pub clusters: bool,
+    /// Let the facets of a group far from a dim shooter share one visibility estimate of a
+    /// few rays instead of a ray each (needs `--clusters true`); false: a ray per facet.
+    #[arg(long, value_name = "true|false", default_value_t = SolverParams::default().shared_visibility, action = clap::ArgAction::Set)]
+    pub shared_visibility: bool,
     /// Memory for keeping each shooter's form factors for its next shots, in MiB (0: keep
     /// none; the answer is the same, only slower).
     #[arg(long, default_value_t = SolverParams::default().row_cache_bytes >> 20, value_name = "MIB")]
@@ -323,6 +327,7 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
         overshoot: if o.overshoot == 1.0 { Overshoot::Off } else { Overshoot::Relaxation(o.overshoot) },
         row_cache_bytes: o.row_cache_mib.saturating_mul(1 << 20),
         clustering: o.clusters,
+        shared_visibility: o.shared_visibility,
         ..defaults
     };
     Ok((Settings { scene, mesh_params, solver_params }, no_light))

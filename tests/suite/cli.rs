@@ -518,14 +518,16 @@ fn a_tessellated_model_shoots_in_groups() {
     let out = String::from_utf8_lossy(&o.stdout);
     let groups = leading_count(&out, "groups");
     assert!(groups > 4, "{out}");
-    let ball = |clusters: &str| {
-        let json = dir.path().join(format!("{clusters}.json"));
+    let ball = |clusters: &str, shared: &str| {
+        let json = dir.path().join(format!("{clusters}-{shared}.json"));
         let json = json.to_str().unwrap();
         let o = radiosity(&[
             "solve",
             scene,
             "--clusters",
             clusters,
+            "--shared-visibility",
+            shared,
             "--unshot-threshold",
             "1e-3",
             "--json",
@@ -536,8 +538,11 @@ fn a_tessellated_model_shoots_in_groups() {
         let ball = r["objects"].as_array().unwrap().iter().find(|o| o["name"] == "ball").unwrap().clone();
         (ball["radiosity"][0].as_f64().unwrap(), r["shots"].as_u64().unwrap())
     };
-    let ((grouped, grouped_shots), (alone, alone_shots)) = (ball("true"), ball("false"));
+    let ((grouped, grouped_shots), (alone, alone_shots)) = (ball("true", "true"), ball("false", "true"));
     println!("grouped {grouped} in {grouped_shots} shots, alone {alone} in {alone_shots}");
     assert!((grouped / alone - 1.0).abs() < 0.02, "grouped {grouped} vs alone {alone}");
+    // A ray per facet instead of shared visibility: the same light within noise.
+    let (unshared, _) = ball("true", "false");
+    assert!((grouped / unshared - 1.0).abs() < 0.01, "shared {grouped} vs unshared {unshared}");
     assert!(grouped_shots < alone_shots, "{grouped_shots} vs {alone_shots} shots");
 }

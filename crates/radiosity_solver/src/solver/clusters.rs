@@ -39,6 +39,7 @@ use super::mesh_tables::MeshTables;
 use super::parallel::for_each_maybe_parallel;
 use super::receive::corners_of;
 use super::row::Row;
+use super::shot::ShotScratch;
 use crate::sampling::{Rng, point_on, point_on_f32};
 
 /// Cells per scene diagonal: a group spans at most one cell.
@@ -83,9 +84,9 @@ pub(super) struct Group {
     /// Σ of their areas.
     pub(super) area: f64,
     /// Area-weighted centroid.
-    centre: DVec3,
+    pub(super) centre: DVec3,
     /// Largest distance from `centre` to a member's corner.
-    radius: f64,
+    pub(super) radius: f64,
     /// What its first shot fixed.
     frozen: Option<Frozen>,
 }
@@ -172,6 +173,12 @@ impl Clusters {
     /// Per patch, whether it is in a group.
     pub(super) fn members(&self) -> &[bool] {
         &self.members
+    }
+
+    /// Patch `q`'s group, if it is in one.
+    pub(super) fn group_of(&self, q: usize) -> Option<usize> {
+        let g = self.of_patch[q];
+        (g != NONE).then_some(g as usize)
     }
 
     /// Number of groups.
@@ -295,7 +302,8 @@ impl Clusters {
     }
 
     /// Group `g`'s row (it must be frozen): every element's form factor to it, visibility
-    /// included, for the patches that receive any; and the rays traced.
+    /// included, for the patches that receive any; and the rays traced. Receiving groups
+    /// far from a dim group share their visibility (`sharing`, see [`super::shared`]).
     pub(super) fn row(
         &self,
         g: usize,
@@ -303,69 +311,66 @@ impl Clusters {
         tables: &MeshTables,
         accel: &dyn RayQuery,
         params: &SolverParams,
-        factors: &mut Vec<f32>,
+        scratch: &mut ShotScratch,
     ) -> (Row, u64) {
         let group = &self.groups[g];
         let frozen = group.frozen.as_ref().expect("a group is frozen before its row is computed");
-        let rays = if frozen.bright { super::row::facet_rays(params) } else { params.dim_rays };
+        let share = params.clustering && params.shared_visibility;
+        scratch.sharing.choose(self, group.centre, group.radius, frozen.bright, share, Some(g));
+        let (sharing, factors) = (&scratch.sharing, &mut scratch.group_factors);
+        let stream = GROUP_STREAM ^ g as u64;
+        let aim = Aim {
+            frozen,
+            mesh,
+            tables,
+            accel,
+            rays: if frozen.bright { super::row::facet_rays(params) } else { params.dim_rays },
+            seed: params.seed,
+            stream,
+        };
         factors.clear();
         factors.resize(mesh.elements.len(), 0.0);
-        let receive = |e: usize| -> (f32, u64) {
-            let el = &mesh.elements[e];
-            let p = tables.vertex_means[e];
-            let mut shares = [0.0; POINTS];
-            let (f, near) = unoccluded(group, frozen, p, el.normal, el.patch, &mut shares);
-            if f <= 0.0 {
-                return (0.0, 0);
-            }
-            let corners = &tables.lifted_corners[e][..el.vertex_count as usize];
-            let mut rng = Rng::for_task(params.seed, GROUP_STREAM ^ g as u64, e as u64);
-            let (mut visible, mut traced) = (0u32, 0u32);
-            // Rays end at points that give the receiver light: a ray to a point on a facet
-            // turned away would cross the model and count as blocked (the model then came
-            // out 2 % dark). Near the group, points by their share of the form factor,
-            // stratified; far, points by the cosine at them (rejection).
-            let (mut walked, mut at) = (0.0, 0);
-            for j in 0..rays {
-                let target = if near {
-                    let t = (f64::from(j) + rng.next_f64()) / f64::from(rays) * f;
-                    while at + 1 < POINTS && walked + shares[at] < t {
-                        walked += shares[at];
-                        at += 1;
-                    }
-                    Some(at)
-                } else {
-                    let mut found = None;
-                    for _ in 0..FAR_TRIES {
-                        // Kept with probability cos θ at the point: its share of the far
-                        // field (one distance for all).
-                        let i = (rng.next_u64() % POINTS as u64) as usize;
-                        let (q, nq, _) = frozen.points[i];
-                        let d = p - q;
-                        if el.normal.dot(q - p) > 0.0 && rng.next_f64() * d.length() < nq.dot(d) {
-                            found = Some(i);
-                            break;
-                        }
-                    }
-                    found
-                };
-                let Some(i) = target else { continue };
-                let (u, v) = (rng.next_f64() as f32, rng.next_f64() as f32);
-                let from = Vec3::from(point_on_f32(corners, u, v));
-                visible += u32::from(!accel.occluded(from, frozen.lifted[i]));
-                traced += 1;
-            }
-            let visibility = if traced == 0 { 1.0 } else { f64::from(visible) / f64::from(traced) };
-            ((f * visibility) as f32, u64::from(traced))
-        };
         // Rays traced, for the progress figures (an integer sum: the same in any order).
         let traced = AtomicU64::new(0);
-        for_each_maybe_parallel(factors, |e, f| {
-            let (value, rays) = receive(e);
-            *f = value;
-            traced.fetch_add(rays, Ordering::Relaxed);
+        // Without visibility for the elements of sharing groups, with it for the others.
+        for_each_maybe_parallel(factors, |e, out| {
+            let el = &mesh.elements[e];
+            let mut shares = [0.0; POINTS];
+            let (f, near) =
+                unoccluded(group, frozen, tables.vertex_means[e], el.normal, el.patch, &mut shares);
+            *out = f as f32;
+            if f > 0.0 && !sharing.shares(self, el.patch as usize) {
+                let (visible, n) = aim.trace(e, f, near, &shares);
+                *out = if n == 0 { f as f32 } else { (f * f64::from(visible) / f64::from(n)) as f32 };
+                traced.fetch_add(u64::from(n), Ordering::Relaxed);
+            }
         });
-        let traced = traced.into_inner();
+        let mut traced = traced.into_inner();
+        if sharing.any() {
+            let first: &[f32] = factors;
+            let (seen, rays) = sharing.trace(
+                self,
+                mesh,
+                params.seed,
+                stream,
+                |e| tables.element_area[e] * f64::from(first[e]),
+                |e| {
+                    let el = &mesh.elements[e];
+                    let mut shares = [0.0; POINTS];
+                    let (f, near) =
+                        unoccluded(group, frozen, tables.vertex_means[e], el.normal, el.patch, &mut shares);
+                    aim.trace(e, f, near, &shares)
+                },
+            );
+            traced += rays;
+            for_each_maybe_parallel(factors, |e, out| {
+                if let Some(g) = sharing.group_of(self, mesh.elements[e].patch as usize)
+                    && seen[g].1 > 0
+                {
+                    *out = (f64::from(*out) * f64::from(seen[g].0) / f64::from(seen[g].1)) as f32;
+                }
+            });
+        }
         let mut row = Row { spans: Vec::new(), factors: Vec::new() };
         for range in &tables.patch_elements {
             let span = &factors[range.clone()];
@@ -375,6 +380,69 @@ impl Clusters {
             }
         }
         (row, traced)
+    }
+}
+
+/// What a group's row aims its visibility rays with.
+struct Aim<'a> {
+    frozen: &'a Frozen,
+    mesh: &'a Mesh,
+    tables: &'a MeshTables,
+    accel: &'a dyn RayQuery,
+    /// Rays per receiving element.
+    rays: u32,
+    seed: u64,
+    /// The group's random stream.
+    stream: u64,
+}
+
+impl Aim<'_> {
+    /// Element `e`'s visibility rays to the group, whose unoccluded form factor to it is
+    /// `f`, near or not, with its points' `shares` of it when near: (unblocked, traced),
+    /// from the element's own stream.
+    ///
+    /// Rays end at points that give the receiver light: a ray to a point on a facet turned
+    /// away would cross the model and count as blocked (the model then came out 2 % dark).
+    /// Near the group, points by their share of the form factor, stratified; far, points by
+    /// the cosine at them (rejection).
+    fn trace(&self, e: usize, f: f64, near: bool, shares: &[f64; POINTS]) -> (u32, u32) {
+        let Self { frozen, mesh, tables, accel, rays, seed, stream } = *self;
+        let el = &mesh.elements[e];
+        let p = tables.vertex_means[e];
+        let corners = &tables.lifted_corners[e][..el.vertex_count as usize];
+        let mut rng = Rng::for_task(seed, stream, e as u64);
+        let (mut visible, mut traced) = (0u32, 0u32);
+        let (mut walked, mut at) = (0.0, 0);
+        for j in 0..rays {
+            let target = if near {
+                let t = (f64::from(j) + rng.next_f64()) / f64::from(rays) * f;
+                while at + 1 < POINTS && walked + shares[at] < t {
+                    walked += shares[at];
+                    at += 1;
+                }
+                Some(at)
+            } else {
+                let mut found = None;
+                for _ in 0..FAR_TRIES {
+                    // Kept with probability cos θ at the point: its share of the far field
+                    // (one distance for all).
+                    let i = (rng.next_u64() % POINTS as u64) as usize;
+                    let (q, nq, _) = frozen.points[i];
+                    let d = p - q;
+                    if el.normal.dot(q - p) > 0.0 && rng.next_f64() * d.length() < nq.dot(d) {
+                        found = Some(i);
+                        break;
+                    }
+                }
+                found
+            };
+            let Some(i) = target else { continue };
+            let (u, v) = (rng.next_f64() as f32, rng.next_f64() as f32);
+            let from = Vec3::from(point_on_f32(corners, u, v));
+            visible += u32::from(!accel.occluded(from, frozen.lifted[i]));
+            traced += 1;
+        }
+        (visible, traced)
     }
 }
 

@@ -48,6 +48,7 @@ mod rays;
 mod receive;
 mod row;
 mod row_cache;
+mod shared;
 mod shooting;
 mod shot;
 mod stop;

@@ -5,7 +5,7 @@
 //! its elements may use one midpoint.
 
 use glam::DVec3;
-use radiosity_core::{Mesh, Patch};
+use radiosity_core::Mesh;
 
 use super::mesh_tables::MeshTables;
 use super::parallel::for_each_maybe_parallel;
@@ -57,30 +57,34 @@ pub(super) fn plan_entries(plans: &[PatchPlan]) -> usize {
 
 /// Plans every receiving patch of `mesh` for shooter patch `shooter`, into `plans` (one per
 /// patch). On the reference path only `live` and `touching` are set: every element then
-/// takes the plain path.
+/// takes the plain path. A patch that `shares` its group's visibility (see
+/// [`super::shared`]) gathers no candidates: the few rays its group traces go through the
+/// ray structure.
 pub(super) fn plan_patches(
     mesh: &Mesh,
     shooter: usize,
     tables: &MeshTables,
     reference_path: bool,
+    shares: impl Fn(usize) -> bool + Sync,
     plans: &mut [PatchPlan],
 ) {
-    let patch = &mesh.patches[shooter];
     for_each_maybe_parallel(plans, |q, plan| {
-        plan_patch(mesh, q, patch, q == shooter, tables, reference_path, plan);
+        plan_patch(mesh, q, shooter, tables, reference_path, shares(q), plan);
     });
 }
 
-/// Plans receiving patch `q` for `shooter` (`is_shooter` when they are the same patch).
+/// Plans receiving patch `q` for patch `shooter`.
 fn plan_patch(
     mesh: &Mesh,
     q: usize,
-    shooter: &Patch,
-    is_shooter: bool,
+    shooter: usize,
     tables: &MeshTables,
     reference_path: bool,
+    shares: bool,
     plan: &mut PatchPlan,
 ) {
+    let is_shooter = q == shooter;
+    let shooter = &mesh.patches[shooter];
     let corners = shooter.corners();
     let in_front =
         |pts: &[DVec3], c: DVec3, n: DVec3| pts.iter().any(|p| n.dot(*p - c) > 1e-12 * shooter.area.sqrt());
@@ -113,6 +117,11 @@ fn plan_patch(
     let patch_radius = r.corners().iter().map(|p| p.distance(r.centre)).fold(0.0, f64::max);
     plan.far = (MIDPOINT_RATIO + 1.0) * tables.patch_element_radius[q]
         < distance_to_polygon(r.centre, shooter.normal, corners) - patch_radius;
+    if shares {
+        plan.visibility = Visibility::Tree;
+        plan.candidates.clear();
+        return;
+    }
     plan.visibility = tables.blockers.gather(
         Pair { a: corners, na: shooter.normal, b: r.corners(), nb: r.normal, offset: tables.ray_offset },
         &mut plan.candidates,

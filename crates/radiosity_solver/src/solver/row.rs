@@ -17,6 +17,7 @@ use super::receive::{Received, receive_patch};
 use super::shot::Shot;
 use super::uneven::{Uneven, cluster_elements};
 use crate::sampling::{Rng, Strata};
+use crate::shaft::Visibility;
 
 /// One shooter's form factors F_{j→shooter} (visibility included) to the elements of every
 /// patch that can receive from it, as runs of consecutive elements.
@@ -41,11 +42,18 @@ impl Solver {
     pub(super) fn compute_row(&mut self, shooter: usize) -> Row {
         let mesh = Arc::clone(&self.mesh);
         let patch = &mesh.patches[shooter];
-        if self.rows.plans(shooter).is_none() {
-            plan_patches(&mesh, shooter, &self.tables, self.params.reference_path, &mut self.scratch.plans);
-        }
         let first_of_solve = self.progress.shots == 0;
         self.first_shots.freeze(&mesh, shooter, &self.tally, first_of_solve, self.params.bright_share);
+        let bright = self.first_shots.bright(shooter);
+        let shooter_radius = patch.corners().iter().map(|c| c.distance(patch.centre)).fold(0.0, f64::max);
+        let share = self.params.clustering && self.params.shared_visibility;
+        self.scratch.sharing.choose(&self.clusters, patch.centre, shooter_radius, bright, share, None);
+        if self.rows.plans(shooter).is_none() {
+            let (sharing, clusters) = (&self.scratch.sharing, &self.clusters);
+            let shares = |q: usize| sharing.shares(clusters, q);
+            let reference = self.params.reference_path;
+            plan_patches(&mesh, shooter, &self.tables, reference, shares, &mut self.scratch.plans);
+        }
         let scratch = &mut self.scratch;
         scratch.load_shooter(&mesh, patch, &self.tables.element_radii);
         let cdf = self.first_shots.cdf(&mesh, shooter);
@@ -68,7 +76,6 @@ impl Solver {
             cluster_elements(&scratch.shooter_elements, density, order, clusters);
         }
 
-        let bright = self.first_shots.bright(shooter);
         let (params, tables) = (&self.params, &self.tables);
         let shot = Shot {
             mesh: &mesh,
@@ -90,24 +97,26 @@ impl Solver {
             params,
             offset: tables.ray_offset,
             stream: shooter as u64,
-            shooter_radius: patch.corners().iter().map(|c| c.distance(patch.centre)).fold(0.0, f64::max),
+            shooter_radius,
             single_key: Rng::for_task(params.seed, shooter as u64, SINGLE_STREAM).next_u64(),
             pilot: Strata::new(if bright { params.visibility_rays } else { params.dim_rays }),
             facet_pilot: Strata::new(if bright { facet_rays(params) } else { params.dim_rays }),
-            facets: self.clusters.members(),
+            clusters: &self.clusters,
+            sharing: &scratch.sharing,
             patch_elements: &tables.patch_elements,
             penumbra: Strata::new(params.penumbra_rays),
         };
         let plans: &[PatchPlan] = self.rows.plans(shooter).unwrap_or(&scratch.plans);
         first_pass(&shot, plans, &mut scratch.factors);
+        let shared_rays = share_visibility(&shot, plans, &tables.element_area, &mut scratch.factors);
         if params.penumbra_rays > 0 && bright {
             penumbra_pass(&shot, plans, tables, &mut scratch.penumbra, &mut scratch.factors);
         }
         if shot.uneven.is_some() {
             keep_uneven_power(&tables.element_area, &tables.patch_elements, plans, &mut scratch.factors);
         }
-        let (row, rays) = gather(&tables.patch_elements, plans, &scratch.factors);
-        self.progress.rays += rays;
+        let (row, rays) = gather(&tables.patch_elements, plans, &scratch.factors, |q| shot.shares(q));
+        self.progress.rays += rays + shared_rays;
         row
     }
 }
@@ -163,7 +172,7 @@ fn first_pass(shot: &Shot, plans: &[PatchPlan], factors: &mut [Received]) {
         rest = after;
     }
     let receive_one = |q: usize, out: &mut &mut [Received]| {
-        receive_patch(shot, &plans[q], shot.patch_elements[q].start, out)
+        receive_patch(shot, &plans[q], q, shot.patch_elements[q].start, out)
     };
     if mesh.elements.len() < PARALLEL_MIN || rayon::current_num_threads() == 1 {
         slices.iter_mut().enumerate().for_each(|(q, out)| receive_one(q, out));
@@ -198,12 +207,43 @@ fn penumbra_pass(
     });
 }
 
+/// The facets of groups that share their visibility (see [`super::shared`]): each group's
+/// rays, from members drawn by area × unoccluded form factor, and every member's visibility
+/// theirs. Members that nothing can block keep their own (full) visibility and are not
+/// drawn. Returns the rays traced.
+fn share_visibility(shot: &Shot, plans: &[PatchPlan], element_area: &[f64], factors: &mut [Received]) -> u64 {
+    if !shot.sharing.any() {
+        return 0;
+    }
+    let mesh = shot.mesh;
+    let plan_of = |e: usize| &plans[mesh.elements[e].patch as usize];
+    let takes = |e: usize, r: &Received| r.unoccluded > 0.0 && plan_of(e).visibility != Visibility::Clear;
+    let first: &[Received] = factors;
+    let (seen, rays) = shot.sharing.trace(
+        shot.clusters,
+        mesh,
+        shot.params.seed,
+        shot.stream,
+        |e| if takes(e, &first[e]) { element_area[e] * first[e].unoccluded } else { 0.0 },
+        |e| trace(shot, plan_of(e), e, Rays::Pilot),
+    );
+    for_each_maybe_parallel(factors, |e, r| {
+        if let Some(g) = shot.sharing.group_of(shot.clusters, mesh.elements[e].patch as usize)
+            && takes(e, r)
+        {
+            (r.visible, r.traced) = seen[g];
+        }
+    });
+    rays
+}
+
 /// The row of the live patches' factors (those that receive anything), and the rays traced
-/// for them.
+/// for them (none counted for patches whose group `shares` its rays).
 fn gather(
     patch_elements: &[std::ops::Range<usize>],
     plans: &[PatchPlan],
     factors: &[Received],
+    shares: impl Fn(usize) -> bool,
 ) -> (Row, u64) {
     let mut row = Row { spans: Vec::new(), factors: Vec::new() };
     let mut rays = 0;
@@ -213,7 +253,9 @@ fn gather(
         }
         let range = patch_elements[q].clone();
         let factors = &factors[range.clone()];
-        rays += factors.iter().map(|r| u64::from(r.traced)).sum::<u64>();
+        if !shares(q) {
+            rays += factors.iter().map(|r| u64::from(r.traced)).sum::<u64>();
+        }
         // A patch that receives nothing (facing, but every ray blocked: the inside of a
         // model, a face in shadow) is left out: applying zeros changes no sum, and a model's
         // rows shrink by about half.

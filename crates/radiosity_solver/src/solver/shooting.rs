@@ -85,8 +85,7 @@ impl Solver {
         let (mesh, tables, params) = (&*self.mesh, &self.tables, &self.params);
         let first_power = self.first_shots.first_shot_power;
         self.clusters.freeze(g, mesh, &self.tally.unshot, tables, params, first_power);
-        let (row, rays) =
-            self.clusters.row(g, mesh, tables, &*self.accel, params, &mut self.scratch.group_factors);
+        let (row, rays) = self.clusters.row(g, mesh, tables, &*self.accel, params, &mut self.scratch);
         self.progress.rays += rays;
         row
     }

@@ -6,8 +6,10 @@ use radiosity_accel::RayQuery;
 use radiosity_core::{Mesh, Patch};
 
 use super::SolverParams;
+use super::clusters::Clusters;
 use super::plans::PatchPlan;
 use super::receive::Received;
+use super::shared::Sharing;
 use super::uneven::{Cluster, Uneven};
 use crate::form_factor::{point_to_point, point_to_polygon};
 use crate::occluders::OccluderBoxes;
@@ -92,17 +94,25 @@ pub(super) struct Shot<'a> {
     /// of what the eye sees and its noise is pooled with its neighbours' at their shared
     /// vertices.
     pub(super) facet_pilot: Strata,
-    /// Per patch, whether it is such a facet.
-    pub(super) facets: &'a [bool],
+    /// The shooter groups: which patches are such facets.
+    pub(super) clusters: &'a Clusters,
+    /// Which receiving groups share one visibility estimate (see [`super::shared`]).
+    pub(super) sharing: &'a Sharing,
     /// Per patch, its elements' range (see `MeshTables::patch_elements`).
     pub(super) patch_elements: &'a [std::ops::Range<usize>],
     pub(super) penumbra: Strata,
 }
 
 impl Shot<'_> {
+    /// Whether patch `q`'s elements take their group's shared visibility instead of rays
+    /// of their own.
+    pub(super) fn shares(&self, q: usize) -> bool {
+        self.sharing.shares(self.clusters, q)
+    }
+
     /// The pilot-ray strata of element `e`'s patch.
     pub(super) fn pilot_for(&self, e: usize) -> Strata {
-        if self.facets.get(self.mesh.elements[e].patch as usize).copied().unwrap_or(false) {
+        if self.clusters.members()[self.mesh.elements[e].patch as usize] {
             self.facet_pilot
         } else {
             self.pilot
@@ -130,6 +140,8 @@ pub(super) struct ShotScratch {
     pub(super) cluster_order: Vec<u32>,
     /// Per element, its form factor to the shooting group of facets (see [`super::clusters`]).
     pub(super) group_factors: Vec<f32>,
+    /// Which receiving groups share their visibility in this shot.
+    pub(super) sharing: Sharing,
 }
 
 impl ShotScratch {
@@ -146,6 +158,7 @@ impl ShotScratch {
             clusters: Vec::new(),
             cluster_order: Vec::new(),
             group_factors: Vec::new(),
+            sharing: Sharing::default(),
         }
     }
 

@@ -1,0 +1,146 @@
+//! Receiving groups: far from a dim shooter, the facets of a shooter group share one
+//! visibility estimate instead of tracing a ray each.
+//!
+//! A row's cost was one ray per receiving element, and a tessellated model's facets are most
+//! of the elements: on a 120 k-triangle room 84 % of a row's rays went to them, and past
+//! that size every row is traced again at each shot because the rows no longer fit their
+//! cache. Light from a dim shooter (indirect light) changes slowly across a small group far
+//! away, so the group traces [`SHARED_RAYS`] rays from members drawn by their share of the
+//! row's power (area × unoccluded form factor) and every member takes their unblocked
+//! fraction. That fraction is an unbiased estimate of the group's power-weighted visibility,
+//! Σ_k A_k F_k V_k / Σ_k A_k F_k, so what the group receives in all is kept; what is lost is
+//! the variation of the dim light's visibility inside one group. Bright shooters (the lamps
+//! and what they light first) and near ones keep a ray per element, as do groups too small
+//! to gain: their shadows are the ones the eye reads. This is the receiving half of
+//! clustering (Smits, Arvo & Greenberg 1994 link a far cluster as one receiver; Sillion
+//! 1995 estimates a cluster's visibility from a few rays), with the irradiance still pushed
+//! to each facet through its own unoccluded form factor.
+
+use rayon::prelude::*;
+
+use super::clusters::Clusters;
+use crate::sampling::Rng;
+use glam::DVec3;
+use radiosity_core::Mesh;
+
+/// A receiving group shares its visibility when its centre is at least this many times the
+/// sum of its radius and the shooter's away from the shooter's centre.
+const SHARE_DISTANCE: f64 = 2.5;
+
+/// Rays a sharing group traces (from members drawn by power, stratified).
+pub(super) const SHARED_RAYS: u32 = 16;
+
+/// Random streams of the draws are keyed apart from elements' and groups' own.
+const SHARED_STREAM: u64 = 0x7368_6172_6564_0000;
+
+/// Which receiving groups share their visibility in one row.
+#[derive(Default)]
+pub(super) struct Sharing {
+    /// Per group, whether it shares.
+    groups: Vec<bool>,
+}
+
+/// Per group, (unblocked, traced) of its shared rays; (0, 0) when it does not share or
+/// nothing of it receives.
+pub(super) type Seen = Vec<(u32, u32)>;
+
+impl Sharing {
+    /// Chooses the sharing groups for a shooter centred at `centre` with circumradius
+    /// `radius`: none when it is `bright` or when sharing is off, else those at least
+    /// [`SHARE_DISTANCE`] radii away with more members than [`SHARED_RAYS`]; `shooter_group`
+    /// is the shooting group, which never shares (its members receive from each other up
+    /// close).
+    pub(super) fn choose(
+        &mut self,
+        clusters: &Clusters,
+        centre: DVec3,
+        radius: f64,
+        bright: bool,
+        enabled: bool,
+        shooter_group: Option<usize>,
+    ) {
+        self.groups.clear();
+        self.groups.extend((0..clusters.len()).map(|g| {
+            let group = clusters.group(g);
+            enabled
+                && !bright
+                && Some(g) != shooter_group
+                && group.patches.len() > SHARED_RAYS as usize
+                && group.centre.distance(centre) > SHARE_DISTANCE * (group.radius + radius)
+        }));
+    }
+
+    /// Whether any group shares.
+    pub(super) fn any(&self) -> bool {
+        self.groups.iter().any(|&s| s)
+    }
+
+    /// Whether patch `q`'s elements take their group's shared visibility.
+    pub(super) fn shares(&self, clusters: &Clusters, q: usize) -> bool {
+        self.group_of(clusters, q).is_some()
+    }
+
+    /// Patch `q`'s group, when it shares.
+    pub(super) fn group_of(&self, clusters: &Clusters, q: usize) -> Option<usize> {
+        clusters.group_of(q).filter(|&g| self.groups[g])
+    }
+
+    /// Traces each sharing group's rays: [`SHARED_RAYS`] members' elements drawn by
+    /// `weight(e)` (area × unoccluded form factor), stratified, and `ray(e)` the
+    /// (unblocked, traced) of element `e`'s own first ray (drawn twice, the same ray).
+    /// Returns what each group saw and the rays traced. Each group draws from its own
+    /// stream, so the threads change nothing.
+    pub(super) fn trace(
+        &self,
+        clusters: &Clusters,
+        mesh: &Mesh,
+        seed: u64,
+        stream: u64,
+        weight: impl Fn(usize) -> f64 + Sync,
+        ray: impl Fn(usize) -> (u32, u32) + Sync,
+    ) -> (Seen, u64) {
+        let groups = &self.groups;
+        let one = |g: usize| -> (u32, u32) {
+            if !groups[g] {
+                return (0, 0);
+            }
+            let elements = || {
+                clusters.group(g).patches.iter().flat_map(|&q| {
+                    let r = &mesh.patches[q as usize].elements;
+                    r.start as usize..r.end as usize
+                })
+            };
+            let total: f64 = elements().map(&weight).sum();
+            if !(total > 0.0 && total.is_finite()) {
+                return (0, 0);
+            }
+            let mut rng = Rng::for_task(seed, stream ^ SHARED_STREAM, g as u64);
+            let (mut visible, mut traced) = (0, 0);
+            let (mut walked, mut draws) = (0.0, elements().peekable());
+            let mut current = draws.next();
+            for j in 0..SHARED_RAYS {
+                // Stratified over the cumulative weights: the j-th draw lands in the
+                // j-th slice of the group's power.
+                let t = (f64::from(j) + rng.next_f64()) / f64::from(SHARED_RAYS) * total;
+                while let Some(e) = current {
+                    let w = weight(e);
+                    if walked + w >= t || draws.peek().is_none() {
+                        break;
+                    }
+                    walked += w;
+                    current = draws.next();
+                }
+                let Some(e) = current else { break };
+                let (v, n) = ray(e);
+                // No ray needed (nothing can block it): one unblocked.
+                let (v, n) = if n == 0 { (1, 1) } else { (v, n) };
+                visible += v;
+                traced += n;
+            }
+            (visible, traced)
+        };
+        let seen: Seen = (0..groups.len()).into_par_iter().map(one).collect();
+        let rays = seen.iter().map(|&(_, n)| u64::from(n)).sum();
+        (seen, rays)
+    }
+}
