@@ -371,12 +371,11 @@ impl Clusters {
                 }
             });
         }
-        let mut row = Row { spans: Vec::new(), factors: Vec::new() };
+        let mut row = Row::new();
         for range in &tables.patch_elements {
             let span = &factors[range.clone()];
             if span.iter().any(|&f| f > 0.0) {
-                row.spans.push((range.start as u32, range.len() as u32));
-                row.factors.extend_from_slice(span);
+                row.push(range.clone(), span.iter().copied());
             }
         }
         (row, traced)

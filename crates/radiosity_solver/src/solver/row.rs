@@ -22,14 +22,36 @@ use crate::shaft::Visibility;
 /// One shooter's form factors F_{j→shooter} (visibility included) to the elements of every
 /// patch that can receive from it, as runs of consecutive elements.
 pub(super) struct Row {
-    /// `(first element, element count)` of each receiving patch, in patch order.
+    /// `(first element, element count)` of each run of whole consecutive receiving patches
+    /// (at most [`MAX_RUN`] elements unless one patch has more), in element order. A model's
+    /// facets are one-element patches: a span each took twice the memory of their factors.
     pub(super) spans: Vec<(u32, u32)>,
     /// The factors, span after span, in f32 (7 digits, far below the visibility noise); a
     /// row applied fresh is rounded the same way, so keeping it changes nothing.
     pub(super) factors: Vec<f32>,
 }
 
+/// Receiving patches merge into one span up to this many elements, so that a shot's
+/// chunks of spans (see `Tally::shoot`) stay small enough to share among threads.
+const MAX_RUN: u32 = 1024;
+
 impl Row {
+    /// An empty row.
+    pub(super) fn new() -> Self {
+        Self { spans: Vec::new(), factors: Vec::new() }
+    }
+
+    /// Appends the factors of a receiving patch whose elements are `elements` (after those
+    /// of the patches pushed before it), merging it into the last span when it follows it.
+    pub(super) fn push(&mut self, elements: std::ops::Range<usize>, factors: impl IntoIterator<Item = f32>) {
+        let (first, count) = (elements.start as u32, elements.len() as u32);
+        match self.spans.last_mut() {
+            Some((start, n)) if *start + *n == first && *n + count <= MAX_RUN => *n += count,
+            _ => self.spans.push((first, count)),
+        }
+        self.factors.extend(factors);
+    }
+
     /// Heap and inline bytes the row holds.
     pub(super) fn bytes(&self) -> usize {
         std::mem::size_of::<Self>() + 8 * self.spans.len() + 4 * self.factors.len()
@@ -245,7 +267,7 @@ fn gather(
     factors: &[Received],
     shares: impl Fn(usize) -> bool,
 ) -> (Row, u64) {
-    let mut row = Row { spans: Vec::new(), factors: Vec::new() };
+    let mut row = Row::new();
     let mut rays = 0;
     for (q, plan) in plans.iter().enumerate() {
         if !plan.live {
@@ -262,8 +284,7 @@ fn gather(
         if factors.iter().all(|r| r.factor() as f32 == 0.0) {
             continue;
         }
-        row.spans.push((range.start as u32, range.len() as u32));
-        row.factors.extend(factors.iter().map(|r| r.factor() as f32));
+        row.push(range, factors.iter().map(|r| r.factor() as f32));
     }
     (row, rays)
 }

@@ -68,15 +68,34 @@ pub(super) const RESUM: u32 = 256;
 /// Below this many elements a shot is applied on one thread (a parallel pass costs more).
 const APPLY_PARALLEL_MIN: usize = 32_768;
 
-/// Consecutive receiving spans of one shot with their factors and their elements' radiosity,
-/// unshot radiosity and Σ F·A per span.
-type Chunk<'a> = (&'a [(u32, u32)], &'a [f32], &'a mut [Rgb], &'a mut [Rgb], &'a mut [f64]);
+/// Consecutive receiving spans of one shot with their factors and their elements' radiosity
+/// and unshot radiosity, and the (patch, Σ F·A) of each patch they cover, filled in order.
+type Chunk<'a> = (&'a [(u32, u32)], &'a [f32], &'a mut [Rgb], &'a mut [Rgb], Vec<(u32, f64)>);
 
 /// A shot is applied in about this many chunks of consecutive receiving spans...
 const CHUNKS: usize = 256;
 
 /// ... of at least this many spans each.
 const MIN_SPANS_PER_CHUNK: usize = 16;
+
+/// Calls `f(patch, its elements)` for every patch the row's `spans` cover, in order (a span
+/// is whole consecutive patches).
+fn for_each_patch(
+    mesh: &Mesh,
+    tables: &MeshTables,
+    spans: &[(u32, u32)],
+    mut f: impl FnMut(usize, std::ops::Range<usize>),
+) {
+    for &(first, count) in spans {
+        let (mut e, end) = (first as usize, first as usize + count as usize);
+        while e < end {
+            let patch = mesh.elements[e].patch as usize;
+            let next = tables.patch_elements[patch].end.min(end);
+            f(patch, e..next);
+            e = next;
+        }
+    }
+}
 
 impl Tally {
     /// Shot 0: B = E and ΔB = E on every element.
@@ -159,16 +178,14 @@ impl Tally {
             self.patch_unshot_power[q as usize] *= 1.0 - omega;
             self.changed(q as usize);
         }
-        // Each receiving span (one patch, of one reflectance) takes ρ × the shot's radiosity
-        // times F per element, and its Σ F·A; spans own disjoint elements, so they may run
-        // in parallel, in chunks of consecutive spans (a model's facets are a span each: one
-        // task per span cost more than the arithmetic). The sums over spans then run in span
-        // order: the same numbers for any thread count.
-        let mut seen = vec![0.0; row.spans.len()];
+        // Each receiving span (whole consecutive patches, see `Row`) takes, patch by patch,
+        // ρ × the shot's radiosity times F per element, and each patch its Σ F·A; spans own
+        // disjoint elements, so they may run in parallel, in chunks of consecutive spans
+        // (one task per span cost more than the arithmetic). The sums over patches then run
+        // in span order: the same numbers for any thread count.
         let per_chunk = (row.spans.len() / CHUNKS).max(MIN_SPANS_PER_CHUNK);
-        let mut chunks = Vec::with_capacity(row.spans.len().div_ceil(per_chunk));
-        let (mut radiosity, mut unshot, mut seen_rest) =
-            (&mut self.radiosity[..], &mut self.unshot[..], &mut seen[..]);
+        let mut chunks: Vec<Chunk> = Vec::with_capacity(row.spans.len().div_ceil(per_chunk));
+        let (mut radiosity, mut unshot) = (&mut self.radiosity[..], &mut self.unshot[..]);
         let (mut at, mut offset) = (0, 0);
         for spans in row.spans.chunks(per_chunk) {
             let first = spans[0].0 as usize;
@@ -176,40 +193,39 @@ impl Tally {
             let end = last as usize + count as usize;
             let (r, rest_r) = std::mem::take(&mut radiosity)[first - at..].split_at_mut(end - first);
             let (u, rest_u) = std::mem::take(&mut unshot)[first - at..].split_at_mut(end - first);
-            let (s, rest_s) = std::mem::take(&mut seen_rest).split_at_mut(spans.len());
-            (radiosity, unshot, seen_rest, at) = (rest_r, rest_u, rest_s, end);
+            (radiosity, unshot, at) = (rest_r, rest_u, end);
             let factors: usize = spans.iter().map(|&(_, c)| c as usize).sum();
-            chunks.push((spans, &row.factors[offset..offset + factors], r, u, s));
+            chunks.push((spans, &row.factors[offset..offset + factors], r, u, Vec::new()));
             offset += factors;
         }
         let receive = |(spans, factors, radiosity, unshot, seen): &mut Chunk| {
             let base = spans[0].0 as usize;
             let mut offset = 0;
-            for (&(first, count), seen) in spans.iter().zip(seen.iter_mut()) {
-                let (first, count) = (first as usize, count as usize);
-                let per_factor = tables.patch_reflectance[mesh.elements[first].patch as usize] * shot_b;
-                let area = &tables.element_area[first..first + count];
-                let local = first - base;
+            for_each_patch(mesh, tables, spans, |patch, elements| {
+                let per_factor = tables.patch_reflectance[patch] * shot_b;
+                let area = &tables.element_area[elements.clone()];
+                let local = elements.start - base;
                 let mut sum = 0.0;
-                for k in 0..count {
+                for k in 0..elements.len() {
                     let f = f64::from(factors[offset + k]);
                     let reflected = per_factor * f; // ρ × irradiance from this shot, W/unit²
                     radiosity[local + k] += reflected;
                     unshot[local + k] += reflected;
                     sum += f * area[k];
                 }
-                *seen = sum;
-                offset += count;
-            }
+                seen.push((patch as u32, sum));
+                offset += elements.len();
+            });
         };
         if mesh.elements.len() < APPLY_PARALLEL_MIN || rayon::current_num_threads() == 1 {
             chunks.iter_mut().for_each(receive);
         } else {
             chunks.par_iter_mut().for_each(receive);
         }
+        let seen: Vec<Vec<(u32, f64)>> = chunks.into_iter().map(|c| c.4).collect();
         let mut received = Rgb::ZERO;
-        for (&(first, _), seen) in row.spans.iter().zip(seen) {
-            let patch = mesh.elements[first as usize].patch as usize;
+        for &(patch, seen) in seen.iter().flatten() {
+            let patch = patch as usize;
             let gained = tables.patch_reflectance[patch] * shot_b * seen;
             let span_received = shot_b * seen;
             received += span_received;
@@ -234,14 +250,14 @@ impl Tally {
             self.patch_unshot_emission[q as usize] *= 1.0 - omega;
         }
         let mut offset = 0;
-        for &(first, count) in &row.spans {
-            let (first, count) = (first as usize, count as usize);
-            let per_factor = tables.patch_reflectance[mesh.elements[first].patch as usize] * shot_e;
-            for (k, f) in row.factors[offset..offset + count].iter().enumerate() {
-                self.direct[first + k] += per_factor * f64::from(*f);
+        for_each_patch(mesh, tables, &row.spans, |patch, elements| {
+            let per_factor = tables.patch_reflectance[patch] * shot_e;
+            let factors = &row.factors[offset..offset + elements.len()];
+            for (direct, f) in self.direct[elements.clone()].iter_mut().zip(factors) {
+                *direct += per_factor * f64::from(*f);
             }
-            offset += count;
-        }
+            offset += elements.len();
+        });
     }
 
     /// Power bookkeeping, with the unshot power summed fresh from the elements.
