@@ -140,7 +140,7 @@ pub struct SolveOpts {
     /// count; false: every facet shoots on its own.
     #[arg(long, value_name = "true|false", default_value_t = SolverParams::default().clustering, action = clap::ArgAction::Set)]
     pub clusters: bool,
-    /// Let the facets of a group far from a dim shooter share one visibility estimate of a
+    /// Let the facets of a group far from a shooter that does not emit share one visibility estimate of a
     /// few rays instead of a ray each (needs `--clusters true`); false: a ray per facet.
     #[arg(long, value_name = "true|false", default_value_t = SolverParams::default().shared_visibility, action = clap::ArgAction::Set)]
     pub shared_visibility: bool,

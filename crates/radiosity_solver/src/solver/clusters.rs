@@ -316,7 +316,11 @@ impl Clusters {
         let group = &self.groups[g];
         let frozen = group.frozen.as_ref().expect("a group is frozen before its row is computed");
         let share = params.clustering && params.shared_visibility;
-        scratch.sharing.choose(self, group.centre, group.radius, frozen.bright, share, Some(g));
+        let emits = (group.patches.iter()).any(|&q| {
+            mesh.element_material(mesh.patches[q as usize].elements.start as usize).emission.max_channel()
+                > 0.0
+        });
+        scratch.sharing.choose(self, group.centre, group.radius, emits, share, Some(g));
         let (sharing, factors) = (&scratch.sharing, &mut scratch.group_factors);
         let stream = GROUP_STREAM ^ g as u64;
         let aim = Aim {

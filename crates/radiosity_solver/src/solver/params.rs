@@ -104,7 +104,7 @@ pub struct SolverParams {
     /// solver's `clusters` module): the shots then follow the scene's extent, not its
     /// triangle count. Scenes of polygons and spheres have no such facets. Default true.
     pub clustering: bool,
-    /// Far from a dim shooter, the facets of a group share one visibility estimate of
+    /// Far from a shooter that does not emit, the facets of a group share one visibility estimate of
     /// `SHARED_RAYS` rays instead of a ray each (see the solver's `shared` module): a row's
     /// rays then follow the groups, not the facets. Needs `clustering`. Default true.
     pub shared_visibility: bool,

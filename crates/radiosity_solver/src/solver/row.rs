@@ -69,7 +69,8 @@ impl Solver {
         let bright = self.first_shots.bright(shooter);
         let shooter_radius = patch.corners().iter().map(|c| c.distance(patch.centre)).fold(0.0, f64::max);
         let share = self.params.clustering && self.params.shared_visibility;
-        self.scratch.sharing.choose(&self.clusters, patch.centre, shooter_radius, bright, share, None);
+        let emits = mesh.element_material(patch.elements.start as usize).emission.max_channel() > 0.0;
+        self.scratch.sharing.choose(&self.clusters, patch.centre, shooter_radius, emits, share, None);
         if self.rows.plans(shooter).is_none() {
             let (sharing, clusters) = (&self.scratch.sharing, &self.clusters);
             let shares = |q: usize| sharing.shares(clusters, q);
