@@ -67,6 +67,8 @@ pub(super) struct Clusters {
     of_patch: Vec<u32>,
     /// Per patch, whether it is in a group.
     members: Vec<bool>,
+    /// Per element of a group's patch, its place in the group's `elements`.
+    slot: Vec<u32>,
     /// The groups, in order of their first member.
     groups: Vec<Group>,
     /// Per group, Σ |unshot power| over its members, kept up to date by [`Clusters::update`].
@@ -81,6 +83,12 @@ pub(super) struct Clusters {
 pub(super) struct Group {
     /// Its patches, in index order.
     pub(super) patches: Vec<u32>,
+    /// Their elements, in the same order.
+    pub(super) elements: Vec<u32>,
+    /// Per element, its vertex mean (its one quadrature point far away, as
+    /// `MeshTables::vertex_means`) and its normal: a group is received whole, and these
+    /// read from the mesh's scattered elements were most of that time.
+    pub(super) receivers: Vec<(DVec3, DVec3)>,
     /// Σ of their areas.
     pub(super) area: f64,
     /// Area-weighted centroid.
@@ -159,15 +167,29 @@ impl Clusters {
                     .flat_map(|&q| mesh.patches[q as usize].corners().iter())
                     .map(|c| c.distance(centre))
                     .fold(0.0, f64::max);
+                let mut elements = Vec::new();
                 for &q in &patches {
                     of_patch[q as usize] = groups.len() as u32;
+                    elements.extend(mesh.patches[q as usize].elements.clone());
                 }
-                groups.push(Group { patches, area, centre, radius, frozen: None });
+                let receivers = (elements.iter())
+                    .map(|&e| {
+                        let (e, el) = (e as usize, &mesh.elements[e as usize]);
+                        (mesh.element_corners(e).sum::<DVec3>() / f64::from(el.vertex_count), el.normal)
+                    })
+                    .collect();
+                groups.push(Group { patches, elements, receivers, area, centre, radius, frozen: None });
             }
         }
         let members = of_patch.iter().map(|&g| g != NONE).collect();
+        let mut slot = vec![NONE; mesh.elements.len()];
+        for group in &groups {
+            for (k, &e) in group.elements.iter().enumerate() {
+                slot[e as usize] = k as u32;
+            }
+        }
         let singles = (0..of_patch.len() as u32).filter(|&q| of_patch[q as usize] == NONE).collect();
-        Self { of_patch, members, power: vec![0.0; groups.len()], singles, since_sum: 0, groups }
+        Self { of_patch, members, slot, power: vec![0.0; groups.len()], singles, since_sum: 0, groups }
     }
 
     /// Per patch, whether it is in a group.
@@ -179,6 +201,11 @@ impl Clusters {
     pub(super) fn group_of(&self, q: usize) -> Option<usize> {
         let g = self.of_patch[q];
         (g != NONE).then_some(g as usize)
+    }
+
+    /// Element `e`'s place in its group's `elements` (meaningless for elements in no group).
+    pub(super) fn slot(&self, e: usize) -> usize {
+        self.slot[e] as usize
     }
 
     /// Number of groups.
@@ -336,14 +363,17 @@ impl Clusters {
         factors.resize(mesh.elements.len(), 0.0);
         // Rays traced, for the progress figures (an integer sum: the same in any order).
         let traced = AtomicU64::new(0);
-        // Without visibility for the elements of sharing groups, with it for the others.
+        // Elements in no sharing group, with their own rays; the sharing groups' below.
         for_each_maybe_parallel(factors, |e, out| {
             let el = &mesh.elements[e];
+            if sharing.shares(self, el.patch as usize) {
+                return;
+            }
             let mut shares = [0.0; POINTS];
             let (f, near) =
                 unoccluded(group, frozen, tables.vertex_means[e], el.normal, el.patch, &mut shares);
             *out = f as f32;
-            if f > 0.0 && !sharing.shares(self, el.patch as usize) {
+            if f > 0.0 {
                 let (visible, n) = aim.trace(e, f, near, &shares);
                 *out = if n == 0 { f as f32 } else { (f * f64::from(visible) / f64::from(n)) as f32 };
                 traced.fetch_add(u64::from(n), Ordering::Relaxed);
@@ -351,27 +381,34 @@ impl Clusters {
         });
         let mut traced = traced.into_inner();
         if sharing.any() {
-            let first: &[f32] = factors;
-            let (seen, rays) = sharing.trace(
+            let unoccluded_at = |e: usize, shares: &mut [f64; POINTS]| {
+                let el = &mesh.elements[e];
+                unoccluded(group, frozen, tables.vertex_means[e], el.normal, el.patch, shares)
+            };
+
+            let (received, rays) = sharing.receive(
                 self,
-                mesh,
-                params.seed,
-                stream,
-                |e| tables.element_area[e] * f64::from(first[e]),
+                &tables.element_area,
+                (params.seed, stream),
+                // Another group's members: none is a patch of the shooting group.
+                |r| {
+                    let receivers = &self.groups[r].receivers;
+                    receivers
+                        .iter()
+                        .map(|&(p, n)| unoccluded(group, frozen, p, n, NONE, &mut [0.0; POINTS]).0)
+                        .collect()
+                },
                 |e| {
-                    let el = &mesh.elements[e];
                     let mut shares = [0.0; POINTS];
-                    let (f, near) =
-                        unoccluded(group, frozen, tables.vertex_means[e], el.normal, el.patch, &mut shares);
+                    let (f, near) = unoccluded_at(e, &mut shares);
                     aim.trace(e, f, near, &shares)
                 },
             );
             traced += rays;
             for_each_maybe_parallel(factors, |e, out| {
-                if let Some(g) = sharing.group_of(self, mesh.elements[e].patch as usize)
-                    && seen[g].1 > 0
-                {
-                    *out = (f64::from(*out) * f64::from(seen[g].0) / f64::from(seen[g].1)) as f32;
+                if let Some(g) = sharing.group_of(self, mesh.elements[e].patch as usize) {
+                    let r = &received[g];
+                    *out = (r.factors[self.slot(e)] * r.visibility()) as f32;
                 }
             });
         }

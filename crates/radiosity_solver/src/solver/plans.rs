@@ -58,8 +58,8 @@ pub(super) fn plan_entries(plans: &[PatchPlan]) -> usize {
 /// Plans every receiving patch of `mesh` for shooter patch `shooter`, into `plans` (one per
 /// patch). On the reference path only `live` and `touching` are set: every element then
 /// takes the plain path. A patch that `shares` its group's visibility (see
-/// [`super::shared`]) gathers no candidates: the few rays its group traces go through the
-/// ray structure.
+/// [`super::shared`]) is only marked live: its group is received whole, and the few rays it
+/// traces go through the ray structure.
 pub(super) fn plan_patches(
     mesh: &Mesh,
     shooter: usize,
@@ -83,6 +83,10 @@ fn plan_patch(
     shares: bool,
     plan: &mut PatchPlan,
 ) {
+    if shares && !reference_path {
+        *plan = PatchPlan { live: true, facing: true, far: true, ..PatchPlan::default() };
+        return;
+    }
     let is_shooter = q == shooter;
     let shooter = &mesh.patches[shooter];
     let corners = shooter.corners();
@@ -117,11 +121,6 @@ fn plan_patch(
     let patch_radius = r.corners().iter().map(|p| p.distance(r.centre)).fold(0.0, f64::max);
     plan.far = (MIDPOINT_RATIO + 1.0) * tables.patch_element_radius[q]
         < distance_to_polygon(r.centre, shooter.normal, corners) - patch_radius;
-    if shares {
-        plan.visibility = Visibility::Tree;
-        plan.candidates.clear();
-        return;
-    }
     plan.visibility = tables.blockers.gather(
         Pair { a: corners, na: shooter.normal, b: r.corners(), nb: r.normal, offset: tables.ray_offset },
         &mut plan.candidates,

@@ -127,16 +127,16 @@ fn unoccluded(shot: &Shot, plan: &PatchPlan, e: usize) -> (f64, f64) {
 }
 
 /// The first pass for the elements of receiving patch `q` (`first` is its first element,
-/// `out` its slice): their unoccluded form factors, then their pilot rays (none when its
-/// group shares its visibility: see [`super::shared`]).
+/// `out` its slice): their unoccluded form factors, then their pilot rays (nothing when its
+/// group shares its visibility: the group is received whole, see `row::receive_shared`).
 #[inline]
 pub(super) fn receive_patch(shot: &Shot, plan: &PatchPlan, q: usize, first: usize, out: &mut [Received]) {
     out.fill(Received::default());
-    if !plan.live {
+    if !plan.live || shot.shares(q) {
         return;
     }
     unoccluded_factors(shot, plan, first, out);
-    if plan.visibility == Visibility::Clear || shot.shares(q) {
+    if plan.visibility == Visibility::Clear {
         return;
     }
     if shot.pilot_for(first).count() == 1 && plan.visibility == Visibility::Few {

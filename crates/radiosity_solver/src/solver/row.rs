@@ -16,8 +16,8 @@ use super::rays::{Rays, SINGLE_STREAM, trace};
 use super::receive::{Received, receive_patch};
 use super::shot::Shot;
 use super::uneven::{Uneven, cluster_elements};
+use crate::form_factor::{point_to_polygon, points_to_polygon_in_front_x4};
 use crate::sampling::{Rng, Strata};
-use crate::shaft::Visibility;
 
 /// One shooter's form factors F_{j→shooter} (visibility included) to the elements of every
 /// patch that can receive from it, as runs of consecutive elements.
@@ -131,7 +131,7 @@ impl Solver {
         };
         let plans: &[PatchPlan] = self.rows.plans(shooter).unwrap_or(&scratch.plans);
         first_pass(&shot, plans, &mut scratch.factors);
-        let shared_rays = share_visibility(&shot, plans, &tables.element_area, &mut scratch.factors);
+        let shared_rays = receive_shared(&shot, plans, &tables.element_area, &mut scratch.factors);
         if params.penumbra_rays > 0 && bright {
             penumbra_pass(&shot, plans, tables, &mut scratch.penumbra, &mut scratch.factors);
         }
@@ -221,8 +221,10 @@ fn penumbra_pass(
     });
     let flags: &[bool] = flags;
     for_each_maybe_parallel(factors, |e, out| {
-        if flags[e] {
-            let plan = &plans[shot.mesh.elements[e].patch as usize];
+        // A sharing group's members take its visibility, not rays of their own.
+        let patch = shot.mesh.elements[e].patch as usize;
+        if flags[e] && !shot.shares(patch) {
+            let plan = &plans[patch];
             let (visible, traced) = trace(shot, plan, e, Rays::Penumbra);
             out.visible += visible;
             out.traced += traced;
@@ -230,31 +232,65 @@ fn penumbra_pass(
     });
 }
 
-/// The facets of groups that share their visibility (see [`super::shared`]): each group's
-/// rays, from members drawn by area × unoccluded form factor, and every member's visibility
-/// theirs. Members that nothing can block keep their own (full) visibility and are not
-/// drawn. Returns the rays traced.
-fn share_visibility(shot: &Shot, plans: &[PatchPlan], element_area: &[f64], factors: &mut [Received]) -> u64 {
+/// The facets of groups that share their visibility (see [`super::shared`]), received group
+/// by group: each member's unoccluded form factor (its vertex mean, one point: the group is
+/// far), four members at a time where they strictly face the shooter, clipped one by one
+/// where they straddle each other's planes, none behind the shooter; then the group's rays,
+/// and every member's visibility theirs. Returns the rays traced.
+fn receive_shared(shot: &Shot, plans: &[PatchPlan], element_area: &[f64], factors: &mut [Received]) -> u64 {
     if !shot.sharing.any() {
         return 0;
     }
-    let mesh = shot.mesh;
+    let Shot { mesh, shooter, clusters, sharing, .. } = *shot;
+    let corners = shooter.corners();
+    let factors_of = |g: usize| -> Vec<f64> {
+        let receivers = &clusters.group(g).receivers;
+        let mut out = vec![0.0; receivers.len()];
+        // Strictly facing members, batched four at a time.
+        let (mut batch, mut n) = ([0usize; 4], 0);
+        let flush = |batch: &[usize; 4], n: usize, out: &mut [f64]| {
+            let (mut points, mut normals) = ([glam::DVec3::ZERO; 4], [glam::DVec3::ZERO; 4]);
+            for k in 0..n {
+                (points[k], normals[k]) = receivers[batch[k]];
+            }
+            let f = points_to_polygon_in_front_x4(&points, &normals, n, corners);
+            for k in 0..n {
+                out[batch[k]] = f[k].max(0.0);
+            }
+        };
+        let tolerance = 1e-9 * shooter.area.sqrt();
+        for (k, &(p, normal)) in receivers.iter().enumerate() {
+            let ahead = shooter.normal.dot(p - corners[0]);
+            if ahead <= 0.0 {
+                continue;
+            }
+            let facing = corners.iter().map(|c| normal.dot(*c - p)).fold(f64::INFINITY, f64::min);
+            if facing > tolerance && ahead > tolerance {
+                batch[n] = k;
+                n += 1;
+                if n == 4 {
+                    flush(&batch, n, &mut out);
+                    n = 0;
+                }
+            } else {
+                out[k] = point_to_polygon(p, normal, corners);
+            }
+        }
+        if n > 0 {
+            flush(&batch, n, &mut out);
+        }
+        out
+    };
     let plan_of = |e: usize| &plans[mesh.elements[e].patch as usize];
-    let takes = |e: usize, r: &Received| r.unoccluded > 0.0 && plan_of(e).visibility != Visibility::Clear;
-    let first: &[Received] = factors;
-    let (seen, rays) = shot.sharing.trace(
-        shot.clusters,
-        mesh,
-        shot.params.seed,
-        shot.stream,
-        |e| if takes(e, &first[e]) { element_area[e] * first[e].unoccluded } else { 0.0 },
-        |e| trace(shot, plan_of(e), e, Rays::Pilot),
-    );
+    let (received, rays) =
+        sharing.receive(clusters, element_area, (shot.params.seed, shot.stream), factors_of, |e| {
+            trace(shot, plan_of(e), e, Rays::Pilot)
+        });
     for_each_maybe_parallel(factors, |e, r| {
-        if let Some(g) = shot.sharing.group_of(shot.clusters, mesh.elements[e].patch as usize)
-            && takes(e, r)
-        {
-            (r.visible, r.traced) = seen[g];
+        if let Some(g) = sharing.group_of(clusters, mesh.elements[e].patch as usize) {
+            let f = received[g].factors[clusters.slot(e)];
+            (r.unoccluded, r.unweighted) = (f, f);
+            (r.visible, r.traced) = if f > 0.0 { received[g].seen } else { (0, 0) };
         }
     });
     rays

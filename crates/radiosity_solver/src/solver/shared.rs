@@ -24,7 +24,6 @@ use rayon::prelude::*;
 use super::clusters::Clusters;
 use crate::sampling::Rng;
 use glam::DVec3;
-use radiosity_core::Mesh;
 
 /// A receiving group shares its visibility when its centre is at least this many times the
 /// sum of its radius and the shooter's away from the shooter's centre.
@@ -43,9 +42,21 @@ pub(super) struct Sharing {
     groups: Vec<bool>,
 }
 
-/// Per group, (unblocked, traced) of its shared rays; (0, 0) when it does not share or
-/// nothing of it receives.
-pub(super) type Seen = Vec<(u32, u32)>;
+/// What one sharing group received from a shot.
+#[derive(Default)]
+pub(super) struct Received {
+    /// Its member elements' unoccluded form factors, in the group's element order.
+    pub(super) factors: Vec<f64>,
+    /// (unblocked, traced) of its shared rays; (0, 0) when nothing of it receives.
+    pub(super) seen: (u32, u32),
+}
+
+impl Received {
+    /// The fraction of its rays that were unblocked (1 when it traced none).
+    pub(super) fn visibility(&self) -> f64 {
+        if self.seen.1 == 0 { 1.0 } else { f64::from(self.seen.0) / f64::from(self.seen.1) }
+    }
+}
 
 impl Sharing {
     /// Chooses the sharing groups for a shooter centred at `centre` with circumradius
@@ -88,62 +99,52 @@ impl Sharing {
         clusters.group_of(q).filter(|&g| self.groups[g])
     }
 
-    /// Traces each sharing group's rays: [`SHARED_RAYS`] members' elements drawn by
-    /// `weight(e)` (area × unoccluded form factor), stratified, and `ray(e)` the
-    /// (unblocked, traced) of element `e`'s own first ray (drawn twice, the same ray).
-    /// Returns what each group saw and the rays traced. Each group draws from its own
-    /// stream, so the threads change nothing.
-    pub(super) fn trace(
+    /// Each sharing group's receiving: `factors(g)` gives group `g`'s member elements'
+    /// unoccluded form factors (in the group's element order), then [`SHARED_RAYS`] members
+    /// drawn by area × factor, stratified, trace `ray(e)` (the (unblocked, traced) of
+    /// element `e`'s own first ray; drawn twice, the same ray). Returns, per group, its
+    /// factors and what its rays saw (empty and (0, 0) when it does not share), and the
+    /// rays traced. Each group draws from its own stream, so the threads change nothing.
+    pub(super) fn receive(
         &self,
         clusters: &Clusters,
-        mesh: &Mesh,
-        seed: u64,
-        stream: u64,
-        weight: impl Fn(usize) -> f64 + Sync,
+        area: &[f64],
+        (seed, stream): (u64, u64),
+        factors: impl Fn(usize) -> Vec<f64> + Sync,
         ray: impl Fn(usize) -> (u32, u32) + Sync,
-    ) -> (Seen, u64) {
-        let groups = &self.groups;
-        let one = |g: usize| -> (u32, u32) {
-            if !groups[g] {
-                return (0, 0);
+    ) -> (Vec<Received>, u64) {
+        let one = |g: usize| -> Received {
+            if !self.groups[g] {
+                return Received::default();
             }
-            let elements = || {
-                clusters.group(g).patches.iter().flat_map(|&q| {
-                    let r = &mesh.patches[q as usize].elements;
-                    r.start as usize..r.end as usize
-                })
-            };
-            let total: f64 = elements().map(&weight).sum();
+            let elements = &clusters.group(g).elements;
+            let factors = factors(g);
+            let weight = |k: usize| area[elements[k] as usize] * factors[k];
+            let total: f64 = (0..elements.len()).map(weight).sum();
             if !(total > 0.0 && total.is_finite()) {
-                return (0, 0);
+                return Received { factors, seen: (0, 0) };
             }
             let mut rng = Rng::for_task(seed, stream ^ SHARED_STREAM, g as u64);
             let (mut visible, mut traced) = (0, 0);
-            let (mut walked, mut draws) = (0.0, elements().peekable());
-            let mut current = draws.next();
+            let (mut walked, mut k) = (0.0, 0);
             for j in 0..SHARED_RAYS {
-                // Stratified over the cumulative weights: the j-th draw lands in the
-                // j-th slice of the group's power.
+                // Stratified over the cumulative weights: the j-th draw lands in the j-th
+                // slice of the group's power.
                 let t = (f64::from(j) + rng.next_f64()) / f64::from(SHARED_RAYS) * total;
-                while let Some(e) = current {
-                    let w = weight(e);
-                    if walked + w >= t || draws.peek().is_none() {
-                        break;
-                    }
-                    walked += w;
-                    current = draws.next();
+                while k + 1 < elements.len() && walked + weight(k) < t {
+                    walked += weight(k);
+                    k += 1;
                 }
-                let Some(e) = current else { break };
-                let (v, n) = ray(e);
+                let (v, n) = ray(elements[k] as usize);
                 // No ray needed (nothing can block it): one unblocked.
                 let (v, n) = if n == 0 { (1, 1) } else { (v, n) };
                 visible += v;
                 traced += n;
             }
-            (visible, traced)
+            Received { factors, seen: (visible, traced) }
         };
-        let seen: Seen = (0..groups.len()).into_par_iter().map(one).collect();
-        let rays = seen.iter().map(|&(_, n)| u64::from(n)).sum();
-        (seen, rays)
+        let received: Vec<Received> = (0..self.groups.len()).into_par_iter().map(one).collect();
+        let rays = received.iter().map(|r| u64::from(r.seen.1)).sum();
+        (received, rays)
     }
 }
