@@ -69,6 +69,9 @@ pub(super) struct Clusters {
     members: Vec<bool>,
     /// Per element of a group's patch, its place in the group's `elements`.
     slot: Vec<u32>,
+    /// Per element, its patch's group, or [`NONE`] (read in element order: the elements
+    /// themselves are 168 bytes each).
+    of_element: Vec<u32>,
     /// The groups, in order of their first member.
     groups: Vec<Group>,
     /// Per group, Σ |unshot power| over its members, kept up to date by [`Clusters::update`].
@@ -182,14 +185,24 @@ impl Clusters {
             }
         }
         let members = of_patch.iter().map(|&g| g != NONE).collect();
-        let mut slot = vec![NONE; mesh.elements.len()];
-        for group in &groups {
+        let (mut slot, mut of_element) = (vec![NONE; mesh.elements.len()], vec![NONE; mesh.elements.len()]);
+        for (g, group) in groups.iter().enumerate() {
             for (k, &e) in group.elements.iter().enumerate() {
                 slot[e as usize] = k as u32;
+                of_element[e as usize] = g as u32;
             }
         }
         let singles = (0..of_patch.len() as u32).filter(|&q| of_patch[q as usize] == NONE).collect();
-        Self { of_patch, members, slot, power: vec![0.0; groups.len()], singles, since_sum: 0, groups }
+        Self {
+            of_patch,
+            members,
+            slot,
+            of_element,
+            power: vec![0.0; groups.len()],
+            singles,
+            since_sum: 0,
+            groups,
+        }
     }
 
     /// Per patch, whether it is in a group.
@@ -200,6 +213,12 @@ impl Clusters {
     /// Patch `q`'s group, if it is in one.
     pub(super) fn group_of(&self, q: usize) -> Option<usize> {
         let g = self.of_patch[q];
+        (g != NONE).then_some(g as usize)
+    }
+
+    /// Element `e`'s group, if its patch is in one.
+    pub(super) fn group_of_element(&self, e: usize) -> Option<usize> {
+        let g = self.of_element[e];
         (g != NONE).then_some(g as usize)
     }
 
@@ -365,10 +384,10 @@ impl Clusters {
         let traced = AtomicU64::new(0);
         // Elements in no sharing group, with their own rays; the sharing groups' below.
         for_each_maybe_parallel(factors, |e, out| {
-            let el = &mesh.elements[e];
-            if sharing.shares(self, el.patch as usize) {
+            if sharing.element_group(self, e).is_some() {
                 return;
             }
+            let el = &mesh.elements[e];
             let mut shares = [0.0; POINTS];
             let (f, near) =
                 unoccluded(group, frozen, tables.vertex_means[e], el.normal, el.patch, &mut shares);
@@ -406,7 +425,7 @@ impl Clusters {
             );
             traced += rays;
             for_each_maybe_parallel(factors, |e, out| {
-                if let Some(g) = sharing.group_of(self, mesh.elements[e].patch as usize) {
+                if let Some(g) = sharing.element_group(self, e) {
                     let r = &received[g];
                     *out = (r.factors[self.slot(e)] * r.visibility()) as f32;
                 }

@@ -17,6 +17,9 @@ pub(super) struct MeshTables {
     /// Per element, the mean of its vertices: the one quadrature point of a far element (the
     /// centre of the bilinear map, see `for_each_point`), which every row needs.
     pub(super) vertex_means: Vec<DVec3>,
+    /// Per element, its patch (the loops over a row's elements read this, not the 168-byte
+    /// elements).
+    pub(super) element_patch: Vec<u32>,
     /// Per element, its circumradius about its centre (see [`element_radius`]).
     pub(super) element_radii: Vec<f64>,
     /// Per element, its corners lifted off it by the ray offset (see [`lift_corners`]).
@@ -82,6 +85,7 @@ impl MeshTables {
             vertex_means: (0..n)
                 .map(|e| mesh.element_corners(e).sum::<DVec3>() / f64::from(mesh.elements[e].vertex_count))
                 .collect(),
+            element_patch: mesh.elements.iter().map(|el| el.patch).collect(),
             element_radii,
             lifted_corners: lift_corners(mesh, ray_offset),
             patch_elements: mesh

@@ -222,9 +222,8 @@ fn penumbra_pass(
     let flags: &[bool] = flags;
     for_each_maybe_parallel(factors, |e, out| {
         // A sharing group's members take its visibility, not rays of their own.
-        let patch = shot.mesh.elements[e].patch as usize;
-        if flags[e] && !shot.shares(patch) {
-            let plan = &plans[patch];
+        if flags[e] && shot.sharing.element_group(shot.clusters, e).is_none() {
+            let plan = &plans[tables.element_patch[e] as usize];
             let (visible, traced) = trace(shot, plan, e, Rays::Penumbra);
             out.visible += visible;
             out.traced += traced;
@@ -287,7 +286,7 @@ fn receive_shared(shot: &Shot, plans: &[PatchPlan], element_area: &[f64], factor
             trace(shot, plan_of(e), e, Rays::Pilot)
         });
     for_each_maybe_parallel(factors, |e, r| {
-        if let Some(g) = sharing.group_of(clusters, mesh.elements[e].patch as usize) {
+        if let Some(g) = sharing.element_group(clusters, e) {
             let f = received[g].factors[clusters.slot(e)];
             (r.unoccluded, r.unweighted) = (f, f);
             (r.visible, r.traced) = if f > 0.0 { received[g].seen } else { (0, 0) };

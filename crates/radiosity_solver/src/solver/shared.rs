@@ -94,6 +94,11 @@ impl Sharing {
         self.group_of(clusters, q).is_some()
     }
 
+    /// Element `e`'s group, when it shares.
+    pub(super) fn element_group(&self, clusters: &Clusters, e: usize) -> Option<usize> {
+        clusters.group_of_element(e).filter(|&g| self.groups[g])
+    }
+
     /// Patch `q`'s group, when it shares.
     pub(super) fn group_of(&self, clusters: &Clusters, q: usize) -> Option<usize> {
         clusters.group_of(q).filter(|&g| self.groups[g])

@@ -81,7 +81,6 @@ const MIN_SPANS_PER_CHUNK: usize = 16;
 /// Calls `f(patch, its elements)` for every patch the row's `spans` cover, in order (a span
 /// is whole consecutive patches).
 fn for_each_patch(
-    mesh: &Mesh,
     tables: &MeshTables,
     spans: &[(u32, u32)],
     mut f: impl FnMut(usize, std::ops::Range<usize>),
@@ -89,7 +88,7 @@ fn for_each_patch(
     for &(first, count) in spans {
         let (mut e, end) = (first as usize, first as usize + count as usize);
         while e < end {
-            let patch = mesh.elements[e].patch as usize;
+            let patch = tables.element_patch[e] as usize;
             let next = tables.patch_elements[patch].end.min(end);
             f(patch, e..next);
             e = next;
@@ -201,7 +200,7 @@ impl Tally {
         let receive = |(spans, factors, radiosity, unshot, seen): &mut Chunk| {
             let base = spans[0].0 as usize;
             let mut offset = 0;
-            for_each_patch(mesh, tables, spans, |patch, elements| {
+            for_each_patch(tables, spans, |patch, elements| {
                 let per_factor = tables.patch_reflectance[patch] * shot_b;
                 let area = &tables.element_area[elements.clone()];
                 let local = elements.start - base;
@@ -234,12 +233,12 @@ impl Tally {
             self.changed(patch);
         }
         self.escaped += shot_b * area - received;
-        self.tally_direct(mesh, tables, by, row, omega);
+        self.tally_direct(tables, by, row, omega);
     }
 
     /// Adds to each receiver the part of this shot that is the shooter's own emission (its
     /// direct light). Only emitters' shots carry any, so the extra pass is rare.
-    fn tally_direct(&mut self, mesh: &Mesh, tables: &MeshTables, by: Shooters, row: &Row, omega: f64) {
+    fn tally_direct(&mut self, tables: &MeshTables, by: Shooters, row: &Row, omega: f64) {
         let Shooters { patches: shooters, area } = by;
         let emission: Rgb = shooters.iter().map(|&q| self.patch_unshot_emission[q as usize]).sum();
         if emission.max_channel() <= 0.0 {
@@ -250,7 +249,7 @@ impl Tally {
             self.patch_unshot_emission[q as usize] *= 1.0 - omega;
         }
         let mut offset = 0;
-        for_each_patch(mesh, tables, &row.spans, |patch, elements| {
+        for_each_patch(tables, &row.spans, |patch, elements| {
             let per_factor = tables.patch_reflectance[patch] * shot_e;
             let factors = &row.factors[offset..offset + elements.len()];
             for (direct, f) in self.direct[elements.clone()].iter_mut().zip(factors) {
