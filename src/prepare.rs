@@ -145,9 +145,10 @@ pub struct SolveOpts {
     #[arg(long, value_name = "true|false", default_value_t = SolverParams::default().shared_visibility, action = clap::ArgAction::Set)]
     pub shared_visibility: bool,
     /// Memory for keeping each shooter's form factors for its next shots, in MiB (0: keep
-    /// none; the answer is the same, only slower).
-    #[arg(long, default_value_t = SolverParams::default().row_cache_bytes >> 20, value_name = "MIB")]
-    pub row_cache_mib: usize,
+    /// none; the answer is the same, only slower). Default: 256, or room for 64 rows of form
+    /// factors (4 bytes per element each) when the mesh is bigger.
+    #[arg(long, value_name = "MIB")]
+    pub row_cache_mib: Option<usize>,
     /// Over-relaxation factor ω in [1, 2) (1: plain shooting).
     #[arg(long, allow_negative_numbers = true, default_value_t = overshoot_factor(SolverParams::default().overshoot))]
     pub overshoot: f64,
@@ -325,7 +326,7 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
         seed: o.seed,
         ambient: if o.ambient { Ambient::On } else { Ambient::Off },
         overshoot: if o.overshoot == 1.0 { Overshoot::Off } else { Overshoot::Relaxation(o.overshoot) },
-        row_cache_bytes: o.row_cache_mib.saturating_mul(1 << 20),
+        row_cache_bytes: o.row_cache_mib.map(|mib| mib.saturating_mul(1 << 20)),
         clustering: o.clusters,
         shared_visibility: o.shared_visibility,
         ..defaults

@@ -87,7 +87,11 @@ fn kept_rows_change_nothing_whatever_the_budget() {
     let with = |row_cache_bytes| {
         solve_with(
             &problem,
-            SolverParams { max_shots: Some(400), row_cache_bytes, ..SolverParams::default() },
+            SolverParams {
+                max_shots: Some(400),
+                row_cache_bytes: Some(row_cache_bytes),
+                ..SolverParams::default()
+            },
         )
     };
     let all = with(usize::MAX);

@@ -571,7 +571,7 @@ mod tests {
             // so the solve outlasts the test unless something stops it.
             solver_params: SolverParams {
                 unshot_threshold: 1e-12,
-                row_cache_bytes: 0,
+                row_cache_bytes: Some(0),
                 ..SolverParams::preview()
             },
         }

@@ -111,7 +111,10 @@ impl Solver {
         Ok(Self {
             tables: MeshTables::new(&mesh),
             first_shots: FirstShots::new(&mesh),
-            rows: RowCache::new(mesh.patches.len() + clusters.len()),
+            rows: RowCache::new(
+                mesh.patches.len() + clusters.len(),
+                params.row_cache_budget(mesh.elements.len()),
+            ),
             clusters,
             scratch: ShotScratch::new(&mesh),
             tally,

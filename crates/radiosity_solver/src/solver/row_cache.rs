@@ -29,6 +29,8 @@ pub(super) struct RowCache {
     /// when its form factors are not, up to [`PLAN_CACHE_ENTRIES`] in all.
     plans: Vec<Option<Box<[PatchPlan]>>>,
     plan_entries: usize,
+    /// Bytes the rows may take (see `SolverParams::row_cache_budget`).
+    budget: usize,
     /// Per shooter, its shots so far.
     shots: Vec<u32>,
     /// The shooters whose rows are kept (or taken out for a shot).
@@ -36,9 +38,10 @@ pub(super) struct RowCache {
 }
 
 impl RowCache {
-    /// Nothing kept, for `patches` shooters.
-    pub(super) fn new(patches: usize) -> Self {
+    /// Nothing kept, for `patches` shooters, rows kept within `budget` bytes.
+    pub(super) fn new(patches: usize, budget: usize) -> Self {
         Self {
+            budget,
             rows: (0..patches).map(|_| None).collect(),
             row_bytes: 0,
             plans: vec![None; patches],
@@ -76,7 +79,7 @@ impl RowCache {
             return;
         }
         let bytes = row.bytes();
-        if !params.reference_path && self.make_room(shooter, bytes, params.row_cache_bytes) {
+        if !params.reference_path && self.make_room(shooter, bytes, self.budget) {
             self.row_bytes += bytes;
             self.rows[shooter] = Some(row);
             self.kept.push(shooter);
@@ -133,8 +136,8 @@ mod tests {
     #[test]
     fn rows_of_shooters_that_shoot_more_often_displace_the_others() {
         let size = row(100).bytes();
-        let params = SolverParams { row_cache_bytes: 2 * size, ..SolverParams::default() };
-        let mut cache = RowCache::new(4);
+        let params = SolverParams::default();
+        let mut cache = RowCache::new(4, 2 * size);
         cache.keep(0, row(100), false, &[], &params);
         cache.keep(1, row(100), false, &[], &params);
         // Shooter 1 shoots again (its kept row taken out and handed back).
@@ -150,7 +153,7 @@ mod tests {
         assert!(cache.take(2).is_some());
         // The reference path keeps nothing.
         let reference = SolverParams { reference_path: true, ..params };
-        let mut cache = RowCache::new(1);
+        let mut cache = RowCache::new(1, usize::MAX);
         cache.keep(0, row(1), false, &[], &reference);
         assert!(cache.take(0).is_none());
     }
