@@ -36,17 +36,26 @@ pub(crate) fn choose(scene: &Scene) -> Camera {
     // From outside first: an open scene (a box without a front wall, a model on a plane) is
     // shown as a whole from its open side whenever some side shows enough front faces (the
     // backs of two-sided walls, seen from outside, are not enough: nothing lights them).
-    let best_outside = best_of(scene, candidates);
+    let best_outside = best_of(scene, candidates, false);
     if best_outside.2 >= PROBE.0 * PROBE.1 / 4 {
         return best_outside.0;
     }
-    // A closed room shows only the backs of its walls from outside: look from its middle.
-    let inside = [DVec3::Z, -DVec3::Z, DVec3::X, -DVec3::X]
-        .into_iter()
-        .filter_map(|d| Camera::try_new(centre, centre + d, DVec3::Y, INSIDE_FOV_DEG).ok());
-    let best_inside = best_of(scene, inside.collect());
+    // A closed room shows only the backs of its walls from outside: look from inside, at
+    // mid-height, standing back from the middle towards one wall (as a photographer stands
+    // to show a room), along each horizontal axis; the view that shows the most objects
+    // wins (from the middle along +z, the generated furnished room showed a bare wall and
+    // the sofa, and none of the models on the table).
+    let inside = [DVec3::Z, -DVec3::Z, DVec3::X, -DVec3::X].into_iter().filter_map(|d| {
+        let from = centre - d * (INSIDE_STEP_BACK * (hi - lo).dot(d.abs()));
+        Camera::try_new(from, from + d, DVec3::Y, INSIDE_FOV_DEG).ok()
+    });
+    let best_inside = best_of(scene, inside.collect(), true);
     if best_inside.1 > best_outside.1 { best_inside.0 } else { best_outside.0 }
 }
+
+/// How far back from the middle an inside camera stands, as a share of the room's depth
+/// along its view (0.5 would be against the wall behind it; furniture stands there).
+const INSIDE_STEP_BACK: f64 = 0.3;
 
 /// What a probe ray meets first.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
@@ -60,16 +69,23 @@ enum Seen {
 }
 
 /// The candidate with the best score (a front face 2, a two-sided back face 1), its score
-/// and its front faces; ties keep the earlier one (the classic framing first). `candidates`
-/// must not be empty.
-fn best_of(scene: &Scene, candidates: Vec<Camera>) -> (Camera, usize, usize) {
+/// and its front faces; ties keep the earlier one (the classic framing first). With
+/// `by_objects`, the number of objects whose lit sides the probe rays meet comes first.
+/// `candidates` must not be empty.
+fn best_of(scene: &Scene, candidates: Vec<Camera>, by_objects: bool) -> (Camera, usize, usize) {
     let mut best = (candidates[0], 0usize, 0usize);
+    let mut best_key = (0, 0);
     for camera in candidates {
-        let seen = probe(scene, &camera);
-        let fronts = seen.iter().filter(|&&s| s == Seen::Front).count();
-        let score = 2 * fronts + seen.iter().filter(|&&s| s == Seen::TwoSidedBack).count();
-        if score > best.1 {
-            best = (camera, score, fronts);
+        let seen = probe_objects(scene, &camera);
+        let fronts = seen.iter().filter(|(s, _)| *s == Seen::Front).count();
+        let score = 2 * fronts + seen.iter().filter(|(s, _)| *s == Seen::TwoSidedBack).count();
+        let mut objects: Vec<usize> =
+            seen.iter().filter(|(s, _)| *s != Seen::Back).map(|&(_, o)| o).collect();
+        objects.sort_unstable();
+        objects.dedup();
+        let key = (if by_objects { objects.len() } else { 0 }, score);
+        if key > best_key {
+            (best, best_key) = ((camera, score, fronts), key);
         }
     }
     best
@@ -83,12 +99,17 @@ pub(crate) fn lit_share(scene: &Scene, camera: &Camera) -> f64 {
 
 /// What each probe ray through `camera` meets first (rays that meet nothing are left out).
 fn probe(scene: &Scene, camera: &Camera) -> Vec<Seen> {
+    probe_objects(scene, camera).into_iter().map(|(seen, _)| seen).collect()
+}
+
+/// [`probe`], with the object each ray meets.
+fn probe_objects(scene: &Scene, camera: &Camera) -> Vec<(Seen, usize)> {
     let rays = CameraRays::new(camera, PROBE.0 as u32, PROBE.1 as u32);
     (0..PROBE.1)
         .flat_map(|j| (0..PROBE.0).map(move |i| (i, j)))
         .filter_map(|(i, j)| {
             let dir = rays.direction(i as f64 + 0.5, j as f64 + 0.5);
-            first_hit(scene, camera.position, dir).map(|(_, seen)| seen)
+            first_hit(scene, camera.position, dir).map(|(_, seen, object)| (seen, object))
         })
         .collect()
 }
@@ -100,11 +121,11 @@ pub(crate) fn front_faces_seen(scene: &Scene, camera: &Camera) -> usize {
     probe(scene, camera).into_iter().filter(|&s| s != Seen::Back).count()
 }
 
-/// The nearest surface along `origin + t·dir` (t > 0): its distance and which of its faces
-/// the ray meets.
-fn first_hit(scene: &Scene, origin: DVec3, dir: DVec3) -> Option<(f64, Seen)> {
-    let mut best: Option<(f64, Seen)> = None;
-    for object in &scene.objects {
+/// The nearest surface along `origin + t·dir` (t > 0): its distance, which of its faces the
+/// ray meets, and its object.
+fn first_hit(scene: &Scene, origin: DVec3, dir: DVec3) -> Option<(f64, Seen, usize)> {
+    let mut best: Option<(f64, Seen, usize)> = None;
+    for (index, object) in scene.objects.iter().enumerate() {
         let two_sided = object.sides != Sides::One;
         let mut take = |t: f64, front: bool| {
             let seen = match (front, two_sided) {
@@ -112,8 +133,8 @@ fn first_hit(scene: &Scene, origin: DVec3, dir: DVec3) -> Option<(f64, Seen)> {
                 (false, true) => Seen::TwoSidedBack,
                 (false, false) => Seen::Back,
             };
-            if best.is_none_or(|(b, _)| t < b) {
-                best = Some((t, seen));
+            if best.is_none_or(|(b, _, _)| t < b) {
+                best = Some((t, seen, index));
             }
         };
         match &object.shape {
@@ -230,6 +251,32 @@ mod tests {
         let camera = scene.camera_or_framing();
         let (lo, hi) = scene.bounds();
         assert!(camera.position.cmpgt(lo).all() && camera.position.cmplt(hi).all(), "{camera:?}");
+    }
+
+    /// In a closed room holding a block by one wall, the inside view looks towards the
+    /// block (it shows two objects, the other views one), from behind the room's middle.
+    #[test]
+    fn inside_a_room_the_view_shows_the_most_objects() {
+        use crate::box_faces;
+        for (side, min, max) in [
+            (DVec3::X, DVec3::new(0.7, 0.2, 0.3), DVec3::new(0.95, 0.7, 0.7)),
+            (-DVec3::Z, DVec3::new(0.3, 0.2, 0.05), DVec3::new(0.7, 0.7, 0.3)),
+        ] {
+            let mut scene = furnace_box(0.5, 1.0);
+            let block = box_faces(min, max, Facing::Outward, 0.0).unwrap();
+            scene.objects.push(crate::Object {
+                name: "block".into(),
+                material: 0,
+                shape: Shape::Polygons(block),
+                sides: Sides::One,
+            });
+            let camera = scene.camera_or_framing();
+            let (lo, hi) = scene.bounds();
+            assert!(camera.position.cmpgt(lo).all() && camera.position.cmplt(hi).all(), "{camera:?}");
+            let view = (camera.look_at - camera.position).normalize();
+            assert!(view.dot(side) > 0.99, "{side}: {camera:?}");
+            assert!((camera.position - (lo + hi) * 0.5).dot(side) < -0.2, "stands back: {camera:?}");
+        }
     }
 
     /// Two facing plates show their lit sides.
