@@ -84,7 +84,10 @@ fn plan_patch(
     plan: &mut PatchPlan,
 ) {
     if shares && !reference_path {
-        *plan = PatchPlan { live: true, facing: true, far: true, ..PatchPlan::default() };
+        // Not `facing`: the group's few rays then keep to the part of the shooter in front
+        // of each member, which is the part its form factor counts (a ray to a point behind
+        // a facet's plane crosses its own model and counts as blocked).
+        *plan = PatchPlan { live: true, far: true, ..PatchPlan::default() };
         return;
     }
     let is_shooter = q == shooter;
