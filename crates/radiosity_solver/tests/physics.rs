@@ -140,6 +140,14 @@ fn radiosity_on_threads(scene: &Scene, params: &SolverParams, threads: usize) ->
     })
 }
 
+/// Asserts that `scene` solved with `params` gives the same bits on 1 and 2 threads.
+fn same_on_one_and_two_threads(scene: &Scene, params: &SolverParams) {
+    assert!(
+        radiosity_on_threads(scene, params, 1) == radiosity_on_threads(scene, params, 2),
+        "1 and 2 threads differ"
+    );
+}
+
 /// Same seed, 1 or 2 threads: bit-identical solutions.
 #[test]
 fn one_and_two_threads_agree_exactly() {
@@ -668,11 +676,7 @@ fn a_furnace_box_holding_a_clustered_torus_reaches_e_over_one_minus_rho() {
         }
     }
     // Groups' rows run in parallel over receivers: same seed, 1 or 2 threads, same bits.
-    let params = SolverParams { max_shots: Some(300), ..SolverParams::default() };
-    assert!(
-        radiosity_on_threads(&scene, &params, 1) == radiosity_on_threads(&scene, &params, 2),
-        "1 and 2 threads differ"
-    );
+    same_on_one_and_two_threads(&scene, &SolverParams { max_shots: Some(300), ..SolverParams::default() });
 }
 
 /// Far from a shooter that does not emit, a group's facets share one visibility estimate (a
@@ -726,11 +730,7 @@ fn groups_far_from_shooters_that_do_not_emit_share_their_visibility() {
         assert!(rel(shared[object], unshared[object]) < 0.01, "object {object}: {shared:?} vs {unshared:?}");
     }
     assert!(shared_rays * 10 < unshared_rays * 9, "{shared_rays} shared rays vs {unshared_rays} unshared");
-    let params = SolverParams { max_shots: Some(200), ..params(true) };
-    assert!(
-        radiosity_on_threads(&scene, &params, 1) == radiosity_on_threads(&scene, &params, 2),
-        "1 and 2 threads differ"
-    );
+    same_on_one_and_two_threads(&scene, &SolverParams { max_shots: Some(200), ..params(true) });
 }
 
 /// A receiving group far from a shooter takes its members' form factors in one pass over the
