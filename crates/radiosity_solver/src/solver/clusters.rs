@@ -98,6 +98,8 @@ pub(super) struct Group {
     pub(super) centre: DVec3,
     /// Largest distance from `centre` to a member's corner.
     pub(super) radius: f64,
+    /// Some member emits (see [`patch_emits`]).
+    pub(super) emits: bool,
     /// What its first shot fixed.
     frozen: Option<Frozen>,
 }
@@ -181,7 +183,17 @@ impl Clusters {
                         (mesh.element_corners(e).sum::<DVec3>() / f64::from(el.vertex_count), el.normal)
                     })
                     .collect();
-                groups.push(Group { patches, elements, receivers, area, centre, radius, frozen: None });
+                let emits = patches.iter().any(|&q| patch_emits(mesh, q as usize));
+                groups.push(Group {
+                    patches,
+                    elements,
+                    receivers,
+                    area,
+                    centre,
+                    radius,
+                    emits,
+                    frozen: None,
+                });
             }
         }
         let members = of_patch.iter().map(|&g| g != NONE).collect();
@@ -362,11 +374,7 @@ impl Clusters {
         let group = &self.groups[g];
         let frozen = group.frozen.as_ref().expect("a group is frozen before its row is computed");
         let share = params.clustering && params.shared_visibility;
-        let emits = (group.patches.iter()).any(|&q| {
-            mesh.element_material(mesh.patches[q as usize].elements.start as usize).emission.max_channel()
-                > 0.0
-        });
-        scratch.sharing.choose(self, group.centre, group.radius, emits, share, Some(g));
+        scratch.sharing.choose(self, group.centre, group.radius, group.emits, share, Some(g));
         let (sharing, factors) = (&scratch.sharing, &mut scratch.group_factors);
         let stream = GROUP_STREAM ^ g as u64;
         let aim = Aim {
@@ -503,6 +511,12 @@ impl Aim<'_> {
         }
         (visible, traced)
     }
+}
+
+/// Whether patch `q` emits: its shots carry direct light, whose sharp shadows receiving
+/// groups must not share (see [`super::shared`]).
+pub(super) fn patch_emits(mesh: &Mesh, q: usize) -> bool {
+    mesh.element_material(mesh.patches[q].elements.start as usize).emission.max_channel() > 0.0
 }
 
 /// Random streams of groups are keyed apart from patches' (whose keys are patch indices).

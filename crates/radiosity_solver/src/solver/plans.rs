@@ -83,7 +83,7 @@ fn plan_patch(
     shares: bool,
     plan: &mut PatchPlan,
 ) {
-    if shares && !reference_path {
+    if shares {
         // Not `facing`: the group's few rays then keep to the part of the shooter in front
         // of each member, which is the part its form factor counts (a ray to a point behind
         // a facet's plane crosses its own model and counts as blocked).

@@ -69,7 +69,7 @@ impl Solver {
         let bright = self.first_shots.bright(shooter);
         let shooter_radius = patch.corners().iter().map(|c| c.distance(patch.centre)).fold(0.0, f64::max);
         let share = self.params.clustering && self.params.shared_visibility;
-        let emits = mesh.element_material(patch.elements.start as usize).emission.max_channel() > 0.0;
+        let emits = super::clusters::patch_emits(&mesh, shooter);
         self.scratch.sharing.choose(&self.clusters, patch.centre, shooter_radius, emits, share, None);
         if self.rows.plans(shooter).is_none() {
             let (sharing, clusters) = (&self.scratch.sharing, &self.clusters);

@@ -79,7 +79,7 @@ impl RowCache {
             return;
         }
         let bytes = row.bytes();
-        if !params.reference_path && self.make_room(shooter, bytes, self.budget) {
+        if !params.reference_path && self.make_room(shooter, bytes) {
             self.row_bytes += bytes;
             self.rows[shooter] = Some(row);
             self.kept.push(shooter);
@@ -93,10 +93,11 @@ impl RowCache {
         }
     }
 
-    /// Frees `bytes` within `budget` for `shooter`'s row by dropping the rows of shooters
+    /// Frees `bytes` within the budget for `shooter`'s row by dropping the rows of shooters
     /// that have shot fewer times than it (fewest first, then the later shooter index), if
     /// that is enough; whether the row now fits.
-    fn make_room(&mut self, shooter: usize, bytes: usize, budget: usize) -> bool {
+    fn make_room(&mut self, shooter: usize, bytes: usize) -> bool {
+        let budget = self.budget;
         if self.row_bytes + bytes <= budget {
             return true;
         }

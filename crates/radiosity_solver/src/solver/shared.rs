@@ -30,7 +30,7 @@ use glam::DVec3;
 const SHARE_DISTANCE: f64 = 2.5;
 
 /// Rays a sharing group traces (from members drawn by power, stratified).
-pub(super) const SHARED_RAYS: u32 = 16;
+const SHARED_RAYS: u32 = 16;
 
 /// Random streams of the draws are keyed apart from elements' and groups' own.
 const SHARED_STREAM: u64 = 0x7368_6172_6564_0000;
@@ -44,14 +44,17 @@ pub(super) struct Sharing {
 
 /// What one sharing group received from a shot.
 #[derive(Default)]
-pub(super) struct Received {
+pub(super) struct Shared {
     /// Its member elements' unoccluded form factors, in the group's element order.
     pub(super) factors: Vec<f64>,
-    /// (unblocked, traced) of its shared rays; (0, 0) when nothing of it receives.
+    /// (unblocked, traced) of its shared rays, a draw that needed no ray counted as one
+    /// unblocked; (0, 0) when nothing of it receives.
     pub(super) seen: (u32, u32),
+    /// Rays it traced.
+    rays: u32,
 }
 
-impl Received {
+impl Shared {
     /// The fraction of its rays that were unblocked (1 when it traced none).
     pub(super) fn visibility(&self) -> f64 {
         if self.seen.1 == 0 { 1.0 } else { f64::from(self.seen.0) / f64::from(self.seen.1) }
@@ -117,20 +120,20 @@ impl Sharing {
         (seed, stream): (u64, u64),
         factors: impl Fn(usize) -> Vec<f64> + Sync,
         ray: impl Fn(usize) -> (u32, u32) + Sync,
-    ) -> (Vec<Received>, u64) {
-        let one = |g: usize| -> Received {
+    ) -> (Vec<Shared>, u64) {
+        let one = |g: usize| -> Shared {
             if !self.groups[g] {
-                return Received::default();
+                return Shared::default();
             }
             let elements = &clusters.group(g).elements;
             let factors = factors(g);
             let weight = |k: usize| area[elements[k] as usize] * factors[k];
             let total: f64 = (0..elements.len()).map(weight).sum();
             if !(total > 0.0 && total.is_finite()) {
-                return Received { factors, seen: (0, 0) };
+                return Shared { factors, ..Shared::default() };
             }
             let mut rng = Rng::for_task(seed, stream ^ SHARED_STREAM, g as u64);
-            let (mut visible, mut traced) = (0, 0);
+            let (mut visible, mut drawn, mut rays) = (0, 0, 0);
             let (mut walked, mut k) = (0.0, 0);
             for j in 0..SHARED_RAYS {
                 // Stratified over the cumulative weights: the j-th draw lands in the j-th
@@ -141,15 +144,16 @@ impl Sharing {
                     k += 1;
                 }
                 let (v, n) = ray(elements[k] as usize);
+                rays += n;
                 // No ray needed (nothing can block it): one unblocked.
                 let (v, n) = if n == 0 { (1, 1) } else { (v, n) };
                 visible += v;
-                traced += n;
+                drawn += n;
             }
-            Received { factors, seen: (visible, traced) }
+            Shared { factors, seen: (visible, drawn), rays }
         };
-        let received: Vec<Received> = (0..self.groups.len()).into_par_iter().map(one).collect();
-        let rays = received.iter().map(|r| u64::from(r.seen.1)).sum();
+        let received: Vec<Shared> = (0..self.groups.len()).into_par_iter().map(one).collect();
+        let rays = received.iter().map(|r| u64::from(r.rays)).sum();
         (received, rays)
     }
 }
