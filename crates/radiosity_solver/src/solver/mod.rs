@@ -25,7 +25,7 @@
 //!   B, ΔB and the power bookkeeping, and applying a shot);
 //! * computing a row: `row` (the passes), `plans` (per receiving patch), `ray_ends` (where
 //!   rays end on the shooter), `receive` (form factors and pilot rays), `quadrature`,
-//!   `rays` (drawing and tracing), `penumbra` (which receivers take more rays), `uneven`
+//!   `rays` (drawing and tracing; near receivers draw their ends by the form factor), `penumbra` (which receivers take more rays), `uneven`
 //!   (shooters whose unshot radiosity is uneven), `parallel`.
 
 use std::sync::Arc;

@@ -1,7 +1,8 @@
 //! Where a shooter's rays end: one jittered point per cell of a [`TARGETS`] × [`TARGETS`]
 //! grid over the unit square, mapped onto the shooter by its unshot power at its first shot
 //! (see [`super::first_shots`]). A ray's stratified `(u, v)` picks its cell's point, so the
-//! rays keep their stratification and cost a lookup each instead of a draw.
+//! rays keep their stratification and cost a lookup each instead of a draw. (Receivers near
+//! the shooter draw theirs afresh by the form factor instead, see `rays::NearEnds`.)
 
 use glam::{DVec3, Vec3};
 

@@ -106,6 +106,7 @@ impl Solver {
             targets: &scratch.targets,
             lifted_targets: &scratch.lifted_targets,
             shooter_elements: &scratch.shooter_elements,
+            cdf,
             vertex_means: &tables.vertex_means,
             element_radii: &tables.element_radii,
             lifted_corners: &tables.lifted_corners,
