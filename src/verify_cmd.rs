@@ -237,7 +237,9 @@ pub fn run(a: VerifyArgs) -> Result<()> {
     let Prepared { scene, problem, .. } = &prepared;
     let mesh = problem.mesh();
     let solution = solver.solution();
-    let solved = with_back_faces(over_whole_area(solution.object_radiosity(mesh), &mesh.hidden_area));
+    let fronts = over_whole_area(solution.object_radiosity(mesh), &mesh.hidden_area);
+    let front_count = fronts.len();
+    let solved = with_back_faces(fronts);
     let solve_secs = report.elapsed.as_secs_f64();
     let stop = report.stop_reason.map_or("running", |s| s.as_str());
     crate::output::note(format_args!(
@@ -309,28 +311,15 @@ pub fn run(a: VerifyArgs) -> Result<()> {
         .enumerate()
         .filter_map(|(i, c)| c.luminance_percent().map(|p| (i, p, c.luminance_sigma())))
         .collect();
-    let over = judged.iter().filter(|(_, _, z)| z.abs() > 3.0).count();
-    let worst = judged.iter().max_by(|x, y| x.1.abs().total_cmp(&y.1.abs()));
-    let median_abs = median(judged.iter().map(|j| j.1.abs()).collect());
-    let area_weighted = {
-        let (mut sum, mut area) = (0.0, 0.0);
-        for &(i, p, _) in &judged {
-            sum += p * solved[i].area;
-            area += solved[i].area;
-        }
-        (area > 0.0).then(|| sum / area)
-    };
-    let summary = match worst {
-        Some(&(i, p, z)) => format!(
-            "{over} of {} objects differ by more than 3 σ; worst {} {:+.2} % ({} σ), median |difference| {:.2} %, area-weighted mean {:+.2} %",
-            judged.len(),
-            solved[i].name,
-            p,
-            fmt_sigma(z),
-            median_abs.unwrap_or(0.0),
-            area_weighted.unwrap_or(0.0)
-        ),
-        None => "no object has light to compare".into(),
+    // Back faces (the insides of models, the far sides of two-sided sheets) get little
+    // light and large relative differences; summed with the front faces they would set the
+    // median a reader takes for the whole scene, so each side is summed on its own too.
+    let all = Summary::of(&judged, &solved);
+    let (front, back): (Vec<(usize, f64, f64)>, _) = judged.iter().partition(|j| j.0 < front_count);
+    let sides = (!back.is_empty()).then(|| (Summary::of(&front, &solved), Summary::of(&back, &solved)));
+    let summary = match &sides {
+        None => all.text.clone(),
+        Some((front, back)) => format!("front faces: {}\nback faces: {}", front.text, back.text),
     };
     table += &summary;
     table.push('\n');
@@ -399,21 +388,74 @@ pub fn run(a: VerifyArgs) -> Result<()> {
             "seed": a.solve.seed,
             "reflections": a.reflections,
             "objects": objects,
-            "summary": {
-                "text": summary,
-                "objects": judged.len(),
-                "over_3_sigma": over,
-                "worst": worst.map(|&(i, p, z)| json!({"name": solved[i].name, "difference_percent": num(p), "difference_sigma": num(z)})),
-                "median_abs_difference_percent": median_abs,
-                "area_weighted_difference_percent": area_weighted,
-            },
+            "summary": all.json(&summary),
         });
+        if let Some((front, back)) = &sides {
+            doc["summary"]["front_faces"] = front.json(&front.text);
+            doc["summary"]["back_faces"] = back.json(&back.text);
+        }
         if let Some(part) = element_part {
             doc["element_sample"] = part.json;
         }
         write_report(path, a.force, &serde_json::to_string_pretty(&doc)?)?;
     }
     Ok(())
+}
+
+/// The verdict over some of the compared objects: how many differ by more than 3 σ, the
+/// worst, the median |difference| and the area-weighted mean difference.
+struct Summary {
+    objects: usize,
+    over: usize,
+    /// `(name, difference %, difference σ)`.
+    worst: Option<(String, f64, f64)>,
+    median_abs: Option<f64>,
+    area_weighted: Option<f64>,
+    /// The one-line verdict.
+    text: String,
+}
+
+impl Summary {
+    /// The verdict over `judged` (`(index into solved, difference %, difference σ)`).
+    fn of(judged: &[(usize, f64, f64)], solved: &[ObjectRadiosity]) -> Self {
+        let over = judged.iter().filter(|(_, _, z)| z.abs() > 3.0).count();
+        let worst = judged
+            .iter()
+            .max_by(|x, y| x.1.abs().total_cmp(&y.1.abs()))
+            .map(|&(i, p, z)| (solved[i].name.clone(), p, z));
+        let median_abs = median(judged.iter().map(|j| j.1.abs()).collect());
+        let area_weighted = {
+            let (mut sum, mut area) = (0.0, 0.0);
+            for &(i, p, _) in judged {
+                sum += p * solved[i].area;
+                area += solved[i].area;
+            }
+            (area > 0.0).then(|| sum / area)
+        };
+        let text = match &worst {
+            Some((name, p, z)) => format!(
+                "{over} of {} objects differ by more than 3 σ; worst {name} {p:+.2} % ({} σ), median |difference| {:.2} %, area-weighted mean {:+.2} %",
+                judged.len(),
+                fmt_sigma(*z),
+                median_abs.unwrap_or(0.0),
+                area_weighted.unwrap_or(0.0)
+            ),
+            None => "no object has light to compare".into(),
+        };
+        Self { objects: judged.len(), over, worst, median_abs, area_weighted, text }
+    }
+
+    /// The report's form of it, with `text` as its text.
+    fn json(&self, text: &str) -> Value {
+        json!({
+            "text": text,
+            "objects": self.objects,
+            "over_3_sigma": self.over,
+            "worst": self.worst.as_ref().map(|(name, p, z)| json!({"name": name, "difference_percent": num(*p), "difference_sigma": num(*z)})),
+            "median_abs_difference_percent": self.median_abs,
+            "area_weighted_difference_percent": self.area_weighted,
+        })
+    }
 }
 
 /// What the element sample adds to the table and to the report.

@@ -150,3 +150,52 @@ fn render_reference_and_compare() {
     let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert!(r["channels"].as_array().unwrap().iter().all(|c| c["rmse"] == 0.0));
 }
+
+/// A scene with back faces sums them apart: the back of a model gets little light and
+/// large relative differences, which would set the median of the whole scene. The totals
+/// stay over every object; front and back each get their own verdict, in the text and the
+/// report.
+#[test]
+fn verify_sums_front_and_back_faces_apart() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("plate.toml");
+    std::fs::write(
+        &scene,
+        r#"[[material]]
+name = "lamp"
+reflectance = [0, 0, 0]
+emission = [1, 1, 1]
+[[material]]
+name = "paper"
+reflectance = [0.5, 0.5, 0.5]
+sides = 2
+[[object]]
+name = "below"
+type = "polygon"
+material = "lamp"
+vertices = [[0, 0, 0], [0, 0, 1], [1, 0, 1], [1, 0, 0]]
+[[object]]
+name = "above"
+type = "polygon"
+material = "lamp"
+vertices = [[0, 2, 0], [1, 2, 0], [1, 2, 1], [0, 2, 1]]
+[[object]]
+name = "plate"
+type = "polygon"
+material = "paper"
+vertices = [[0, 1, 0], [1, 1, 0], [1, 1, 1], [0, 1, 1]]
+"#,
+    )
+    .unwrap();
+    let r = verify_json(&[scene.to_str().unwrap(), "--paths", "20000"]);
+    let summary = &r["summary"];
+    let (front, back) = (&summary["front_faces"], &summary["back_faces"]);
+    assert_eq!(summary["objects"], 4, "{summary}");
+    assert_eq!(front["objects"], 3, "{summary}");
+    assert_eq!(back["objects"], 1, "{summary}");
+    assert_eq!(back["worst"]["name"], "plate (back)", "{summary}");
+    let over = |s: &serde_json::Value| s["over_3_sigma"].as_u64().unwrap();
+    assert_eq!(over(front) + over(back), over(summary), "{summary}");
+    let text = summary["text"].as_str().unwrap();
+    assert!(text.starts_with("front faces: ") && text.contains("\nback faces: "), "{text}");
+}
