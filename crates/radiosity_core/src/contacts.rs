@@ -48,7 +48,93 @@ const INSIDE_CORNER_COS: f64 = 0.1;
 /// Every polygon of a scene that can stand on another, with its bounding box.
 pub(crate) struct Contacts<'a> {
     candidates: Vec<(PolygonId, &'a Polygon, DVec3, DVec3)>,
+    /// The candidates by where they are, so that a query visits those near it only.
+    grid: Grid,
     pairs_left: std::cell::Cell<u64>,
+}
+
+/// A uniform grid over the candidates' bounds: each cell lists the candidates whose boxes
+/// overlap it, in candidate order; a candidate over more than [`Grid::SPREAD`] cells (a
+/// floor, a wall) is listed in `large` instead. Without it every query looked at every
+/// candidate, and a room holding a 30 k-facet model spent the pair budget before the floor
+/// was reached: its table legs and sofa were meshed uncut.
+struct Grid {
+    lo: DVec3,
+    cell: DVec3,
+    dims: [usize; 3],
+    cells: Vec<Vec<u32>>,
+    large: Vec<u32>,
+}
+
+impl Grid {
+    /// Most cells a candidate is listed in; one over more goes to `large`.
+    const SPREAD: usize = 64;
+
+    /// The grid of the candidates' bounding `boxes`, in candidate order.
+    fn new(boxes: impl ExactSizeIterator<Item = (DVec3, DVec3)> + Clone) -> Self {
+        let count = boxes.len();
+        let (lo, hi) = boxes
+            .clone()
+            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), (a, b)| (lo.min(a), hi.max(b)));
+        // About four candidates a cell, at most 64 cells a side.
+        let side = ((count as f64 / 4.0).cbrt().ceil() as usize).clamp(1, 64);
+        let extent = (hi - lo).max(DVec3::splat(1e-9));
+        let cell = extent / side as f64;
+        let mut grid = Self {
+            lo,
+            cell,
+            dims: [side; 3],
+            cells: vec![Vec::new(); side * side * side],
+            large: Vec::new(),
+        };
+        if count == 0 {
+            return grid;
+        }
+        for (k, (a, b)) in boxes.enumerate() {
+            let (from, to) = (grid.cell_of(a), grid.cell_of(b));
+            let spread = (0..3).map(|i| to[i] - from[i] + 1).product::<usize>();
+            if spread > Self::SPREAD {
+                grid.large.push(k as u32);
+                continue;
+            }
+            grid.for_cells(from, to, |c| c.push(k as u32));
+        }
+        grid
+    }
+
+    /// The cell holding `p`, clamped into the grid.
+    fn cell_of(&self, p: DVec3) -> [usize; 3] {
+        let t = ((p - self.lo) / self.cell).floor();
+        [0, 1, 2].map(|i| (t[i].max(0.0) as usize).min(self.dims[i] - 1))
+    }
+
+    /// Calls `f` on every cell from `from` to `to`, both included.
+    fn for_cells(&mut self, from: [usize; 3], to: [usize; 3], mut f: impl FnMut(&mut Vec<u32>)) {
+        for z in from[2]..=to[2] {
+            for y in from[1]..=to[1] {
+                let row = (z * self.dims[1] + y) * self.dims[0];
+                self.cells[row + from[0]..=row + to[0]].iter_mut().for_each(&mut f);
+            }
+        }
+    }
+
+    /// The candidates listed in the cells overlapping `[lo, hi]`, and the large ones, each
+    /// once, in candidate order.
+    fn near(&self, lo: DVec3, hi: DVec3) -> Vec<u32> {
+        let (from, to) = (self.cell_of(lo), self.cell_of(hi));
+        let mut out = self.large.clone();
+        for z in from[2]..=to[2] {
+            for y in from[1]..=to[1] {
+                let row = (z * self.dims[1] + y) * self.dims[0];
+                for cell in &self.cells[row + from[0]..=row + to[0]] {
+                    out.extend_from_slice(cell);
+                }
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
 }
 
 /// A surface cut along footprints.
@@ -75,7 +161,8 @@ impl<'a> Contacts<'a> {
                 candidates.push((PolygonId { object, index }, p, lo, hi));
             }
         }
-        Self { candidates, pairs_left: std::cell::Cell::new(PAIR_BUDGET) }
+        let grid = Grid::new(candidates.iter().map(|c| (c.2, c.3)));
+        Self { candidates, grid, pairs_left: std::cell::Cell::new(PAIR_BUDGET) }
     }
 
     /// Whether the budget of polygon pairs ran out (some surfaces were meshed uncut).
@@ -83,21 +170,24 @@ impl<'a> Contacts<'a> {
         self.pairs_left.get() == 0
     }
 
-    /// The candidates whose bounding boxes touch `[lo, hi]` widened by `eps`, or none once
-    /// the budget is spent.
+    /// The candidates whose bounding boxes touch `[lo, hi]` widened by `eps`, in candidate
+    /// order, or none once the budget is spent.
     fn near(
         &self,
         lo: DVec3,
         hi: DVec3,
         eps: f64,
     ) -> impl Iterator<Item = &(PolygonId, &'a Polygon, DVec3, DVec3)> {
-        let n = self.candidates.len() as u64;
+        let (lo, hi) = (lo - eps, hi + eps);
+        let listed = self.grid.near(lo, hi);
+        let n = listed.len() as u64;
         let left = self.pairs_left.get();
         let allowed = left >= n;
         self.pairs_left.set(if allowed { left - n } else { 0 });
-        self.candidates
-            .iter()
-            .filter(move |c| allowed && c.2.cmple(hi + eps).all() && c.3.cmpge(lo - eps).all())
+        listed
+            .into_iter()
+            .map(|k| &self.candidates[k as usize])
+            .filter(move |c| allowed && c.2.cmple(hi).all() && c.3.cmpge(lo).all())
     }
 
     /// Whether polygon `id` lies flat against another polygon and within it, facing it (a
@@ -210,7 +300,7 @@ impl<'a> Contacts<'a> {
         let eps = tolerance(target);
         let (n, d) = plane(target);
         let height = |q: DVec3| n.dot(q) - d;
-        let mut edges: Vec<(DVec3, DVec3, DVec3)> = Vec::new();
+        let mut edges: Vec<Edge> = Vec::new();
         // A solid that stands partly over the edge is seen whole: faces up to the target's
         // size beyond it count.
         for &(other, p, _, _) in self.near(lo, hi, lo.distance(hi)) {
@@ -227,7 +317,8 @@ impl<'a> Contacts<'a> {
                 let j = (i + 1) % pv.len();
                 if heights[i].abs() <= eps && heights[j].abs() <= eps {
                     // Onto the plane exactly, so the loop's corners are the target's plane.
-                    edges.push((pv[i] - n * heights[i], pv[j] - n * heights[j], p.normal()));
+                    let centre = pv.iter().copied().sum::<DVec3>() / pv.len() as f64;
+                    edges.push((pv[i] - n * heights[i], pv[j] - n * heights[j], p.normal(), centre));
                 }
             }
         }
@@ -244,6 +335,9 @@ impl<'a> Contacts<'a> {
     /// Whether `p`, a point of a footprint on a plane with normal `n`, lies inside a closed
     /// solid: the first face straight above it is met from behind. An open box or a cup
     /// standing on a table leaves the table inside it lit, so that footprint must not cut.
+    /// Faces met at the same height (a table leg's top against the table top's underside)
+    /// count as one: met from behind if any of them is, since the point is inside the solid
+    /// whose face that is.
     fn enclosed(&self, p: DVec3, n: DVec3, eps: f64) -> bool {
         let origin = p + n * eps;
         let far = DVec3::splat(f64::INFINITY);
@@ -255,16 +349,24 @@ impl<'a> Contacts<'a> {
                 continue;
             }
             let t = pn.dot(poly.vertices()[0] - origin) / denominator;
-            if t > 0.0
-                && first.is_none_or(|(best, _)| t < best)
-                && contains_within(poly.vertices(), pn, origin + n * t, 0.0)
-            {
-                first = Some((t, denominator > 0.0));
+            if t <= 0.0 || !contains_within(poly.vertices(), pn, origin + n * t, 0.0) {
+                continue;
             }
+            let behind = denominator > 0.0;
+            first = match first {
+                Some((best, b)) if (t - best).abs() <= eps => Some((best.min(t), b || behind)),
+                Some((best, _)) if t < best => Some((t, behind)),
+                None => Some((t, behind)),
+                keep => keep,
+            };
         }
         first.is_some_and(|(_, from_behind)| from_behind)
     }
 }
+
+/// An edge of a face standing on a surface: its two corners on the surface's plane, the
+/// face's normal and the face's vertex mean.
+type Edge = (DVec3, DVec3, DVec3, DVec3);
 
 /// The bounding box of `v` (not empty).
 fn bounds(v: &[DVec3]) -> (DVec3, DVec3) {
@@ -298,14 +400,42 @@ fn key(p: DVec3) -> [u64; 3] {
 /// them) around which every edge's face turns its lit side outwards: the outline of a solid
 /// standing on the plane whose normal is `n`, not the walls of a room standing around its
 /// floor. A corner that does not join exactly two edges ends its component: no loop.
-fn chain(edges: &[(DVec3, DVec3, DVec3)], n: DVec3) -> Vec<Vec<DVec3>> {
-    let mut next: HashMap<[u64; 3], Vec<DVec3>> = HashMap::new();
-    let mut face_normal = HashMap::new();
-    for &(a, b, normal) in edges {
+///
+/// An edge of two faces back to back (a sofa's seat and its arm, two boxes pressed side by
+/// side) lies inside the outline of the two and is dropped, so that they stand on one
+/// footprint: kept, it met the two boxes' other edges at corners of three, and the floor
+/// under the sofa was meshed uncut. (A face given twice, once each way round, as some
+/// models give their faces, is one face: its two copies share their centre.)
+fn chain(edges: &[Edge], n: DVec3) -> Vec<Vec<DVec3>> {
+    let pair_of = |a: DVec3, b: DVec3| {
         let (ka, kb) = (key(a), key(b));
-        let pair = if ka < kb { (ka, kb) } else { (kb, ka) };
-        // The same edge from two faces (a shell modelled with both sides) counts once.
-        if ka == kb || face_normal.insert(pair, normal).is_some() {
+        if ka < kb { (ka, kb) } else { (kb, ka) }
+    };
+    let mut face_normal = HashMap::new();
+    let mut first_face = HashMap::new();
+    let mut inside = std::collections::HashSet::new();
+    for &(a, b, normal, centre) in edges {
+        if key(a) == key(b) {
+            continue;
+        }
+        let pair = pair_of(a, b);
+        match first_face.get(&pair) {
+            None => {
+                face_normal.insert(pair, normal);
+                first_face.insert(pair, (normal, centre));
+            }
+            Some(&(first, at)) if first.dot(normal) < 0.0 && key(at) != key(centre) => {
+                inside.insert(pair);
+            }
+            // The same face again: it counts once.
+            Some(_) => {}
+        }
+    }
+    let mut next: HashMap<[u64; 3], Vec<DVec3>> = HashMap::new();
+    let mut added = std::collections::HashSet::new();
+    for &(a, b, _, _) in edges {
+        let pair = pair_of(a, b);
+        if key(a) == key(b) || inside.contains(&pair) || !added.insert(pair) {
             continue;
         }
         next.entry(key(a)).or_default().push(b);
@@ -565,6 +695,55 @@ mod tests {
             .into_iter()
             .filter(|p| p.normal().y > 0.5);
         assert!((cut_of(no_lid.into_iter().chain(lid).collect()).unwrap() - 1.0).abs() < 1e-9);
+    }
+
+    /// Boxes pressed side by side (a sofa's seat between its arms, in one object) stand on
+    /// the union of their footprints; a box whose faces are each given twice, once each way
+    /// round, still stands on its own.
+    #[test]
+    fn boxes_side_by_side_stand_on_one_footprint() {
+        let cut_of = |block: Vec<Polygon>| {
+            let scene = floor_and(block);
+            let contacts = Contacts::new(&scene);
+            let Shape::Polygons(floor) = &scene.objects[0].shape else { unreachable!() };
+            contacts
+                .cut(&floor[0], Some(PolygonId { object: 0, index: 0 }), |q| (q.area() * 100.0) as usize)
+                .map(|c| c.hidden)
+        };
+        let cuboid = |x0: f64, x1: f64, top: f64| {
+            box_faces(DVec3::new(x0, 0.0, 1.0), DVec3::new(x1, top, 1.8), Facing::Outward, 0.0).unwrap()
+        };
+        let sofa: Vec<Polygon> =
+            [cuboid(0.8, 1.0, 0.62), cuboid(1.0, 3.2, 0.42), cuboid(3.2, 3.4, 0.62)].concat();
+        let hidden = cut_of(sofa).expect("the sofa cuts the floor");
+        assert!((hidden - 2.6 * 0.8).abs() < 1e-9, "{hidden}");
+        let both_ways: Vec<Polygon> = cuboid(1.0, 2.0, 1.0)
+            .into_iter()
+            .flat_map(|p| {
+                let back = Polygon::try_new(p.vertices().iter().rev().copied().collect()).unwrap();
+                [p, back]
+            })
+            .collect();
+        let hidden = cut_of(both_ways).expect("a box given both ways round cuts the floor");
+        assert!((hidden - 0.8).abs() < 1e-9, "{hidden}");
+    }
+
+    /// A table leg under its table top: straight above the leg's footprint, the leg's top
+    /// and the top's underside meet at one height, and the leg's footprint still cuts (the
+    /// underside, met first from the front, once made it look open to the light).
+    #[test]
+    fn a_leg_under_a_table_top_cuts_its_footprint() {
+        let leg =
+            box_faces(DVec3::new(1.0, 0.0, 1.0), DVec3::new(1.2, 1.0, 1.2), Facing::Outward, 0.0).unwrap();
+        let top =
+            box_faces(DVec3::new(0.5, 1.0, 0.5), DVec3::new(2.5, 1.1, 2.5), Facing::Outward, 0.0).unwrap();
+        let scene = floor_and([top, leg].concat());
+        let contacts = Contacts::new(&scene);
+        let Shape::Polygons(floor) = &scene.objects[0].shape else { unreachable!() };
+        let cut = contacts
+            .cut(&floor[0], Some(PolygonId { object: 0, index: 0 }), |q| (q.area() * 100.0) as usize)
+            .expect("the leg cuts the floor");
+        assert!((cut.hidden - 0.04).abs() < 1e-9, "{}", cut.hidden);
     }
 
     /// A footprint half off the surface's edge hides only the part on it.
