@@ -349,15 +349,8 @@ fn rgb(v: &serde_json::Value) -> Vec<f64> {
     v.as_array().unwrap().iter().map(|c| c.as_f64().unwrap()).collect()
 }
 
-/// A two-sided plate halfway between a lamp below (facing up) and one above (facing down):
-/// both faces are lit alike, and each is reported.
-#[test]
-fn a_two_sided_plate_between_two_lamps_is_lit_on_both_faces() {
-    let dir = tempfile::tempdir().unwrap();
-    let scene = dir.path().join("plate.toml");
-    std::fs::write(
-        &scene,
-        r#"[[material]]
+/// A two-sided plate halfway between a lamp below (facing up) and one above (facing down).
+pub(crate) const PLATE_BETWEEN_LAMPS: &str = r#"[[material]]
 name = "lamp"
 reflectance = [0, 0, 0]
 emission = [1, 1, 1]
@@ -380,9 +373,15 @@ name = "plate"
 type = "polygon"
 material = "paper"
 vertices = [[0, 1, 0], [0, 1, 1], [1, 1, 1], [1, 1, 0]]
-"#,
-    )
-    .unwrap();
+"#;
+
+/// A two-sided plate halfway between a lamp below (facing up) and one above (facing down):
+/// both faces are lit alike, and each is reported.
+#[test]
+fn a_two_sided_plate_between_two_lamps_is_lit_on_both_faces() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("plate.toml");
+    std::fs::write(&scene, PLATE_BETWEEN_LAMPS).unwrap();
     let report = solve_json(&scene, &[]);
     let plate = object(&report, "plate");
     let (front, back) = (rgb(&plate["radiosity"]), rgb(&plate["radiosity_back"]));

@@ -159,34 +159,7 @@ fn render_reference_and_compare() {
 fn verify_sums_front_and_back_faces_apart() {
     let dir = tempfile::tempdir().unwrap();
     let scene = dir.path().join("plate.toml");
-    std::fs::write(
-        &scene,
-        r#"[[material]]
-name = "lamp"
-reflectance = [0, 0, 0]
-emission = [1, 1, 1]
-[[material]]
-name = "paper"
-reflectance = [0.5, 0.5, 0.5]
-sides = 2
-[[object]]
-name = "below"
-type = "polygon"
-material = "lamp"
-vertices = [[0, 0, 0], [0, 0, 1], [1, 0, 1], [1, 0, 0]]
-[[object]]
-name = "above"
-type = "polygon"
-material = "lamp"
-vertices = [[0, 2, 0], [1, 2, 0], [1, 2, 1], [0, 2, 1]]
-[[object]]
-name = "plate"
-type = "polygon"
-material = "paper"
-vertices = [[0, 1, 0], [1, 1, 0], [1, 1, 1], [0, 1, 1]]
-"#,
-    )
-    .unwrap();
+    std::fs::write(&scene, crate::cli::PLATE_BETWEEN_LAMPS).unwrap();
     let r = verify_json(&[scene.to_str().unwrap(), "--paths", "20000"]);
     let summary = &r["summary"];
     let (front, back) = (&summary["front_faces"], &summary["back_faces"]);

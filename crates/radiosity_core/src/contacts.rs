@@ -658,43 +658,45 @@ mod tests {
         );
     }
 
+    /// The floor's hidden area with `block` on it, or `None` when it is not cut.
+    fn hidden_under(block: Vec<Polygon>) -> Option<f64> {
+        let scene = floor_and(block);
+        let contacts = Contacts::new(&scene);
+        let Shape::Polygons(floor) = &scene.objects[0].shape else { unreachable!() };
+        contacts
+            .cut(&floor[0], Some(PolygonId { object: 0, index: 0 }), |q| (q.area() * 100.0) as usize)
+            .map(|c| c.hidden)
+    }
+
     /// A box floating above the floor, or one sunk through it, or open at the bottom in a way
     /// that leaves no closed outline: nothing is cut.
     #[test]
     fn only_solids_standing_on_the_surface_cut_it() {
-        let cut_of = |block: Vec<Polygon>| {
-            let scene = floor_and(block);
-            let contacts = Contacts::new(&scene);
-            let Shape::Polygons(floor) = &scene.objects[0].shape else { unreachable!() };
-            contacts
-                .cut(&floor[0], Some(PolygonId { object: 0, index: 0 }), |q| (q.area() * 100.0) as usize)
-                .map(|c| c.hidden)
-        };
         let floating =
             box_faces(DVec3::new(1.0, 0.1, 1.0), DVec3::new(2.0, 1.0, 2.0), Facing::Outward, 0.0).unwrap();
-        assert_eq!(cut_of(floating), None);
+        assert_eq!(hidden_under(floating), None);
         let sunk =
             box_faces(DVec3::new(1.0, -0.5, 1.0), DVec3::new(2.0, 1.0, 2.0), Facing::Outward, 0.0).unwrap();
-        assert_eq!(cut_of(sunk), None);
+        assert_eq!(hidden_under(sunk), None);
         // Three sides of a box: the outline does not close.
         let mut open =
             box_faces(DVec3::new(1.0, 0.0, 1.0), DVec3::new(2.0, 1.0, 2.0), Facing::Outward, 0.0).unwrap();
         open.retain(|p| p.normal().x < 0.5 && p.normal().y.abs() < 0.5);
-        assert_eq!(cut_of(open), None);
+        assert_eq!(hidden_under(open), None);
         // Four sides and no lid: the floor inside is lit from above.
         let mut no_lid =
             box_faces(DVec3::new(1.0, 0.0, 1.0), DVec3::new(2.0, 1.0, 2.0), Facing::Outward, 0.0).unwrap();
         no_lid.retain(|p| p.normal().y.abs() < 0.5);
-        assert_eq!(cut_of(no_lid.clone()), None);
+        assert_eq!(hidden_under(no_lid.clone()), None);
         let standing =
             box_faces(DVec3::new(1.0, 0.0, 1.0), DVec3::new(2.0, 1.0, 2.0), Facing::Outward, 0.0).unwrap();
-        assert!((cut_of(standing).unwrap() - 1.0).abs() < 1e-9);
+        assert!((hidden_under(standing).unwrap() - 1.0).abs() < 1e-9);
         // The same sides with a lid and no bottom (how the Cornell box's blocks are given).
         let lid = box_faces(DVec3::new(1.0, 0.0, 1.0), DVec3::new(2.0, 1.0, 2.0), Facing::Outward, 0.0)
             .unwrap()
             .into_iter()
             .filter(|p| p.normal().y > 0.5);
-        assert!((cut_of(no_lid.into_iter().chain(lid).collect()).unwrap() - 1.0).abs() < 1e-9);
+        assert!((hidden_under(no_lid.into_iter().chain(lid).collect()).unwrap() - 1.0).abs() < 1e-9);
     }
 
     /// Boxes pressed side by side (a sofa's seat between its arms, in one object) stand on
@@ -702,20 +704,12 @@ mod tests {
     /// round, still stands on its own.
     #[test]
     fn boxes_side_by_side_stand_on_one_footprint() {
-        let cut_of = |block: Vec<Polygon>| {
-            let scene = floor_and(block);
-            let contacts = Contacts::new(&scene);
-            let Shape::Polygons(floor) = &scene.objects[0].shape else { unreachable!() };
-            contacts
-                .cut(&floor[0], Some(PolygonId { object: 0, index: 0 }), |q| (q.area() * 100.0) as usize)
-                .map(|c| c.hidden)
-        };
         let cuboid = |x0: f64, x1: f64, top: f64| {
             box_faces(DVec3::new(x0, 0.0, 1.0), DVec3::new(x1, top, 1.8), Facing::Outward, 0.0).unwrap()
         };
         let sofa: Vec<Polygon> =
             [cuboid(0.8, 1.0, 0.62), cuboid(1.0, 3.2, 0.42), cuboid(3.2, 3.4, 0.62)].concat();
-        let hidden = cut_of(sofa).expect("the sofa cuts the floor");
+        let hidden = hidden_under(sofa).expect("the sofa cuts the floor");
         assert!((hidden - 2.6 * 0.8).abs() < 1e-9, "{hidden}");
         let both_ways: Vec<Polygon> = cuboid(1.0, 2.0, 1.0)
             .into_iter()
@@ -724,7 +718,7 @@ mod tests {
                 [p, back]
             })
             .collect();
-        let hidden = cut_of(both_ways).expect("a box given both ways round cuts the floor");
+        let hidden = hidden_under(both_ways).expect("a box given both ways round cuts the floor");
         assert!((hidden - 0.8).abs() < 1e-9, "{hidden}");
     }
 
@@ -737,13 +731,8 @@ mod tests {
             box_faces(DVec3::new(1.0, 0.0, 1.0), DVec3::new(1.2, 1.0, 1.2), Facing::Outward, 0.0).unwrap();
         let top =
             box_faces(DVec3::new(0.5, 1.0, 0.5), DVec3::new(2.5, 1.1, 2.5), Facing::Outward, 0.0).unwrap();
-        let scene = floor_and([top, leg].concat());
-        let contacts = Contacts::new(&scene);
-        let Shape::Polygons(floor) = &scene.objects[0].shape else { unreachable!() };
-        let cut = contacts
-            .cut(&floor[0], Some(PolygonId { object: 0, index: 0 }), |q| (q.area() * 100.0) as usize)
-            .expect("the leg cuts the floor");
-        assert!((cut.hidden - 0.04).abs() < 1e-9, "{}", cut.hidden);
+        let hidden = hidden_under([top, leg].concat()).expect("the leg cuts the floor");
+        assert!((hidden - 0.04).abs() < 1e-9, "{hidden}");
     }
 
     /// A footprint half off the surface's edge hides only the part on it.
