@@ -12,8 +12,11 @@
 //! by its ray's share of the visibility (an eighth from a bright shooter, all of it from a
 //! dim one, whose shot is small). Adaptive subdivision puts the smallest elements on shadow
 //! edges, where rays graze the blockers' edges (the seed room: 0.21 % of its 17.9 k elements
-//! differ). So: every element within 1e-5 relative, except at most 0.3 % of
-//! elements, none of them off by more than 5 %; per-object means within 1e-4.
+//! differed). A shooter's row is also computed again when its unshot power has drifted past a
+//! threshold (`first_shots`), a decision that 1e-7 apart can take one way on one path and the
+//! other on the other; with it the seed room has 0.33 % of its elements off. So: every element
+//! within 1e-5 relative, except at most 0.5 % of elements, none of them off by more than 5 %;
+//! per-object means within 1e-4.
 
 use radiosity_core::{Scene, furnace_box, two_plates, unit_cube_floor_light};
 use radiosity_solver::{Problem, Solution, SolverParams};
@@ -49,7 +52,7 @@ fn compare(name: &str, scene: &Scene, max_shots: u64) {
         }
     }
     let n = mesh.elements.len();
-    assert!(off * 1000 <= 3 * n, "{name}: {off} of {n} elements differ");
+    assert!(off * 1000 <= 5 * n, "{name}: {off} of {n} elements differ");
     let (fo, ro) = (fast.object_radiosity(mesh), reference.object_radiosity(mesh));
     for (f, r) in fo.iter().zip(&ro) {
         for (x, y) in [(f.radiosity.r, r.radiosity.r), (f.radiosity.g, r.radiosity.g)] {

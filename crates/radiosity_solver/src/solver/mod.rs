@@ -9,8 +9,9 @@
 //!
 //! A patch shoots several times as light comes back to it. Its rays are drawn from a stream
 //! keyed by the shooter (not the shot) and end where its unshot power was at its first shot,
-//! so each of its shots has the same row of form factors F_{j→i}; the row is kept (within
-//! `SolverParams::row_cache_bytes`) and a later shot is one multiply-add per receiver.
+//! so its shots have the same row of form factors F_{j→i} until the spread of its unshot
+//! power moves (see `first_shots`); the row is kept (within `SolverParams::row_cache_bytes`)
+//! and a later shot is one multiply-add per receiver.
 //!
 //! Options: the ambient term of Cohen et al. 1988 §4 for early display, and overshooting by
 //! over-relaxation (Gortler, Cohen & Slusallek 1993, "Radiosity and relaxation methods"):

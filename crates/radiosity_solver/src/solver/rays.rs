@@ -54,6 +54,20 @@ impl Packet {
 /// a factor 1.8 over the shooter, and visibility seldom varies with it.
 const NEAR: f64 = 3.0;
 
+/// Whether element `e` is near the shooter: its centre within [`NEAR`] shooter radii of the
+/// shooter's centre.
+pub(super) fn near(shot: &Shot, e: usize) -> bool {
+    let limit = NEAR * shot.shooter_radius;
+    shot.vertex_means[e].distance_squared(shot.shooter.centre) < limit * limit
+}
+
+/// Whether some element of patch `q` may be [`near`] the shooter.
+pub(super) fn patch_near(shot: &Shot, q: usize) -> bool {
+    let patch = &shot.mesh.patches[q];
+    let radius = patch.corners().iter().map(|c| c.distance(patch.centre)).fold(0.0, f64::max);
+    patch.centre.distance(shot.shooter.centre) < NEAR * shot.shooter_radius + radius
+}
+
 /// A near receiver draws its ray ends by the kernel only when its circumradius is at most
 /// this share of its centre's distance to the shooter.
 const SMALL: f64 = 0.5;
@@ -86,11 +100,10 @@ impl NearEnds {
     /// The kernel's table for element `e`, or `None` when it is far from the shooter (or sees
     /// none of it).
     fn new(shot: &Shot, e: usize) -> Option<Self> {
-        let centre = shot.vertex_means[e];
-        let limit = NEAR * shot.shooter_radius;
-        if centre.distance_squared(shot.shooter.centre) >= limit * limit {
+        if !near(shot, e) {
             return None;
         }
+        let centre = shot.vertex_means[e];
         // The kernel is taken at the centre, so it must stand for the whole element: not for
         // an element as large as its distance (a floor element along a wall's foot), whose
         // ends would crowd where its centre is nearest.

@@ -9,7 +9,7 @@ use radiosity_core::{Mesh, Patch};
 use super::FormFactorMethod;
 use super::plans::PatchPlan;
 use super::quadrature::element_quadrature;
-use super::rays::{Packet, Rays, draw, trace};
+use super::rays::{Packet, Rays, draw, near, patch_near, trace};
 use super::shot::Shot;
 use super::uneven::density_weight;
 use crate::form_factor::{
@@ -106,7 +106,7 @@ fn unoccluded(shot: &Shot, plan: &PatchPlan, e: usize) -> (f64, f64) {
                     }
                 });
             }
-            if let Some(uneven) = uneven.filter(|_| plan.touching) {
+            if let Some(uneven) = uneven.filter(|_| plan.touching || near(shot, e)) {
                 // A receiver on or across the shooter's plane sees only part of it (a block
                 // side sees the floor in front of it, not under it), so the shooter's mean
                 // unshot radiosity is wrong for it when that radiosity is uneven: the
@@ -155,7 +155,13 @@ pub(super) fn receive_patch(shot: &Shot, plan: &PatchPlan, q: usize, first: usiz
 /// same formula and points as [`unoccluded`]).
 fn unoccluded_factors(shot: &Shot, plan: &PatchPlan, first: usize, out: &mut [Received]) {
     let params = shot.params;
-    if plan.facing && plan.far && !params.reference_path && params.form_factor == FormFactorMethod::Exact {
+    let weighted = shot.uneven.is_some() && patch_near(shot, shot.mesh.elements[first].patch as usize);
+    if plan.facing
+        && plan.far
+        && !weighted
+        && !params.reference_path
+        && params.form_factor == FormFactorMethod::Exact
+    {
         let corners = shot.shooter.corners();
         for (c, chunk) in out.chunks_mut(4).enumerate() {
             let base = first + 4 * c;

@@ -145,11 +145,11 @@ impl Solver {
     }
 }
 
-/// An uneven shooter's weighting moves power between the receivers that touch it: a block
-/// side sees the dark floor in front of it and gets less than the patch's mean would give it.
-/// That power is not lost: the shooter's lit elements send it to the rest of the scene, which
-/// sees the patch whole (in a closed scene every element of a patch sends all its power
-/// somewhere, Σ_j F_kj = 1). So the other receivers' form factors are scaled to keep the
+/// An uneven shooter's weighting moves power between the receivers that touch it or are near
+/// it: a block side sees the dark floor in front of it and gets less than the patch's mean
+/// would give it. That power is not lost: the shooter's lit elements send it to the rest of
+/// the scene, which sees the patch whole (in a closed scene every element of a patch sends all
+/// its power somewhere, Σ_j F_kj = 1). So the other (unweighted) receivers' form factors are scaled to keep the
 /// row's total Σ_j A_j F_j what it is without the weighting (by reciprocity A_j F_j is
 /// the shooter's power share going to j). Without this the Cornell ceiling, lit only by
 /// such transfers, came out 1.2 % dark.
@@ -160,11 +160,12 @@ fn keep_uneven_power(
     factors: &mut [Received],
 ) {
     let elements = |q: usize| patch_elements[q].clone();
+    let weighted = |r: &Received| r.unoccluded != r.unweighted;
     let (mut moved, mut rest) = (0.0, 0.0);
-    for (q, plan) in plans.iter().enumerate().filter(|(_, p)| p.live) {
+    for (q, _) in plans.iter().enumerate().filter(|(_, p)| p.live) {
         for e in elements(q) {
             let (r, area) = (&factors[e], element_area[e]);
-            if plan.touching {
+            if weighted(r) {
                 moved += area * (r.unweighted_factor() - r.factor());
             } else {
                 rest += area * r.factor();
@@ -174,10 +175,10 @@ fn keep_uneven_power(
     if rest <= 0.0 || moved == 0.0 {
         return;
     }
-    // Bounded: a shooter seen almost only by its touching neighbours has little to pass on.
+    // Bounded: a shooter seen almost only by its weighted neighbours has little to pass on.
     let scale = ((rest + moved) / rest).clamp(0.5, 2.0);
-    for (q, _) in plans.iter().enumerate().filter(|(_, p)| p.live && !p.touching) {
-        for r in &mut factors[elements(q)] {
+    for (q, _) in plans.iter().enumerate().filter(|(_, p)| p.live) {
+        for r in factors[elements(q)].iter_mut().filter(|r| !weighted(r)) {
             r.unoccluded *= scale;
             r.unweighted *= scale;
         }

@@ -1,6 +1,7 @@
 //! Rows kept across shots. A patch shoots several times as light comes back to it; its rays
 //! come from a stream keyed by the shooter and end where its unshot power was at its first
-//! shot, so each of its shots has the same row of form factors. The row is kept (within
+//! shot, so its shots have the same row of form factors until that spread is fixed again
+//! (see `first_shots`; the row is then dropped, [`RowCache::forget`]). The row is kept (within
 //! `SolverParams::row_cache_bytes`) and a later shot is one multiply-add per receiver; past
 //! the budget, the row's patch plans (geometry only) are kept instead, up to
 //! [`PLAN_CACHE_ENTRIES`].
@@ -54,6 +55,14 @@ impl RowCache {
     /// Takes `shooter`'s kept row out, if it has one; hand it back with [`RowCache::keep`].
     pub(super) fn take(&mut self, shooter: usize) -> Option<Row> {
         self.rows[shooter].take()
+    }
+
+    /// Drops `shooter`'s kept row, if any: it no longer holds.
+    pub(super) fn forget(&mut self, shooter: usize) {
+        if let Some(row) = self.rows[shooter].take() {
+            self.row_bytes -= row.bytes();
+            self.kept.retain(|&k| k != shooter);
+        }
     }
 
     /// `shooter`'s kept plans, if its row was computed before and its plans kept.

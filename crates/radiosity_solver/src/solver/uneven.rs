@@ -11,8 +11,9 @@ use crate::form_factor::point_to_point;
 use crate::shaft::bounds;
 
 /// A shooter with an element whose unshot density strays from the mean by more than this
-/// share weights the form factors of the receivers that touch it (see `receive`). The density
-/// is fixed at the shooter's first shot, so only strong, lasting structure is trusted:
+/// share weights the form factors of the receivers that touch it or are near it (see
+/// `receive`). The density is fixed with the shooter's row (see `first_shots`), so only
+/// strong, lasting structure is trusted:
 /// shadows and contact lines (a block standing on the patch: dark under it on every shot),
 /// not the gentle gradients of indirect light, which change from shot to shot. Measured: at
 /// 0.05 the ρ = 0.5 furnace's elements drift 2.4 % from E/(1 − ρ); at 0.5 they stay within
