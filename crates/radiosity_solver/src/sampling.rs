@@ -73,7 +73,7 @@ impl Strata {
 
 /// The largest f32 below 1: a jittered coordinate rounded up to 1 is clamped back into its
 /// cell's half-open range.
-const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
+pub(crate) const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
 
 /// The point at `(u, v)` ∈ [0,1)² on a triangle or convex quad in single precision: the map
 /// of [`point_on`], for ray origins that are traced in single precision anyway.

@@ -27,7 +27,7 @@ const DRIFT: f64 = 0.2;
 /// Per shooter, what its first shot fixed.
 pub(super) struct FirstShots {
     /// Per element, the cumulative share of its patch's unshot power over the patch's
-    /// elements, fixed at the patch's first shot.
+    /// elements, fixed at the patch's first shot and again when it drifts.
     cdf: Vec<f64>,
     /// Per patch, whether it has shot.
     frozen: Vec<bool>,

@@ -2,7 +2,7 @@
 //! element neighbours, and the ray-skipping structures over the blocking triangles.
 
 use glam::{DVec3, Vec3A};
-use radiosity_core::{Mesh, Rgb};
+use radiosity_core::{Mesh, Patch, Rgb};
 
 use super::SolverError;
 use crate::occluders::{OccluderBoxes, blocking_triangles};
@@ -191,6 +191,11 @@ fn lift_corners(mesh: &Mesh, offset: f64) -> Vec<[Vec3A; 4]> {
 fn element_radius(mesh: &Mesh, e: usize) -> f64 {
     let c = mesh.elements[e].centre;
     mesh.element_corners(e).map(|p| p.distance(c)).fold(0.0, f64::max)
+}
+
+/// A patch's circumradius about its centre.
+pub(super) fn patch_radius(patch: &Patch) -> f64 {
+    patch.corners().iter().map(|c| c.distance(patch.centre)).fold(0.0, f64::max)
 }
 
 #[cfg(test)]

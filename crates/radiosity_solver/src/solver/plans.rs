@@ -7,7 +7,7 @@
 use glam::DVec3;
 use radiosity_core::Mesh;
 
-use super::mesh_tables::MeshTables;
+use super::mesh_tables::{MeshTables, patch_radius};
 use super::parallel::for_each_maybe_parallel;
 use super::quadrature::MIDPOINT_RATIO;
 use crate::form_factor::distance_to_polygon;
@@ -121,7 +121,7 @@ fn plan_patch(
     plan.shooter_ahead = shooter_ahead;
     // Each element's own test (`quadrature`) is k·r_e < d(c_e) − r_e, and d(c_e) ≥ d(c_q) − r_q for
     // every element centre c_e of the patch, so this implies it for all of them.
-    let patch_radius = r.corners().iter().map(|p| p.distance(r.centre)).fold(0.0, f64::max);
+    let patch_radius = patch_radius(r);
     plan.far = (MIDPOINT_RATIO + 1.0) * tables.patch_element_radius[q]
         < distance_to_polygon(r.centre, shooter.normal, corners) - patch_radius;
     plan.visibility = tables.blockers.gather(

@@ -6,12 +6,13 @@
 use glam::{DVec3, Vec3};
 use radiosity_accel::Segments4;
 
+use super::mesh_tables::patch_radius;
 use super::plans::PatchPlan;
 use super::ray_ends::{shooter_point, target_cell};
 use super::receive::{corners_of, element_facing};
 use super::shot::Shot;
 use crate::form_factor::distance_to_polygon;
-use crate::sampling::{Rng, Strata, four_units, point_on, point_on_f32};
+use crate::sampling::{ONE_BELOW, Rng, Strata, four_units, point_on, point_on_f32};
 use crate::shaft::{FEW, Visibility, bounds};
 
 /// Key bit of an element's penumbra-ray stream, apart from its pilot-ray stream.
@@ -64,8 +65,7 @@ pub(super) fn near(shot: &Shot, e: usize) -> bool {
 /// Whether some element of patch `q` may be [`near`] the shooter.
 pub(super) fn patch_near(shot: &Shot, q: usize) -> bool {
     let patch = &shot.mesh.patches[q];
-    let radius = patch.corners().iter().map(|c| c.distance(patch.centre)).fold(0.0, f64::max);
-    patch.centre.distance(shot.shooter.centre) < NEAR * shot.shooter_radius + radius
+    patch.centre.distance(shot.shooter.centre) < NEAR * shot.shooter_radius + patch_radius(patch)
 }
 
 /// A near receiver draws its ray ends by the kernel only when its circumradius is at most
@@ -119,8 +119,8 @@ impl NearEnds {
         let mut total = 0.0;
         for (r, c) in cumulative[..runs].iter_mut().enumerate() {
             let (first, end) = (r * per_run, ((r + 1) * per_run).min(elements.len()));
-            let below = if first == 0 { 0.0 } else { shot.cdf[first - 1] };
-            let share = shot.cdf[end - 1] - below;
+            let (below, above) = shares(shot.cdf, first..end);
+            let share = above - below;
             let d = elements[(first + end) / 2].centre - centre;
             let r2 = d.length_squared();
             if r2 > 0.0 {
@@ -137,9 +137,13 @@ impl NearEnds {
         let cumulative = &self.cumulative[..self.runs];
         let at = f64::from(t) * cumulative[self.runs - 1];
         let r = cumulative.partition_point(|&c| c <= at).min(self.runs - 1);
-        let (first, end) = (r * self.per_run, ((r + 1) * self.per_run).min(cdf.len()));
-        (if first == 0 { 0.0 } else { cdf[first - 1] }, cdf[end - 1])
+        shares(cdf, r * self.per_run..((r + 1) * self.per_run).min(cdf.len()))
     }
+}
+
+/// The cumulative shares below and at the end of the shooter elements `run` (not empty).
+fn shares(cdf: &[f64], run: std::ops::Range<usize>) -> (f64, f64) {
+    (if run.start == 0 { 0.0 } else { cdf[run.start - 1] }, cdf[run.end - 1])
 }
 
 /// Draws element `e`'s `rays` to the shooter and hands each segment to `ray` (see
@@ -285,9 +289,6 @@ fn draw_rays(
         (strata.jitter(stratum, rng), strata.jitter(stratum, rng))
     });
 }
-
-/// The largest f32 below 1.
-const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
 
 /// [`draw_rays`] for `count` rays whose `(u, v)` on the element and `(a, b)` on the shooter
 /// come from `sample`; `rng` draws the redraws.

@@ -67,7 +67,7 @@ impl Solver {
         let first_of_solve = self.progress.shots == 0;
         self.first_shots.freeze(&mesh, shooter, &self.tally, first_of_solve, self.params.bright_share);
         let bright = self.first_shots.bright(shooter);
-        let shooter_radius = patch.corners().iter().map(|c| c.distance(patch.centre)).fold(0.0, f64::max);
+        let shooter_radius = super::mesh_tables::patch_radius(patch);
         let share = self.params.clustering && self.params.shared_visibility;
         let emits = super::clusters::patch_emits(&mesh, shooter);
         self.scratch.sharing.choose(&self.clusters, patch.centre, shooter_radius, emits, share, None);
@@ -149,8 +149,8 @@ impl Solver {
 /// it: a block side sees the dark floor in front of it and gets less than the patch's mean
 /// would give it. That power is not lost: the shooter's lit elements send it to the rest of
 /// the scene, which sees the patch whole (in a closed scene every element of a patch sends all
-/// its power somewhere, Σ_j F_kj = 1). So the other (unweighted) receivers' form factors are scaled to keep the
-/// row's total Σ_j A_j F_j what it is without the weighting (by reciprocity A_j F_j is
+/// its power somewhere, Σ_j F_kj = 1). So the other (unweighted) receivers' form factors are
+/// scaled to keep the row's total Σ_j A_j F_j what it is without the weighting (by reciprocity A_j F_j is
 /// the shooter's power share going to j). Without this the Cornell ceiling, lit only by
 /// such transfers, came out 1.2 % dark.
 fn keep_uneven_power(

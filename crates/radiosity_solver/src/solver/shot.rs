@@ -66,7 +66,8 @@ pub(super) struct Shot<'a> {
     pub(super) lifted_targets: &'a [Vec3],
     /// The shooter's elements.
     pub(super) shooter_elements: &'a [ShooterElement],
-    /// Their cumulative shares of its unshot power at its first shot (see `first_shots`).
+    /// Their cumulative shares of its unshot power when its spread was last fixed (see
+    /// `first_shots`).
     pub(super) cdf: &'a [f64],
     /// Every element's vertex mean (see `MeshTables::vertex_means`).
     pub(super) vertex_means: &'a [DVec3],
