@@ -127,6 +127,11 @@ pub struct RenderArgs {
     /// this many times --spp samples, 1 to 64; 1: as many as any pixel.
     #[arg(long, default_value_t = RenderParams::default().edge_factor, value_name = "N")]
     pub edge_factor: u32,
+    /// With a gather, pixels whose point sees part of the lamps and not all (a penumbra, or a
+    /// lamp cut by the surface's horizon, found by probe rays apart from the pixel's) take this
+    /// many times --shadow-rays, 1 to 64; 1: as many as any pixel.
+    #[arg(long, default_value_t = RenderParams::default().penumbra_factor, value_name = "N")]
+    pub penumbra_factor: u32,
     /// Eye position `x,y,z` (default: the scene's [camera], or one framing the scene).
     #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
     pub camera_position: Option<DVec3>,
@@ -248,8 +253,11 @@ pub fn run(a: RenderArgs) -> Result<()> {
         shadow_rays: a.shadow_rays,
         gather_rays: a.gather_rays,
         edge_factor: a.edge_factor,
+        penumbra_factor: a.penumbra_factor,
     };
-    params.validate().map_err(|e| input(format!("--width, --height, --spp, --edge-factor: {e}")))?;
+    params
+        .validate()
+        .map_err(|e| input(format!("--width, --height, --spp, --edge-factor, --penumbra-factor: {e}")))?;
     // Every target checked before the solve: folders, --force, and no file named twice.
     let mut targets = Targets::new(a.force);
     for (path, option) in [(&a.output, "-o"), (&a.exr, "--exr"), (&a.pfm, "--pfm")] {

@@ -59,6 +59,12 @@ impl Gather {
     }
 }
 
+/// Points [`Emitters::partly_seen`] probes on the emitters.
+const PROBES: u32 = 16;
+
+/// Largest f64 below 1.
+const ONE_BELOW: f64 = 1.0 - f64::EPSILON / 2.0;
+
 /// The emitting elements of a mesh, for sampling points on them by power.
 pub(crate) struct Emitters {
     /// One entry per emitting triangle (a quad element gives two): corners, the element's
@@ -68,6 +74,8 @@ pub(crate) struct Emitters {
     cdf: Vec<f64>,
     /// Σ over emitting triangles of Σ_c E_c · area.
     total_power: f64,
+    /// Fixed points spread over the emitters by power (see [`Emitters::partly_seen`]).
+    probes: Vec<EmitterSample>,
 }
 
 struct EmitterTriangle {
@@ -125,7 +133,41 @@ impl Emitters {
         if let Some(last) = cdf.last_mut() {
             *last = 1.0;
         }
-        Self { triangles, cdf, total_power: total }
+        let mut emitters = Self { triangles, cdf, total_power: total, probes: Vec::new() };
+        // A Hammersley set (radical inverse in base 2 against i/N): well spread over the
+        // emitters' power in both coordinates, the same for every point probed.
+        emitters.probes = (0..PROBES)
+            .filter_map(|i| {
+                let u = (f64::from(i) + 0.5) / f64::from(PROBES);
+                let v = f64::from(i.reverse_bits()) / 2f64.powi(32) + 0.5 / f64::from(PROBES);
+                emitters.sample(u, v.min(ONE_BELOW))
+            })
+            .collect();
+        emitters
+    }
+
+    /// Whether `x` (unit normal `n`) sees some of the emitters and not all of them, from
+    /// [`PROBES`] fixed points on them: a penumbra, or a lamp cut by `x`'s horizon. That is
+    /// where the direct light's estimate is noisy, so a picture spends more shadow rays
+    /// there; the answer comes from rays apart from the estimate's, so it does not bias it.
+    pub(crate) fn partly_seen(&self, rays: &dyn RayQuery, x: DVec3, n: DVec3, lift: f64) -> bool {
+        let origin = x + n * lift;
+        let (mut seen, mut hidden) = (false, false);
+        for s in &self.probes {
+            let d = s.point - x;
+            let visible = n.dot(d) > 0.0
+                && s.normal.dot(d) < 0.0
+                && !rays.occluded(origin.as_vec3(), s.point.as_vec3());
+            if visible {
+                seen = true;
+            } else {
+                hidden = true;
+            }
+            if seen && hidden {
+                return true;
+            }
+        }
+        false
     }
 
     /// Density per unit area with which [`Emitters::sample`] draws a point of an emitter of
@@ -298,6 +340,39 @@ mod tests {
         let expected = emission * 4.0 * corner;
         let got = h_est.to_array()[0];
         assert!((got / expected - 1.0).abs() < 5e-3, "irradiance {got} vs closed form {expected}");
+    }
+
+    /// A point sees part of a lamp when a blocker hides some of it, or its own horizon cuts
+    /// it; not when it sees all of the lamp or none.
+    #[test]
+    fn partly_seen_finds_penumbrae_and_horizons() {
+        let light = Material::try_new("light", Rgb::ZERO, Rgb::splat(1.0)).unwrap();
+        let polygon = Object {
+            name: "lamp".into(),
+            material: 0,
+            shape: Shape::Polygons(vec![Polygon::try_new(square(1.0, 0.5, false)).unwrap()]),
+            sides: radiosity_core::Sides::One,
+        };
+        let scene = Scene::try_new("lamp", None, vec![light], vec![polygon]).unwrap();
+        let mesh = Mesh::build(&scene, &MeshParams::try_new(0.5, 0.25).unwrap()).unwrap();
+        let emitters = Emitters::new(&mesh);
+        let open = radiosity_accel::BruteForce::new(&[]);
+        let up = DVec3::Z;
+        assert!(!emitters.partly_seen(&open, DVec3::ZERO, up, 1e-6), "in full view");
+        assert!(
+            emitters.partly_seen(&open, DVec3::new(0.0, 0.0, 0.5), DVec3::X, 1e-6),
+            "half behind the horizon"
+        );
+        assert!(!emitters.partly_seen(&open, DVec3::new(0.0, 0.0, 2.0), up, 1e-6), "above the lamp's back");
+        // A sheet at half height over x < 0 hides the half of the lamp beyond it.
+        let v = |x: f32, y: f32| glam::Vec3::new(x, y, 0.5);
+        // Single triangles: no shared edge for a probe ray to slip through.
+        let half = [[v(0.0, -5.0), v(0.0, 5.0), v(-5.0, 0.0)]];
+        let blocked_half = radiosity_accel::BruteForce::new(&half);
+        assert!(emitters.partly_seen(&blocked_half, DVec3::ZERO, up, 1e-6), "half hidden");
+        let whole = [[v(-5.0, -5.0), v(5.0, -5.0), v(0.0, 5.0)]];
+        let blocked = radiosity_accel::BruteForce::new(&whole);
+        assert!(!emitters.partly_seen(&blocked, DVec3::ZERO, up, 1e-6), "all hidden");
     }
 
     /// Cosine-weighted directions lie in the upper hemisphere and have mean cos θ = 2/3

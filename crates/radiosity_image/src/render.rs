@@ -80,6 +80,10 @@ pub struct RenderParams {
     /// or not all an emitter) take this many times `samples_per_pixel`, in 1..=64; 1 treats
     /// them as any other. Default 4.
     pub edge_factor: u32,
+    /// With a gather, pixels (and texels) whose point sees some of the emitters and not all
+    /// of them (a penumbra, or a lamp cut by the surface's horizon) take this many times
+    /// `shadow_rays`, in 1..=64; 1 treats them as any other. Default 4.
+    pub penumbra_factor: u32,
 }
 
 impl Default for RenderParams {
@@ -94,6 +98,7 @@ impl Default for RenderParams {
             shadow_rays: 2,
             gather_rays: 8,
             edge_factor: 4,
+            penumbra_factor: 4,
         }
     }
 }
@@ -105,7 +110,7 @@ impl RenderParams {
     pub const MAX_SAMPLES: u32 = 4096;
     /// Largest number of shadow or gathering rays per sample accepted.
     pub const MAX_GATHER_RAYS: u32 = 1024;
-    /// Largest [`RenderParams::edge_factor`] accepted.
+    /// Largest [`RenderParams::edge_factor`] and [`RenderParams::penumbra_factor`] accepted.
     pub const MAX_EDGE_FACTOR: u32 = 64;
 
     /// Small and quick, for thumbnails and tests: 160 × 120, 4 samples per pixel.
@@ -152,7 +157,8 @@ impl RenderParams {
         check("samples_per_pixel", self.samples_per_pixel, Self::MAX_SAMPLES)?;
         check("shadow_rays", self.shadow_rays, Self::MAX_GATHER_RAYS)?;
         check("gather_rays", self.gather_rays, Self::MAX_GATHER_RAYS)?;
-        check("edge_factor", self.edge_factor, Self::MAX_EDGE_FACTOR)
+        check("edge_factor", self.edge_factor, Self::MAX_EDGE_FACTOR)?;
+        check("penumbra_factor", self.penumbra_factor, Self::MAX_EDGE_FACTOR)
     }
 }
 
@@ -457,6 +463,12 @@ impl Renderer {
                 let on_edge = params.edge_factor > 1 && around.iter().any(|c| *c != centre);
                 let p = if on_edge { &edge } else { &plain };
                 let n = p.samples_per_pixel;
+                let lights = self.light_factor(
+                    solution,
+                    camera.position,
+                    rays.direction(x as f64 + 0.5, y as f64 + 0.5),
+                    p,
+                );
                 let mut sum = Rgb::ZERO;
                 for i in 0..n {
                     let dir = rays.jittered_direction(x as u32, y as u32, i, n, &mut rng);
@@ -466,7 +478,8 @@ impl Renderer {
                             _ if !hit.front_facing => Rgb::ZERO,
                             gather => {
                                 let e = hit.element as usize;
-                                self.gathered_sample(solution, e, hit.p_world, gather, p, i, &mut rng) / PI
+                                self.gathered_sample(solution, e, hit.p_world, gather, p, lights, i, &mut rng)
+                                    / PI
                             }
                         };
                     }
@@ -507,13 +520,38 @@ impl Renderer {
         }
         let mut rng = Rng::for_task(params.seed, TEXEL_TASK, key);
         let n = params.samples_per_pixel;
-        let sum: Rgb =
-            (0..n).map(|i| self.gathered_sample(solution, e, p, params.gather, params, i, &mut rng)).sum();
+        let lights = self.light_factor_at(e, p, params);
+        let sum: Rgb = (0..n)
+            .map(|i| self.gathered_sample(solution, e, p, params.gather, params, lights, i, &mut rng))
+            .sum();
         Ok(sum / f64::from(n))
     }
 
+    /// How many times `params.shadow_rays` a pixel takes: `params.penumbra_factor` where the
+    /// point its centre ray (from `eye` along `dir`) sees is in a penumbra, else 1.
+    fn light_factor(&self, solution: &Solution, eye: DVec3, dir: DVec3, params: &RenderParams) -> u32 {
+        if params.gather == Gather::None || params.penumbra_factor <= 1 {
+            return 1;
+        }
+        match self.trace_unchecked(solution, eye, dir, params.shading) {
+            Some(hit) if hit.front_facing => self.light_factor_at(hit.element as usize, hit.p_world, params),
+            _ => 1,
+        }
+    }
+
+    /// `params.penumbra_factor` where point `p` of element `e` sees part of the emitters
+    /// ([`Emitters::partly_seen`]), else 1.
+    fn light_factor_at(&self, e: usize, p: DVec3, params: &RenderParams) -> u32 {
+        if params.gather == Gather::None || params.penumbra_factor <= 1 {
+            return 1;
+        }
+        let n = self.shading_normal(e, p);
+        if self.emitters.partly_seen(&self.blockers, p, n, self.lift) { params.penumbra_factor } else { 1 }
+    }
+
     /// One sample of the radiosity leaving `x` on element `e` with a final gather, sample
-    /// `sample` of its pixel or texel (see the `gather` module for the estimators).
+    /// `sample` of its pixel or texel, with `light_factor` times `params.shadow_rays` (see the
+    /// `gather` module for the estimators).
     #[allow(clippy::too_many_arguments)]
     fn gathered_sample(
         &self,
@@ -522,15 +560,18 @@ impl Renderer {
         x: DVec3,
         gather: Gather,
         params: &RenderParams,
+        light_factor: u32,
         sample: u32,
         rng: &mut Rng,
     ) -> Rgb {
         let material = self.mesh.element_material(e);
         let n = self.shading_normal(e, x);
-        let lights = if self.emitters.is_empty() { 0 } else { params.shadow_rays };
+        let lights = if self.emitters.is_empty() { 0 } else { params.shadow_rays * light_factor };
+        // As many cosine directions as emitter points for the direct light alone: the two
+        // strategies' balance is what keeps the 1/r² next to a large emitter in check.
         let cosines = match gather {
             Gather::Full => params.gather_rays,
-            _ if lights > 0 => params.shadow_rays,
+            _ if lights > 0 => lights,
             _ => 0,
         };
         let mis = DirectMis { lights, cosines };

@@ -123,3 +123,49 @@ fn gathered_texels_give_the_furnace_radiosity() {
         assert!((mean / expected - 1.0).abs() < 0.01, "{gather:?}: mean {mean}, expected {expected}");
     }
 }
+
+/// Points that see part of the lamp (a penumbra, or a lamp cut by the surface's horizon)
+/// take `penumbra_factor` times the shadow rays, decided by probe rays apart from the
+/// estimate's own, so the estimate stays unbiased and penumbrae get quieter. The Cornell box's
+/// floor, gathered at every element centre with 4 samples, seeds 1 and 2: the mean over the
+/// floor agrees between factor 1 and 4 within 0.5 % (measured +0.06 %), and the seed-to-seed RMS
+/// relative difference falls by at least 1.4× (measured 1.63×; 4× the rays halve the noise
+/// of penumbra points, the lit floor has little to begin with).
+#[test]
+fn penumbra_points_take_more_shadow_rays_without_bias() {
+    let scene = radiosity_core::cornell_box();
+    let (mesh, solution) = common::solve(&scene, SolverParams::default());
+    let floor = mesh.object_names.iter().position(|n| n == "floor").unwrap();
+    let points: Vec<(usize, DVec3)> = (0..mesh.elements.len())
+        .filter(|&e| mesh.element_object(e) == floor)
+        .map(|e| (e, mesh.elements[e].centre))
+        .collect();
+    let renderer = Renderer::new(mesh);
+    let gather = |penumbra_factor, seed| {
+        let params = RenderParams {
+            samples_per_pixel: 4,
+            seed,
+            gather: Gather::Direct,
+            penumbra_factor,
+            ..RenderParams::default()
+        };
+        points
+            .iter()
+            .enumerate()
+            .map(|(k, &(e, p))| {
+                renderer.gathered_radiosity(&solution, e, p, &params, k as u64).unwrap().luminance()
+            })
+            .collect::<Vec<_>>()
+    };
+    let mean = |l: &[f64]| l.iter().sum::<f64>() / l.len() as f64;
+    let rms = |a: &[f64], b: &[f64]| {
+        (a.iter().zip(b).map(|(x, y)| ((x - y) / (x + y).max(1e-12)).powi(2)).sum::<f64>() / a.len() as f64)
+            .sqrt()
+    };
+    let (plain, plain2) = (gather(1, 1), gather(1, 2));
+    let (more, more2) = (gather(4, 1), gather(4, 2));
+    let (m1, m4) = (0.5 * (mean(&plain) + mean(&plain2)), 0.5 * (mean(&more) + mean(&more2)));
+    let (before, after) = (rms(&plain, &plain2), rms(&more, &more2));
+    assert!((m4 / m1 - 1.0).abs() < 0.005, "floor means {m4} with penumbrae sampled more, {m1} without");
+    assert!(after < before / 1.4, "noise {after} with penumbrae sampled more, {before} without");
+}
