@@ -59,8 +59,24 @@ impl Gather {
     }
 }
 
-/// Points [`Emitters::partly_seen`] probes on the emitters.
+/// Points [`Emitters::probe`] probes on the emitters.
 const PROBES: u32 = 16;
+
+/// Where points drawn on the emitters are this many times denser (per unit solid angle) than
+/// cosine-weighted directions at every probe, the directions would carry less than 1/10 of
+/// the balance heuristic's weight: the direct light then takes emitter points alone.
+const SMALL_EMITTER: f64 = 10.0;
+
+/// What a point sees of the emitters ([`Emitters::probe`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Seen {
+    /// Some of them and not all: a penumbra, or a lamp cut by the point's horizon. The direct
+    /// light's estimate is noisy there, so a picture spends more shadow rays.
+    pub partly: bool,
+    /// Every part it sees is small and far beside its distance: cosine-weighted directions
+    /// would add cost and next to nothing else.
+    pub small: bool,
+}
 
 /// Largest f64 below 1.
 const ONE_BELOW: f64 = 1.0 - f64::EPSILON / 2.0;
@@ -74,7 +90,7 @@ pub(crate) struct Emitters {
     cdf: Vec<f64>,
     /// Σ over emitting triangles of Σ_c E_c · area.
     total_power: f64,
-    /// Fixed points spread over the emitters by power (see [`Emitters::partly_seen`]).
+    /// Fixed points spread over the emitters by power (see [`Emitters::probe`]).
     probes: Vec<EmitterSample>,
 }
 
@@ -146,28 +162,30 @@ impl Emitters {
         emitters
     }
 
-    /// Whether `x` (unit normal `n`) sees some of the emitters and not all of them, from
-    /// [`PROBES`] fixed points on them: a penumbra, or a lamp cut by `x`'s horizon. That is
-    /// where the direct light's estimate is noisy, so a picture spends more shadow rays
-    /// there; the answer comes from rays apart from the estimate's, so it does not bias it.
-    pub(crate) fn partly_seen(&self, rays: &dyn RayQuery, x: DVec3, n: DVec3, lift: f64) -> bool {
+    /// What `x` (unit normal `n`) sees of the emitters, from [`PROBES`] fixed points on them
+    /// (rays apart from any estimate's, so a choice made from them biases none).
+    pub(crate) fn probe(&self, rays: &dyn RayQuery, x: DVec3, n: DVec3, lift: f64) -> Seen {
         let origin = x + n * lift;
-        let (mut seen, mut hidden) = (false, false);
+        let (mut seen, mut hidden, mut small) = (false, false, true);
         for s in &self.probes {
             let d = s.point - x;
-            let visible = n.dot(d) > 0.0
-                && s.normal.dot(d) < 0.0
-                && !rays.occluded(origin.as_vec3(), s.point.as_vec3());
-            if visible {
-                seen = true;
-            } else {
+            let r2 = d.length_squared();
+            let (cos_x, cos_y) = (n.dot(d), -s.normal.dot(d));
+            if cos_x <= 0.0 || cos_y <= 0.0 || rays.occluded(origin.as_vec3(), s.point.as_vec3()) {
                 hidden = true;
+                continue;
             }
-            if seen && hidden {
-                return true;
+            seen = true;
+            // Both densities per unit solid angle (see `DirectMis::term`), cosines over r:
+            // p_light = pdf_area · r² / cos θ_y, p_cosine = cos θ_x / π.
+            let r = r2.sqrt();
+            let p_light = s.pdf_area * r2 * r / cos_y;
+            let p_cosine = cos_x / r / PI;
+            if p_light < SMALL_EMITTER * p_cosine {
+                small = false;
             }
         }
-        false
+        Seen { partly: seen && hidden, small }
     }
 
     /// Density per unit area with which [`Emitters::sample`] draws a point of an emitter of
@@ -343,9 +361,10 @@ mod tests {
     }
 
     /// A point sees part of a lamp when a blocker hides some of it, or its own horizon cuts
-    /// it; not when it sees all of the lamp or none.
+    /// it; not when it sees all of the lamp or none. The lamp is small beside its distance
+    /// from far away, not from close under it.
     #[test]
-    fn partly_seen_finds_penumbrae_and_horizons() {
+    fn probes_find_penumbrae_horizons_and_small_lamps() {
         let light = Material::try_new("light", Rgb::ZERO, Rgb::splat(1.0)).unwrap();
         let polygon = Object {
             name: "lamp".into(),
@@ -358,21 +377,25 @@ mod tests {
         let emitters = Emitters::new(&mesh);
         let open = radiosity_accel::BruteForce::new(&[]);
         let up = DVec3::Z;
-        assert!(!emitters.partly_seen(&open, DVec3::ZERO, up, 1e-6), "in full view");
+        assert!(!emitters.probe(&open, DVec3::ZERO, up, 1e-6).partly, "in full view");
         assert!(
-            emitters.partly_seen(&open, DVec3::new(0.0, 0.0, 0.5), DVec3::X, 1e-6),
+            emitters.probe(&open, DVec3::new(0.0, 0.0, 0.5), DVec3::X, 1e-6).partly,
             "half behind the horizon"
         );
-        assert!(!emitters.partly_seen(&open, DVec3::new(0.0, 0.0, 2.0), up, 1e-6), "above the lamp's back");
+        assert!(!emitters.probe(&open, DVec3::new(0.0, 0.0, 2.0), up, 1e-6).partly, "above the lamp's back");
         // A sheet at half height over x < 0 hides the half of the lamp beyond it.
         let v = |x: f32, y: f32| glam::Vec3::new(x, y, 0.5);
         // Single triangles: no shared edge for a probe ray to slip through.
         let half = [[v(0.0, -5.0), v(0.0, 5.0), v(-5.0, 0.0)]];
         let blocked_half = radiosity_accel::BruteForce::new(&half);
-        assert!(emitters.partly_seen(&blocked_half, DVec3::ZERO, up, 1e-6), "half hidden");
+        assert!(emitters.probe(&blocked_half, DVec3::ZERO, up, 1e-6).partly, "half hidden");
         let whole = [[v(-5.0, -5.0), v(5.0, -5.0), v(0.0, 5.0)]];
         let blocked = radiosity_accel::BruteForce::new(&whole);
-        assert!(!emitters.partly_seen(&blocked, DVec3::ZERO, up, 1e-6), "all hidden");
+        assert!(!emitters.probe(&blocked, DVec3::ZERO, up, 1e-6).partly, "all hidden");
+        // The 1 m lamp from 1 m below: p_light = r² / (A cos θ_y) ≈ 1, p_cosine ≈ 1/π.
+        assert!(!emitters.probe(&open, DVec3::ZERO, up, 1e-6).small, "1 m under a 1 m lamp");
+        // From 20 m: p_light ≈ 400, p_cosine ≈ 1/π.
+        assert!(emitters.probe(&open, DVec3::new(0.0, 0.0, -19.0), up, 1e-6).small, "20 m under it");
     }
 
     /// Cosine-weighted directions lie in the upper hemisphere and have mean cos θ = 2/3

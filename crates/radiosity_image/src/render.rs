@@ -32,6 +32,20 @@ use crate::gather::{self, DirectMis, Emitters, Gather};
 
 /// Task key of the pixels' streams (`Rng::for_task(seed, PIXEL_TASK, pixel)`).
 const PIXEL_TASK: u64 = 0x7069_7865_6c73; // "pixels"
+/// What the samples of one pixel or texel take (see [`Renderer::effort_at`]).
+#[derive(Clone, Copy, Debug)]
+struct Effort {
+    /// Times `shadow_rays`.
+    light_factor: u32,
+    /// Whether the direct light takes cosine-weighted directions besides the emitter points.
+    cosines: bool,
+}
+
+impl Effort {
+    /// Nothing more than the parameters say.
+    const PLAIN: Effort = Effort { light_factor: 1, cosines: true };
+}
+
 /// Task key of gathered texels' streams.
 const TEXEL_TASK: u64 = 0x7465_7865_6c73; // "texels"
 
@@ -463,12 +477,8 @@ impl Renderer {
                 let on_edge = params.edge_factor > 1 && around.iter().any(|c| *c != centre);
                 let p = if on_edge { &edge } else { &plain };
                 let n = p.samples_per_pixel;
-                let lights = self.light_factor(
-                    solution,
-                    camera.position,
-                    rays.direction(x as f64 + 0.5, y as f64 + 0.5),
-                    p,
-                );
+                let effort =
+                    self.effort(solution, camera.position, rays.direction(x as f64 + 0.5, y as f64 + 0.5), p);
                 let mut sum = Rgb::ZERO;
                 for i in 0..n {
                     let dir = rays.jittered_direction(x as u32, y as u32, i, n, &mut rng);
@@ -478,7 +488,7 @@ impl Renderer {
                             _ if !hit.front_facing => Rgb::ZERO,
                             gather => {
                                 let e = hit.element as usize;
-                                self.gathered_sample(solution, e, hit.p_world, gather, p, lights, i, &mut rng)
+                                self.gathered_sample(solution, e, hit.p_world, gather, p, effort, i, &mut rng)
                                     / PI
                             }
                         };
@@ -520,38 +530,43 @@ impl Renderer {
         }
         let mut rng = Rng::for_task(params.seed, TEXEL_TASK, key);
         let n = params.samples_per_pixel;
-        let lights = self.light_factor_at(e, p, params);
+        let effort = self.effort_at(e, p, params);
         let sum: Rgb = (0..n)
-            .map(|i| self.gathered_sample(solution, e, p, params.gather, params, lights, i, &mut rng))
+            .map(|i| self.gathered_sample(solution, e, p, params.gather, params, effort, i, &mut rng))
             .sum();
         Ok(sum / f64::from(n))
     }
 
-    /// How many times `params.shadow_rays` a pixel takes: `params.penumbra_factor` where the
-    /// point its centre ray (from `eye` along `dir`) sees is in a penumbra, else 1.
-    fn light_factor(&self, solution: &Solution, eye: DVec3, dir: DVec3, params: &RenderParams) -> u32 {
-        if params.gather == Gather::None || params.penumbra_factor <= 1 {
-            return 1;
+    /// What a pixel asks of its samples ([`Renderer::effort_at`] at the point its centre ray,
+    /// from `eye` along `dir`, sees).
+    fn effort(&self, solution: &Solution, eye: DVec3, dir: DVec3, params: &RenderParams) -> Effort {
+        if params.gather == Gather::None {
+            return Effort::PLAIN;
         }
         match self.trace_unchecked(solution, eye, dir, params.shading) {
-            Some(hit) if hit.front_facing => self.light_factor_at(hit.element as usize, hit.p_world, params),
-            _ => 1,
+            Some(hit) if hit.front_facing => self.effort_at(hit.element as usize, hit.p_world, params),
+            _ => Effort::PLAIN,
         }
     }
 
-    /// `params.penumbra_factor` where point `p` of element `e` sees part of the emitters
-    /// ([`Emitters::partly_seen`]), else 1.
-    fn light_factor_at(&self, e: usize, p: DVec3, params: &RenderParams) -> u32 {
-        if params.gather == Gather::None || params.penumbra_factor <= 1 {
-            return 1;
+    /// What the samples of point `p` of element `e` take, from probe rays apart from theirs
+    /// (so that spending more where it pays does not bias the estimate):
+    /// `params.penumbra_factor` times the shadow rays where `p` sees part of the emitters, and
+    /// no cosine directions for the direct light where every emitter point it sees is far
+    /// and small enough for points drawn on the emitters alone (see [`Emitters::probe`]).
+    fn effort_at(&self, e: usize, p: DVec3, params: &RenderParams) -> Effort {
+        if params.gather == Gather::None {
+            return Effort::PLAIN;
         }
         let n = self.shading_normal(e, p);
-        if self.emitters.partly_seen(&self.blockers, p, n, self.lift) { params.penumbra_factor } else { 1 }
+        let seen = self.emitters.probe(&self.blockers, p, n, self.lift);
+        let light_factor = if seen.partly { params.penumbra_factor } else { 1 };
+        Effort { light_factor, cosines: !seen.small }
     }
 
     /// One sample of the radiosity leaving `x` on element `e` with a final gather, sample
-    /// `sample` of its pixel or texel, with `light_factor` times `params.shadow_rays` (see the
-    /// `gather` module for the estimators).
+    /// `sample` of its pixel or texel, taking what `effort` asks (see the `gather` module for
+    /// the estimators).
     #[allow(clippy::too_many_arguments)]
     fn gathered_sample(
         &self,
@@ -560,18 +575,18 @@ impl Renderer {
         x: DVec3,
         gather: Gather,
         params: &RenderParams,
-        light_factor: u32,
+        effort: Effort,
         sample: u32,
         rng: &mut Rng,
     ) -> Rgb {
         let material = self.mesh.element_material(e);
         let n = self.shading_normal(e, x);
-        let lights = if self.emitters.is_empty() { 0 } else { params.shadow_rays * light_factor };
+        let lights = if self.emitters.is_empty() { 0 } else { params.shadow_rays * effort.light_factor };
         // As many cosine directions as emitter points for the direct light alone: the two
         // strategies' balance is what keeps the 1/r² next to a large emitter in check.
         let cosines = match gather {
             Gather::Full => params.gather_rays,
-            _ if lights > 0 => lights,
+            _ if lights > 0 && effort.cosines => lights,
             _ => 0,
         };
         let mis = DirectMis { lights, cosines };
