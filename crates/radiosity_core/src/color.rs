@@ -75,6 +75,12 @@ impl Rgb {
     pub fn map(self, f: impl Fn(f64) -> f64) -> Self {
         Self::new(f(self.r), f(self.g), f(self.b))
     }
+
+    /// Applies `f` to every pair of channels of `self` and `o` (`a.zip_map(b, f64::max)`: the
+    /// channel-wise maximum).
+    pub fn zip_map(self, o: Self, f: impl Fn(f64, f64) -> f64) -> Self {
+        Self::new(f(self.r, o.r), f(self.g, o.g), f(self.b, o.b))
+    }
 }
 
 impl Add for Rgb {

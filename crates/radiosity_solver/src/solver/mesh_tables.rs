@@ -7,11 +7,14 @@ use radiosity_core::{Mesh, Patch, Rgb};
 use super::SolverError;
 use crate::occluders::{OccluderBoxes, blocking_triangles};
 use crate::shaft::Blockers;
+use crate::solution::RimFits;
 
 /// Per-mesh tables, fixed when the solver is made.
 pub(super) struct MeshTables {
     /// Per vertex, the area of the elements around it (the weights of vertex radiosity).
     pub(super) vertex_area: Vec<f64>,
+    /// The rim vertices' linear fits (see [`RimFits`]).
+    pub(super) rim_fits: RimFits,
     /// Element areas, packed for the shot loop.
     pub(super) element_area: Vec<f64>,
     /// Per element, the mean of its vertices: the one quadrature point of a far element (the
@@ -81,6 +84,7 @@ impl MeshTables {
         let ray_offset = 1e-6 * (hi - lo).length();
         Self {
             vertex_area,
+            rim_fits: RimFits::new(mesh),
             element_area: mesh.elements.iter().map(|el| el.area).collect(),
             vertex_means: (0..n)
                 .map(|e| mesh.element_corners(e).sum::<DVec3>() / f64::from(mesh.elements[e].vertex_count))

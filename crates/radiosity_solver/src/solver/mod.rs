@@ -190,9 +190,19 @@ impl Solver {
             }
         };
         Solution {
-            vertex_radiosity: vertex_average(&self.mesh, &element_radiosity, &self.tables.vertex_area),
+            vertex_radiosity: vertex_average(
+                &self.mesh,
+                &element_radiosity,
+                &self.tables.vertex_area,
+                &self.tables.rim_fits,
+            ),
             element_radiosity,
-            vertex_direct: vertex_average(&self.mesh, &tally.direct, &self.tables.vertex_area),
+            vertex_direct: vertex_average(
+                &self.mesh,
+                &tally.direct,
+                &self.tables.vertex_area,
+                &self.tables.rim_fits,
+            ),
             element_direct: tally.direct.clone(),
             element_unshot: tally.unshot.clone(),
             shots: self.progress.shots,
