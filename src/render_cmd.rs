@@ -112,9 +112,9 @@ pub struct RenderArgs {
     #[arg(long, value_enum, default_value_t = ShadingArg::Smooth)]
     pub shading: ShadingArg,
     /// Final gather: `direct` (direct light by shadow rays per pixel: shadows as sharp as the
-    /// lamp makes them whatever the mesh; the default: on the Cornell box 3.8 % RMS error per
-    /// pixel against the path-traced reference in 3 s), `none` (the radiosity mesh as the
-    /// viewer shows it: 4.1 % in 1.2 s), `full` (also one bounce of gathering rays: noisier).
+    /// lamp makes them whatever the mesh; the default: on the Cornell box 3.2 % RMS error per
+    /// pixel against the path-traced reference in 2.5 s), `none` (the radiosity mesh as the
+    /// viewer shows it: 3.8 % in 1.5 s), `full` (also one bounce of gathering rays: noisier).
     #[arg(long, value_enum, default_value_t = GatherArg::Direct)]
     pub gather: GatherArg,
     /// Shadow rays per sample towards the emitters, with a gather.

@@ -86,6 +86,8 @@ fn out_of_range_options_are_one_line_errors() {
         (&["render", "two-plates", "-o", "never.png", "--fov", "180"], "fov"),
         (&["render", "two-plates", "-o", "never.png", "--width", "16384", "--height", "16384"], "pixels"),
         (&["render", "two-plates", "-o", "never.png", "--width", "0"], "width"),
+        (&["render", "two-plates", "-o", "never.png", "--penumbra-factor", "0"], "penumbra_factor"),
+        (&["render", "two-plates", "-o", "never.png", "--penumbra-factor", "65"], "penumbra_factor"),
     ];
     for (args, needle) in cases {
         let o = run(args);
