@@ -32,6 +32,9 @@ use crate::gather::{self, DirectMis, Emitters, Gather};
 
 /// Task key of the pixels' streams (`Rng::for_task(seed, PIXEL_TASK, pixel)`).
 const PIXEL_TASK: u64 = 0x7069_7865_6c73; // "pixels"
+/// Task key of gathered texels' streams.
+const TEXEL_TASK: u64 = 0x7465_7865_6c73; // "texels"
+
 /// What the samples of one pixel or texel take (see [`Renderer::effort_at`]).
 #[derive(Clone, Copy, Debug)]
 struct Effort {
@@ -45,9 +48,6 @@ impl Effort {
     /// Nothing more than the parameters say.
     const PLAIN: Effort = Effort { light_factor: 1, cosines: true };
 }
-
-/// Task key of gathered texels' streams.
-const TEXEL_TASK: u64 = 0x7465_7865_6c73; // "texels"
 
 /// How radiosity is taken at a hit point.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
