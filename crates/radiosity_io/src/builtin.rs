@@ -33,7 +33,7 @@ pub fn builtin_scene(name: &str) -> Option<Scene> {
 /// not "unknown scene"), otherwise the built-in scene of that name.
 ///
 /// # Errors
-/// As [`load_scene`] for a path; [`LoadError::UnknownScene`], listing the built-ins, for any
+/// As [`load_scene`](crate::load_scene) for a path; [`LoadError::UnknownScene`], listing the built-ins, for any
 /// other name.
 pub fn resolve_scene(arg: &str) -> Result<LoadedScene, LoadError> {
     resolve_scene_with(arg, &LoadOptions::default())
