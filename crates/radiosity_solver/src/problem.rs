@@ -10,6 +10,7 @@ use std::sync::Arc;
 use radiosity_accel::{Bvh, RayQuery};
 use radiosity_core::{MAX_ELEMENTS, Mesh, MeshError, MeshParams, Refinement, Rgb, Scene};
 
+use crate::solution::VertexElements;
 use crate::{Solver, SolverError, SolverParams, occluder_triangles};
 
 /// Unshot share at which [`Problem::new`]'s probe solves stop: the shadows and the light's
@@ -43,12 +44,7 @@ fn steep_elements(mesh: &Mesh, radiosity: &[Rgb], min_area: f64) -> Vec<(usize, 
     let emits = |e: usize| mesh.element_material(e).emission.max_channel() > 0.0;
     let lit: Vec<f64> = (0..y.len()).filter(|&e| !emits(e)).map(|e| y[e]).collect();
     let floor = 0.01 * lit.iter().sum::<f64>() / lit.len().max(1) as f64;
-    let mut at_vertex: Vec<Vec<u32>> = vec![Vec::new(); mesh.positions.len()];
-    for (e, el) in mesh.elements.iter().enumerate() {
-        for &v in el.vertex_indices() {
-            at_vertex[v as usize].push(e as u32);
-        }
-    }
+    let at_vertex = VertexElements::new(mesh);
     let mut out: Vec<(usize, f64)> = Vec::new();
     for (e, el) in mesh.elements.iter().enumerate() {
         if el.area < min_area || emits(e) {
@@ -57,7 +53,7 @@ fn steep_elements(mesh: &Mesh, radiosity: &[Rgb], min_area: f64) -> Vec<(usize, 
         let worst = el
             .vertex_indices()
             .iter()
-            .flat_map(|&v| at_vertex[v as usize].iter())
+            .flat_map(|&v| at_vertex.of(v as usize))
             .map(|&n| {
                 let larger = y[e].max(y[n as usize]);
                 if larger <= floor { 0.0 } else { (y[e] - y[n as usize]).abs() / larger }

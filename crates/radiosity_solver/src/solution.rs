@@ -136,31 +136,18 @@ impl RimFits {
     /// The fits of `mesh`'s rim vertices: those whose elements' angles at them sum to less
     /// than a full turn (by more than 0.1 rad) and that are pooled with no other vertex.
     pub(crate) fn new(mesh: &Mesh) -> Self {
-        let nv = mesh.positions.len();
-        let mut start = vec![0u32; nv + 1];
+        let around = VertexElements::new(mesh);
+        let mut angle = vec![0.0f64; mesh.positions.len()];
         for el in &mesh.elements {
-            for &v in el.vertex_indices() {
-                start[v as usize + 1] += 1;
-            }
-        }
-        for v in 0..nv {
-            start[v + 1] += start[v];
-        }
-        let mut fill = start.clone();
-        let mut around = vec![0u32; start[nv] as usize];
-        let mut angle = vec![0.0f64; nv];
-        for (e, el) in mesh.elements.iter().enumerate() {
             let idx = el.vertex_indices();
             for (k, &v) in idx.iter().enumerate() {
-                around[fill[v as usize] as usize] = e as u32;
-                fill[v as usize] += 1;
                 let p = mesh.positions[v as usize];
                 let prev = mesh.positions[idx[(k + idx.len() - 1) % idx.len()] as usize] - p;
                 let next = mesh.positions[idx[(k + 1) % idx.len()] as usize] - p;
                 angle[v as usize] += prev.angle_between(next);
             }
         }
-        let elements_at = |v: u32| &around[start[v as usize] as usize..start[v as usize + 1] as usize];
+        let elements_at = |v: u32| around.of(v as usize);
         let mut fits = Self { vertices: Vec::new(), start: vec![0], terms: Vec::new() };
         let mut ring: Vec<u32> = Vec::new();
         for (v, &turn) in angle.iter().enumerate() {
@@ -208,6 +195,43 @@ impl RimFits {
                 .zip_map(hi + spread * 0.5, f64::min)
                 .map(|c| c.max(0.0));
         }
+    }
+}
+
+/// The elements around each vertex, packed: vertex `v`'s are
+/// `elements[start[v]..start[v + 1]]`, in element order.
+pub(crate) struct VertexElements {
+    start: Vec<u32>,
+    elements: Vec<u32>,
+}
+
+impl VertexElements {
+    /// The elements around every vertex of `mesh`.
+    pub(crate) fn new(mesh: &Mesh) -> Self {
+        let nv = mesh.positions.len();
+        let mut start = vec![0u32; nv + 1];
+        for el in &mesh.elements {
+            for &v in el.vertex_indices() {
+                start[v as usize + 1] += 1;
+            }
+        }
+        for v in 0..nv {
+            start[v + 1] += start[v];
+        }
+        let mut fill = start.clone();
+        let mut elements = vec![0u32; start[nv] as usize];
+        for (e, el) in mesh.elements.iter().enumerate() {
+            for &v in el.vertex_indices() {
+                elements[fill[v as usize] as usize] = e as u32;
+                fill[v as usize] += 1;
+            }
+        }
+        Self { start, elements }
+    }
+
+    /// The elements around vertex `v`.
+    pub(crate) fn of(&self, v: usize) -> &[u32] {
+        &self.elements[self.start[v] as usize..self.start[v + 1] as usize]
     }
 }
 
