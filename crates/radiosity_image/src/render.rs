@@ -20,7 +20,7 @@ use std::f64::consts::PI;
 use std::sync::Arc;
 
 use glam::{DVec2, DVec3, Vec3};
-use radiosity_accel::{Bvh, RayQuery};
+use radiosity_accel::{Bvh, Hit, RayQuery};
 use radiosity_core::random::Rng;
 use radiosity_core::{Camera, CameraRays, Mesh, Rgb};
 use radiosity_solver::Solution;
@@ -338,6 +338,19 @@ impl Renderer {
         Ok(self.trace_unchecked(solution, origin, direction.normalize(), shading))
     }
 
+    /// Where the BVH's `hit` of the ray from `origin` along unit `dir` lies: the element that
+    /// faces the ray, the point on its plane, the distance, and whether it is its front side.
+    /// The hit is recomputed in double precision against the element's plane: the BVH works
+    /// in single precision, and interpolation wants the point on the plane.
+    fn surface_point(&self, origin: DVec3, dir: DVec3, hit: &Hit) -> (usize, DVec3, f64, bool) {
+        let e = self.facing_element(hit.triangle, dir);
+        let el = &self.mesh.elements[e];
+        let denom = el.normal.dot(dir);
+        let distance =
+            if denom.abs() > 1e-12 { el.normal.dot(el.centre - origin) / denom } else { f64::from(hit.t) };
+        (e, origin + dir * distance, distance, denom < 0.0)
+    }
+
     /// `trace` for a solution already checked and a unit direction.
     fn trace_unchecked(
         &self,
@@ -347,15 +360,7 @@ impl Renderer {
         shading: Shading,
     ) -> Option<SurfaceHit> {
         let hit = self.accel.closest_hit(origin.as_vec3(), dir.as_vec3(), f32::MAX)?;
-        let e = self.facing_element(hit.triangle, dir);
-        let el = &self.mesh.elements[e];
-        // Recompute the hit in double precision against the element's plane: the BVH works in
-        // single precision, and interpolation wants the point on the plane.
-        let denom = el.normal.dot(dir);
-        let distance =
-            if denom.abs() > 1e-12 { el.normal.dot(el.centre - origin) / denom } else { f64::from(hit.t) };
-        let p_world = origin + dir * distance;
-        let front_facing = denom < 0.0;
+        let (e, p_world, distance, front_facing) = self.surface_point(origin, dir, &hit);
         let radiance = if front_facing {
             let b = match shading {
                 Shading::Flat => solution.element_radiosity[e],
@@ -443,14 +448,14 @@ impl Renderer {
         let rays = CameraRays::new(camera, params.width, params.height);
         // What the centre ray of a pixel, or the ray through a pixel corner, sees: the object
         // and whether it emits (a lamp is often one face of a larger object).
-        let seen = |px: f64, py: f64| {
-            let dir = rays.direction(px, py);
-            self.accel.closest_hit(camera.position.as_vec3(), dir.as_vec3(), f32::MAX).map(|hit| {
-                let e = self.triangle_element[hit.triangle as usize] as usize;
-                let emits = self.mesh.element_material(e).emission.max_channel() > 0.0;
-                (self.mesh.element_object(e) as u32, emits)
-            })
+        let what = |hit: &Hit| {
+            let e = self.triangle_element[hit.triangle as usize] as usize;
+            let emits = self.mesh.element_material(e).emission.max_channel() > 0.0;
+            (self.mesh.element_object(e) as u32, emits)
         };
+        let first_hit =
+            |dir: DVec3| self.accel.closest_hit(camera.position.as_vec3(), dir.as_vec3(), f32::MAX);
+        let seen = |px: f64, py: f64| first_hit(rays.direction(px, py)).as_ref().map(what);
         // Pixel corners: (w + 1) × (h + 1), shared by the four pixels around each.
         let corners: Vec<Option<(u32, bool)>> = (0..=h)
             .into_par_iter()
@@ -466,7 +471,9 @@ impl Renderer {
             for x in 0..w {
                 let index = (y * w + x) as u64;
                 let mut rng = Rng::for_task(params.seed, PIXEL_TASK, index);
-                let centre = seen(x as f64 + 0.5, y as f64 + 0.5);
+                let centre_dir = rays.direction(x as f64 + 0.5, y as f64 + 0.5);
+                let centre_hit = first_hit(centre_dir);
+                let centre = centre_hit.as_ref().map(what);
                 ids[x] = centre.map(|(object, _)| object);
                 // An edge is decided from rays apart from the pixel's samples, so that
                 // sampling more where the outline runs does not bias the pixel: a decision
@@ -478,7 +485,7 @@ impl Renderer {
                 let p = if on_edge { &edge } else { &plain };
                 let n = p.samples_per_pixel;
                 let effort =
-                    self.effort(solution, camera.position, rays.direction(x as f64 + 0.5, y as f64 + 0.5), p);
+                    centre_hit.map_or(Effort::PLAIN, |hit| self.effort(camera.position, centre_dir, &hit, p));
                 let mut sum = Rgb::ZERO;
                 for i in 0..n {
                     let dir = rays.jittered_direction(x as u32, y as u32, i, n, &mut rng);
@@ -537,14 +544,14 @@ impl Renderer {
         Ok(sum / f64::from(n))
     }
 
-    /// What a pixel asks of its samples ([`Renderer::effort_at`] at the point its centre ray,
-    /// from `eye` along `dir`, sees).
-    fn effort(&self, solution: &Solution, eye: DVec3, dir: DVec3, params: &RenderParams) -> Effort {
+    /// What a pixel asks of its samples: [`Renderer::effort_at`] at the point its centre ray,
+    /// from `eye` along `dir`, sees (`hit`, the BVH's answer for that ray).
+    fn effort(&self, eye: DVec3, dir: DVec3, hit: &Hit, params: &RenderParams) -> Effort {
         if params.gather == Gather::None {
             return Effort::PLAIN;
         }
-        match self.trace_unchecked(solution, eye, dir, params.shading) {
-            Some(hit) if hit.front_facing => self.effort_at(hit.element as usize, hit.p_world, params),
+        match self.surface_point(eye, dir, hit) {
+            (e, p, _, true) => self.effort_at(e, p, params),
             _ => Effort::PLAIN,
         }
     }
