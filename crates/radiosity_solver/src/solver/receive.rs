@@ -106,16 +106,15 @@ fn unoccluded(shot: &Shot, plan: &PatchPlan, e: usize) -> (f64, f64) {
                     }
                 });
             }
-            if let Some(uneven) = uneven.filter(|_| plan.touching || near(shot, e)) {
-                // A receiver on or across the shooter's plane sees only part of it (a block
-                // side sees the floor in front of it, not under it), and one near it sees its
-                // near part under a larger form factor than the rest (a sofa's back 20 cm from
-                // a wall patch lit above the sofa and dark behind it), so the shooter's mean
-                // unshot radiosity is wrong for it when that radiosity is uneven: the
-                // transfer is Σ_k ΔB_k F_{j→k} = ΔB̄ Σ_k d_k F_{j→k}, d_k = ΔB_k/ΔB̄. The
+            if let Some(uneven) = uneven.filter(|_| !plan.touching && near(shot, e)) {
+                // A receiver near the shooter sees its near part under a larger form factor
+                // than the rest (a sofa's back 20 cm from a wall patch lit above the sofa and
+                // dark behind it), so the shooter's mean unshot radiosity is wrong for it when
+                // that radiosity is uneven: the transfer is Σ_k ΔB_k F_{j→k} = ΔB̄ Σ_k d_k
+                // F_{j→k}, d_k = ΔB_k/ΔB̄, weighted here by the spread fixed with the row. The
                 // form factor keeps its quadrature; the weighting is taken at the centre.
-                // A touching patch is weighted whole, its elements off the plane too: they are
-                // the ones next to the contact line.
+                // Receivers that touch the shooter are weighted at each shot instead, by the
+                // spread it has then (`row::NearField`).
                 let weight = density_weight(el.centre, el.normal, shooter.normal, &uneven, shooter_elements);
                 return (f * weight, f);
             }

@@ -16,7 +16,7 @@ use super::rays::{Rays, SINGLE_STREAM, trace};
 use super::receive::{Received, receive_patch};
 use super::shot::Shot;
 use super::uneven::{Uneven, cluster_elements};
-use crate::form_factor::{point_to_polygon, points_to_polygon_in_front_x4};
+use crate::form_factor::{point_to_point, point_to_polygon, points_to_polygon_in_front_x4};
 use crate::sampling::{Rng, Strata};
 
 /// One shooter's form factors F_{j→shooter} (visibility included) to the elements of every
@@ -29,6 +29,53 @@ pub(super) struct Row {
     /// The factors, span after span, in f32 (7 digits, far below the visibility noise); a
     /// row applied fresh is rounded the same way, so keeping it changes nothing.
     pub(super) factors: Vec<f32>,
+    /// The receivers that touch the shooter, weighted at each shot by the part of it they
+    /// see (see [`NearField`]).
+    pub(super) near: NearField,
+}
+
+/// The receiving elements that touch a patch shooter (across or on its plane: a floor strip
+/// at the foot of a wall, a wall strip in a room's corner), and how much of each of the
+/// shooter's elements each of them sees.
+///
+/// Such a receiver sees the shooter's near edge under a far larger form factor than the
+/// rest, so the patch's mean unshot radiosity is wrong for it whenever the radiosity over
+/// the patch is uneven: the transfer is Σ_k ΔB_k F_{j→k} = F_j Σ_k φ_jk ΔB_k, with
+/// φ_jk = F_{j→k} / F_j. Weighting by the spread fixed at the patch's first shot missed
+/// what changes between shots: an inside corner's indirect light dims towards the corner
+/// while the direct light of the first shot does not, and the strips on both sides of the
+/// Cornell box's back corners came out 1.5–2.5 % bright (element means against the path
+/// tracer). The shares φ are geometry, kept with the row; the weighting is done at each
+/// shot with the unshot radiosity the shooter has then (`Tally::shoot`).
+#[derive(Default)]
+pub(super) struct NearField {
+    /// (element, its factor F_j as in the row, first term, term count).
+    pub(super) receivers: Vec<(u32, f32, u32, u32)>,
+    /// (part of the shooter, share φ), receiver after receiver. A part is one shooter
+    /// element, or, flagged by [`CLUSTER_TERM`], a cluster of nearby ones seen from far
+    /// enough to count as one (`uneven::cluster_elements`, four radii: the point-to-point
+    /// factor is then within ~2 %). Shares below [`MIN_SHARE`] are left out and their part
+    /// of the shooter counts at its mean.
+    pub(super) terms: Vec<(u32, f32)>,
+    /// The clusters' elements (mesh indices): cluster c's are
+    /// `members[clusters[c].0..clusters[c].1]`.
+    pub(super) members: Vec<u32>,
+    /// Each cluster's range of `members`.
+    pub(super) clusters: Vec<(u32, u32)>,
+    /// Σ A_j F_j over the row's other receivers, which take what the near ones do not.
+    pub(super) rest: f64,
+}
+
+/// A [`NearField`] term whose part is a cluster (its index with this bit set).
+pub(super) const CLUSTER_TERM: u32 = 1 << 31;
+
+/// Smallest share of a shooter part kept in a near receiver's terms.
+const MIN_SHARE: f64 = 1e-3;
+
+impl NearField {
+    fn bytes(&self) -> usize {
+        16 * self.receivers.len() + 8 * (self.terms.len() + self.clusters.len()) + 4 * self.members.len()
+    }
 }
 
 /// Receiving patches merge into one span up to this many elements, so that a shot's
@@ -38,7 +85,7 @@ const MAX_RUN: u32 = 1024;
 impl Row {
     /// An empty row.
     pub(super) fn new() -> Self {
-        Self { spans: Vec::new(), factors: Vec::new() }
+        Self { spans: Vec::new(), factors: Vec::new(), near: NearField::default() }
     }
 
     /// Appends the factors of a receiving patch whose elements are `elements` (after those
@@ -54,7 +101,7 @@ impl Row {
 
     /// Heap and inline bytes the row holds.
     pub(super) fn bytes(&self) -> usize {
-        std::mem::size_of::<Self>() + 8 * self.spans.len() + 4 * self.factors.len()
+        std::mem::size_of::<Self>() + 8 * self.spans.len() + 4 * self.factors.len() + self.near.bytes()
     }
 }
 
@@ -139,7 +186,8 @@ impl Solver {
         if shot.uneven.is_some() {
             keep_uneven_power(&tables.element_area, &tables.patch_elements, plans, &mut scratch.factors);
         }
-        let (row, rays) = gather(&tables.patch_elements, plans, &scratch.factors, |q| shot.shares(q));
+        let (mut row, rays) = gather(&tables.patch_elements, plans, &scratch.factors, |q| shot.shares(q));
+        row.near = near_field(&shot, plans, tables, &row);
         self.progress.rays += rays + shared_rays;
         row
     }
@@ -295,6 +343,73 @@ fn receive_shared(shot: &Shot, plans: &[PatchPlan], element_area: &[f64], factor
         }
     });
     rays
+}
+
+/// The near field of a patch's row: every receiving element of a patch that touches the
+/// shooter, with its shares of the shooter's parts (see [`NearField`]).
+fn near_field(
+    shot: &Shot,
+    plans: &[PatchPlan],
+    tables: &super::mesh_tables::MeshTables,
+    row: &Row,
+) -> NearField {
+    let mut near = NearField::default();
+    let elements = shot.shooter_elements;
+    let first_shooter = shot.shooter.elements.start;
+    let (mut order, mut clusters) = (Vec::new(), Vec::new());
+    let mut shares: Vec<(u32, f64)> = Vec::new();
+    let mut offset = 0;
+    let mut total = 0.0;
+    for &(first, count) in &row.spans {
+        for k in 0..count as usize {
+            let e = first as usize + k;
+            let f = row.factors[offset + k];
+            let area = tables.element_area[e];
+            total += area * f64::from(f);
+            if f <= 0.0 || !plans[tables.element_patch[e] as usize].touching {
+                continue;
+            }
+            if clusters.is_empty() {
+                cluster_elements(elements, &vec![1.0; elements.len()], &mut order, &mut clusters);
+                for c in &clusters {
+                    let start = near.members.len() as u32;
+                    near.members.extend(order[c.members.clone()].iter().map(|&i| first_shooter + i));
+                    near.clusters.push((start, near.members.len() as u32));
+                }
+            }
+            let (p, n, ns) =
+                (shot.mesh.elements[e].centre, shot.mesh.elements[e].normal, shot.shooter.normal);
+            shares.clear();
+            for (c, cluster) in clusters.iter().enumerate() {
+                if cluster.centre.distance_squared(p) >= 16.0 * cluster.radius * cluster.radius {
+                    let phi = point_to_point(p, n, cluster.centre, ns, cluster.area);
+                    shares.push((c as u32 | CLUSTER_TERM, phi.max(0.0)));
+                } else {
+                    shares.extend(
+                        order[cluster.members.clone()].iter().map(|&i| {
+                            (first_shooter + i, elements[i as usize].factor_from(p, n, ns).max(0.0))
+                        }),
+                    );
+                }
+            }
+            let sum: f64 = shares.iter().map(|s| s.1).sum();
+            if sum <= 0.0 {
+                continue;
+            }
+            let start = near.terms.len() as u32;
+            near.terms.extend(
+                shares
+                    .iter()
+                    .filter(|s| s.1 >= MIN_SHARE * sum)
+                    .map(|&(part, phi)| (part, (phi / sum) as f32)),
+            );
+            near.receivers.push((e as u32, f, start, near.terms.len() as u32 - start));
+            near.rest -= area * f64::from(f);
+        }
+        offset += count as usize;
+    }
+    near.rest += total;
+    near
 }
 
 /// The row of the live patches' factors (those that receive anything), and the rays traced

@@ -25,11 +25,13 @@ pub(super) const NONUNIFORM: f64 = 0.5;
 #[derive(Clone, Debug)]
 pub(super) struct Cluster {
     /// Its elements, as a range of [`Uneven::order`].
-    members: std::ops::Range<usize>,
-    centre: DVec3,
+    pub(super) members: std::ops::Range<usize>,
+    /// Area-weighted centre of its elements.
+    pub(super) centre: DVec3,
     /// Radius about `centre` that holds all its elements.
-    radius: f64,
-    area: f64,
+    pub(super) radius: f64,
+    /// Its elements' area.
+    pub(super) area: f64,
     /// Area-weighted mean density of its elements.
     density: f64,
 }
