@@ -69,6 +69,12 @@ pub(super) struct NearField {
 /// A [`NearField`] term whose part is a cluster (its index with this bit set).
 pub(super) const CLUSTER_TERM: u32 = 1 << 31;
 
+/// Receivers farther than this many shooter radii from its centre see it small enough to
+/// take its mean. Cornell (`render`, against the path tracer): with no limit 2.70 % per
+/// pixel, 1 570 receivers per row and a third more solve time; at 3 radii 2.82 %, 490
+/// receivers; at 1.5, 2.95 %.
+const NEAR_REACH: f64 = 3.0;
+
 /// Smallest share of a shooter part kept in a near receiver's terms.
 const MIN_SHARE: f64 = 1e-3;
 
@@ -346,7 +352,11 @@ fn receive_shared(shot: &Shot, plans: &[PatchPlan], element_area: &[f64], factor
 }
 
 /// The near field of a patch's row: every receiving element of a patch that touches the
-/// shooter, with its shares of the shooter's parts (see [`NearField`]).
+/// shooter, within [`NEAR_REACH`], with its shares of the shooter's parts (see
+/// [`NearField`]). Not a model's facets that shoot in groups: a curved model near a shooter
+/// has tens of thousands of facets whose planes cut it (a bunny on a floor patch: 71 k): a
+/// 139 k-triangle room solved in 26.4 s with them, 24.3 s without, 23.5 s before any near
+/// field.
 fn near_field(
     shot: &Shot,
     plans: &[PatchPlan],
@@ -366,7 +376,13 @@ fn near_field(
             let f = row.factors[offset + k];
             let area = tables.element_area[e];
             total += area * f64::from(f);
-            if f <= 0.0 || !plans[tables.element_patch[e] as usize].touching {
+            let patch = tables.element_patch[e] as usize;
+            if f <= 0.0
+                || !plans[patch].touching
+                || shot.clusters.members()[patch]
+                || shot.mesh.elements[e].centre.distance_squared(shot.shooter.centre)
+                    > (NEAR_REACH * shot.shooter_radius).powi(2)
+            {
                 continue;
             }
             if clusters.is_empty() {
