@@ -10,6 +10,7 @@ use super::FormFactorMethod;
 use super::plans::PatchPlan;
 use super::quadrature::element_quadrature;
 use super::rays::{Packet, Rays, draw, near, patch_near, trace};
+use super::row::in_near_field;
 use super::shot::Shot;
 use super::uneven::density_weight;
 use crate::form_factor::{
@@ -106,15 +107,18 @@ fn unoccluded(shot: &Shot, plan: &PatchPlan, e: usize) -> (f64, f64) {
                     }
                 });
             }
-            if let Some(uneven) = uneven.filter(|_| !plan.touching && near(shot, e)) {
+            if let Some(uneven) =
+                uneven.filter(|_| if plan.touching { !in_near_field(shot, e) } else { near(shot, e) })
+            {
                 // A receiver near the shooter sees its near part under a larger form factor
                 // than the rest (a sofa's back 20 cm from a wall patch lit above the sofa and
                 // dark behind it), so the shooter's mean unshot radiosity is wrong for it when
                 // that radiosity is uneven: the transfer is Σ_k ΔB_k F_{j→k} = ΔB̄ Σ_k d_k
                 // F_{j→k}, d_k = ΔB_k/ΔB̄, weighted here by the spread fixed with the row. The
                 // form factor keeps its quadrature; the weighting is taken at the centre.
-                // Receivers that touch the shooter are weighted at each shot instead, by the
-                // spread it has then (`row::NearField`).
+                // Receivers that touch the shooter are weighted so too when they are a model's
+                // grouped facets or far from it, else at each shot, by the spread it has then
+                // (`row::NearField`).
                 let weight = density_weight(el.centre, el.normal, shooter.normal, &uneven, shooter_elements);
                 return (f * weight, f);
             }

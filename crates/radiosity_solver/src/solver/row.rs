@@ -62,7 +62,8 @@ pub(super) struct NearField {
     pub(super) members: Vec<u32>,
     /// Each cluster's range of `members`.
     pub(super) clusters: Vec<(u32, u32)>,
-    /// Σ A_j F_j over the row's other receivers, which take what the near ones do not.
+    /// Σ A_j F_j over the row's other receivers but a model's grouped facets (which take the
+    /// mean), which take what the near ones do not.
     pub(super) rest: f64,
 }
 
@@ -351,6 +352,15 @@ fn receive_shared(shot: &Shot, plans: &[PatchPlan], element_area: &[f64], factor
     rays
 }
 
+/// Whether element `e`, of a patch that touches the shooter, is weighted at each shot (see
+/// [`near_field`]); else it takes the spread fixed with the row, as receivers near the
+/// shooter do (`receive`).
+pub(super) fn in_near_field(shot: &Shot, e: usize) -> bool {
+    let reach = NEAR_REACH * shot.shooter_radius;
+    !shot.clusters.members()[shot.mesh.elements[e].patch as usize]
+        && shot.mesh.elements[e].centre.distance_squared(shot.shooter.centre) <= reach * reach
+}
+
 /// The near field of a patch's row: every receiving element of a patch that touches the
 /// shooter, within [`NEAR_REACH`], with its shares of the shooter's parts (see
 /// [`NearField`]). Not a model's facets that shoot in groups: a curved model near a shooter
@@ -375,14 +385,11 @@ fn near_field(
             let e = first as usize + k;
             let f = row.factors[offset + k];
             let area = tables.element_area[e];
-            total += area * f64::from(f);
             let patch = tables.element_patch[e] as usize;
-            if f <= 0.0
-                || !plans[patch].touching
-                || shot.clusters.members()[patch]
-                || shot.mesh.elements[e].centre.distance_squared(shot.shooter.centre)
-                    > (NEAR_REACH * shot.shooter_radius).powi(2)
-            {
+            if !shot.clusters.members()[patch] {
+                total += area * f64::from(f);
+            }
+            if f <= 0.0 || !plans[patch].touching || !in_near_field(shot, e) {
                 continue;
             }
             if clusters.is_empty() {

@@ -72,7 +72,7 @@ impl Solver {
                 Shooters { patches: &group.patches, area: group.area }
             }
         };
-        self.tally.shoot(&self.mesh, &self.tables, by, &row, omega);
+        self.tally.shoot(&self.mesh, &self.tables, by, &row, omega, self.clusters.members());
         // 4. Keep the row (or the plans it was computed with).
         let plans = if key < self.mesh.patches.len() { &self.scratch.plans[..] } else { &[] };
         self.rows.keep(key, row, was_kept, plans, &self.params);
