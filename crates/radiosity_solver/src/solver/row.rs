@@ -376,8 +376,8 @@ fn near_field(
     let mut near = NearField::default();
     let elements = shot.shooter_elements;
     let first_shooter = shot.shooter.elements.start;
-    let (mut order, mut clusters) = (Vec::new(), Vec::new());
-    let mut shares: Vec<(u32, f64)> = Vec::new();
+    // The receivers (element, factor), and the rest's Σ A F.
+    let mut receivers: Vec<(usize, f32)> = Vec::new();
     let mut offset = 0;
     let mut total = 0.0;
     for &(first, count) in &row.spans {
@@ -386,52 +386,71 @@ fn near_field(
             let f = row.factors[offset + k];
             let area = tables.element_area[e];
             let patch = tables.element_patch[e] as usize;
-            if !shot.clusters.members()[patch] {
+            if shot.clusters.members()[patch] {
+                continue;
+            }
+            if f > 0.0 && plans[patch].touching && in_near_field(shot, e) {
+                receivers.push((e, f));
+            } else {
                 total += area * f64::from(f);
             }
-            if f <= 0.0 || !plans[patch].touching || !in_near_field(shot, e) {
-                continue;
-            }
-            if clusters.is_empty() {
-                cluster_elements(elements, &vec![1.0; elements.len()], &mut order, &mut clusters);
-                for c in &clusters {
-                    let start = near.members.len() as u32;
-                    near.members.extend(order[c.members.clone()].iter().map(|&i| first_shooter + i));
-                    near.clusters.push((start, near.members.len() as u32));
-                }
-            }
-            let (p, n, ns) =
-                (shot.mesh.elements[e].centre, shot.mesh.elements[e].normal, shot.shooter.normal);
-            shares.clear();
-            for (c, cluster) in clusters.iter().enumerate() {
-                if cluster.centre.distance_squared(p) >= 16.0 * cluster.radius * cluster.radius {
-                    let phi = point_to_point(p, n, cluster.centre, ns, cluster.area);
-                    shares.push((c as u32 | CLUSTER_TERM, phi.max(0.0)));
-                } else {
-                    shares.extend(
-                        order[cluster.members.clone()].iter().map(|&i| {
-                            (first_shooter + i, elements[i as usize].factor_from(p, n, ns).max(0.0))
-                        }),
-                    );
-                }
-            }
-            let sum: f64 = shares.iter().map(|s| s.1).sum();
-            if sum <= 0.0 {
-                continue;
-            }
-            let start = near.terms.len() as u32;
-            near.terms.extend(
-                shares
-                    .iter()
-                    .filter(|s| s.1 >= MIN_SHARE * sum)
-                    .map(|&(part, phi)| (part, (phi / sum) as f32)),
-            );
-            near.receivers.push((e as u32, f, start, near.terms.len() as u32 - start));
-            near.rest -= area * f64::from(f);
         }
         offset += count as usize;
     }
-    near.rest += total;
+    near.rest = total;
+    if receivers.is_empty() {
+        return near;
+    }
+    let (mut order, mut clusters) = (Vec::new(), Vec::new());
+    cluster_elements(elements, &vec![1.0; elements.len()], &mut order, &mut clusters);
+    for c in &clusters {
+        let start = near.members.len() as u32;
+        near.members.extend(order[c.members.clone()].iter().map(|&i| first_shooter + i));
+        near.clusters.push((start, near.members.len() as u32));
+    }
+    // Each receiver's shares, receivers in parallel (they are a row's costliest part on a
+    // small scene), gathered in receiver order.
+    let ns = shot.shooter.normal;
+    let shares_of = |&(e, _): &(usize, f32)| -> Vec<(u32, f32)> {
+        let (p, n) = (shot.mesh.elements[e].centre, shot.mesh.elements[e].normal);
+        let mut shares: Vec<(u32, f64)> = Vec::new();
+        for (c, cluster) in clusters.iter().enumerate() {
+            if cluster.centre.distance_squared(p) >= 16.0 * cluster.radius * cluster.radius {
+                let phi = point_to_point(p, n, cluster.centre, ns, cluster.area);
+                shares.push((c as u32 | CLUSTER_TERM, phi.max(0.0)));
+            } else {
+                shares.extend(
+                    order[cluster.members.clone()]
+                        .iter()
+                        .map(|&i| (first_shooter + i, elements[i as usize].factor_from(p, n, ns).max(0.0))),
+                );
+            }
+        }
+        let sum: f64 = shares.iter().map(|s| s.1).sum();
+        if sum <= 0.0 {
+            return Vec::new();
+        }
+        shares
+            .iter()
+            .filter(|s| s.1 >= MIN_SHARE * sum)
+            .map(|&(part, phi)| (part, (phi / sum) as f32))
+            .collect()
+    };
+    let all: Vec<Vec<(u32, f32)>> = if receivers.len() < 64 || rayon::current_num_threads() == 1 {
+        receivers.iter().map(shares_of).collect()
+    } else {
+        receivers.par_iter().map(shares_of).collect()
+    };
+    for (&(e, f), terms) in receivers.iter().zip(all) {
+        if terms.is_empty() {
+            // Sees none of the shooter from its centre: it takes the mean with the rest.
+            near.rest += tables.element_area[e] * f64::from(f);
+            continue;
+        }
+        let start = near.terms.len() as u32;
+        near.terms.extend(terms);
+        near.receivers.push((e as u32, f, start, near.terms.len() as u32 - start));
+    }
     near
 }
 
