@@ -161,7 +161,9 @@ impl Tally {
     /// receiving element j gains ρ_j · ω ΔB_i · F_{j→i} in B_j and ΔB_j (Cohen et al. 1988,
     /// with F_{j→i} already the reciprocal form), and the shooter keeps (1 − ω) ΔB_i. The
     /// shooter is one patch or a group of them (`shooters`, of total area `area`), whose ΔB_i
-    /// is then their unshot power over their area.
+    /// is then their unshot power over their area. The receivers touching a patch shooter
+    /// take the part of it they see instead (`row::NearField`), and the others but the
+    /// `grouped` facets (per patch, `Clusters::members`) make up the difference.
     pub(super) fn shoot(
         &mut self,
         mesh: &Mesh,
@@ -315,9 +317,9 @@ impl Tally {
     }
 
     /// Adds to each receiver the part of this shot that is the shooter's own emission (its
-    /// direct light), scaled as the shot's other receivers were (`scale` but for the `grouped`
-    /// facets, see `shoot`). Only
-    /// emitters' shots carry any, so the extra pass is rare.
+    /// direct light), scaled as the shot's other receivers were (`scale`, but for the
+    /// `grouped` facets; see `shoot`). Only emitters' shots carry any, so the extra pass is
+    /// rare.
     fn tally_direct(
         &mut self,
         tables: &MeshTables,
