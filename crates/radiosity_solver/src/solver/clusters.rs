@@ -62,6 +62,10 @@ const POINTS: usize = 64;
 /// faces it: a grazing receiver).
 const FAR_TRIES: usize = 16;
 
+/// A group is cut into tiles of at most this many facets, which share their visibility on
+/// their own when the whole group is too near the shooter to (see [`super::shared`]).
+const TILE_FACETS: usize = 64;
+
 /// No group.
 const NONE: u32 = u32::MAX;
 
@@ -78,6 +82,10 @@ pub(super) struct Clusters {
     of_element: Vec<u32>,
     /// The groups, in order of their first member.
     groups: Vec<Group>,
+    /// The groups' tiles, group after group.
+    tiles: Vec<Tile>,
+    /// Per element of a group's patch, its tile, or [`NONE`].
+    tile_of: Vec<u32>,
     /// Per group, Σ |unshot power| over its members, kept up to date by [`Clusters::update`].
     power: Vec<f64>,
     /// The patches in no group, in index order.
@@ -88,7 +96,7 @@ pub(super) struct Clusters {
 
 /// One group of facets that shoots as one.
 pub(super) struct Group {
-    /// Its patches, in index order.
+    /// Its patches, tile after tile (see [`Tile`]).
     pub(super) patches: Vec<u32>,
     /// Their elements, in the same order.
     pub(super) elements: Vec<u32>,
@@ -104,8 +112,24 @@ pub(super) struct Group {
     pub(super) radius: f64,
     /// Some member emits (see [`patch_emits`]).
     pub(super) emits: bool,
+    /// Its tiles, a range of [`Clusters`]' tiles.
+    pub(super) tiles: std::ops::Range<u32>,
     /// What its first shot fixed.
     frozen: Option<Frozen>,
+}
+
+/// A run of a group's facets that lie together: the group's patches cut in halves across
+/// their longest extent until at most [`TILE_FACETS`] are left. A shooter too near a group
+/// for the whole of it to share one visibility estimate may still be far from each tile.
+pub(super) struct Tile {
+    /// Its elements: a range of its group's `elements` (and `receivers`).
+    pub(super) elements: std::ops::Range<u32>,
+    /// Its number of patches.
+    pub(super) patches: u32,
+    /// Area-weighted centroid.
+    pub(super) centre: DVec3,
+    /// Largest distance from `centre` to a member's corner.
+    pub(super) radius: f64,
 }
 
 /// A group's unshot power as its first shot spread it.
@@ -134,7 +158,7 @@ impl Clusters {
     /// Groups the facets of `mesh` (none when `enabled` is false).
     pub(super) fn new(mesh: &Mesh, enabled: bool) -> Self {
         let mut of_patch = vec![NONE; mesh.patches.len()];
-        let mut groups = Vec::new();
+        let (mut groups, mut tiles) = (Vec::new(), Vec::new());
         if enabled && !mesh.patches.is_empty() {
             let mut patches_of_surface = vec![0u32; mesh.surfaces.len()];
             let mut surface_area = vec![0.0f64; mesh.surfaces.len()];
@@ -173,21 +197,25 @@ impl Clusters {
             }
             let mut lists: Vec<Vec<u32>> = by_key.into_values().filter(|m| m.len() > 1).collect();
             lists.sort_unstable_by_key(|m| m[0]);
-            for patches in lists {
-                let area: f64 = patches.iter().map(|&q| mesh.patches[q as usize].area).sum();
-                let centre = patches
-                    .iter()
-                    .map(|&q| mesh.patches[q as usize].centre * mesh.patches[q as usize].area)
-                    .sum::<DVec3>()
-                    / area;
-                let radius = (patches.iter())
-                    .flat_map(|&q| mesh.patches[q as usize].corners().iter())
-                    .map(|c| c.distance(centre))
-                    .fold(0.0, f64::max);
+            for mut patches in lists {
+                let (centre, radius, area) = extent(mesh, &patches);
+                let mut cuts = Vec::new();
+                cut_into_tiles(mesh, &mut patches, 0, &mut cuts);
                 let mut elements = Vec::new();
-                for &q in &patches {
-                    of_patch[q as usize] = groups.len() as u32;
-                    elements.extend(mesh.patches[q as usize].elements.clone());
+                let first_tile = tiles.len() as u32;
+                for cut in cuts {
+                    let start = elements.len() as u32;
+                    for &q in &patches[cut.clone()] {
+                        of_patch[q as usize] = groups.len() as u32;
+                        elements.extend(mesh.patches[q as usize].elements.clone());
+                    }
+                    let (centre, radius, _) = extent(mesh, &patches[cut.clone()]);
+                    tiles.push(Tile {
+                        elements: start..elements.len() as u32,
+                        patches: cut.len() as u32,
+                        centre,
+                        radius,
+                    });
                 }
                 let receivers = (elements.iter())
                     .map(|&e| {
@@ -204,16 +232,25 @@ impl Clusters {
                     centre,
                     radius,
                     emits,
+                    tiles: first_tile..tiles.len() as u32,
                     frozen: None,
                 });
             }
         }
         let members = of_patch.iter().map(|&g| g != NONE).collect();
         let (mut slot, mut of_element) = (vec![NONE; mesh.elements.len()], vec![NONE; mesh.elements.len()]);
+        let mut tile_of = vec![NONE; mesh.elements.len()];
         for (g, group) in groups.iter().enumerate() {
             for (k, &e) in group.elements.iter().enumerate() {
                 slot[e as usize] = k as u32;
                 of_element[e as usize] = g as u32;
+            }
+            for t in group.tiles.clone() {
+                for &e in &group.elements[tiles[t as usize].elements.start as usize..]
+                    [..tiles[t as usize].elements.len()]
+                {
+                    tile_of[e as usize] = t;
+                }
             }
         }
         let singles = (0..of_patch.len() as u32).filter(|&q| of_patch[q as usize] == NONE).collect();
@@ -226,18 +263,29 @@ impl Clusters {
             singles,
             since_sum: 0,
             groups,
+            tiles,
+            tile_of,
         }
+    }
+
+    /// Tile `t`.
+    pub(super) fn tile(&self, t: usize) -> &Tile {
+        &self.tiles[t]
+    }
+
+    /// Number of tiles.
+    pub(super) fn tile_count(&self) -> usize {
+        self.tiles.len()
+    }
+
+    /// Element `e`'s tile (meaningless for elements in no group).
+    pub(super) fn tile_of(&self, e: usize) -> usize {
+        self.tile_of[e] as usize
     }
 
     /// Per patch, whether it is in a group.
     pub(super) fn members(&self) -> &[bool] {
         &self.members
-    }
-
-    /// Patch `q`'s group, if it is in one.
-    pub(super) fn group_of(&self, q: usize) -> Option<usize> {
-        let g = self.of_patch[q];
-        (g != NONE).then_some(g as usize)
     }
 
     /// Element `e`'s group, if its patch is in one.
@@ -404,7 +452,7 @@ impl Clusters {
         let traced = AtomicU64::new(0);
         // Elements in no sharing group, with their own rays; the sharing groups' below.
         for_each_maybe_parallel(factors, |e, out| {
-            if sharing.element_group(self, e).is_some() {
+            if sharing.member(self, e).is_some() {
                 return;
             }
             let el = &mesh.elements[e];
@@ -430,8 +478,8 @@ impl Clusters {
                 &tables.element_area,
                 (params.seed, stream),
                 // Another group's members: none is a patch of the shooting group.
-                |r| {
-                    let receivers = &self.groups[r].receivers;
+                |r, range| {
+                    let receivers = &self.groups[r].receivers[range];
                     receivers
                         .iter()
                         .map(|&(p, n)| unoccluded(group, frozen, p, n, NONE, &mut [0.0; POINTS]).0)
@@ -445,9 +493,9 @@ impl Clusters {
             );
             traced += rays;
             for_each_maybe_parallel(factors, |e, out| {
-                if let Some(g) = sharing.element_group(self, e) {
-                    let r = &received[g];
-                    *out = (r.factors[self.slot(e)] * r.visibility()) as f32;
+                if let Some((u, k)) = sharing.member(self, e) {
+                    let r = &received[u];
+                    *out = (r.factors[k] * r.visibility()) as f32;
                 }
             });
         }
@@ -545,6 +593,44 @@ fn facing(n: DVec3) -> u8 {
         (2, n.z)
     };
     2 * axis + u8::from(value < 0.0)
+}
+
+/// The area-weighted centroid of `patches`, the largest distance from it to one of their
+/// corners, and their area.
+fn extent(mesh: &Mesh, patches: &[u32]) -> (DVec3, f64, f64) {
+    let area: f64 = patches.iter().map(|&q| mesh.patches[q as usize].area).sum();
+    let centre = patches
+        .iter()
+        .map(|&q| mesh.patches[q as usize].centre * mesh.patches[q as usize].area)
+        .sum::<DVec3>()
+        / area;
+    let radius = (patches.iter())
+        .flat_map(|&q| mesh.patches[q as usize].corners().iter())
+        .map(|c| c.distance(centre))
+        .fold(0.0, f64::max);
+    (centre, radius, area)
+}
+
+/// Orders `patches` (starting at `offset` in their group) into tiles of at most
+/// [`TILE_FACETS`], halved at the median of their centres along the longest side of the
+/// centres' box, and pushes each tile's range. Ties are broken by index, so the order is
+/// the same from run to run.
+fn cut_into_tiles(mesh: &Mesh, patches: &mut [u32], offset: usize, cuts: &mut Vec<std::ops::Range<usize>>) {
+    if patches.len() <= TILE_FACETS {
+        cuts.push(offset..offset + patches.len());
+        return;
+    }
+    let centre = |q: u32| mesh.patches[q as usize].centre;
+    let (lo, hi) = patches
+        .iter()
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &q| (lo.min(centre(q)), hi.max(centre(q))));
+    let axis = (hi - lo).max_position();
+    let half = patches.len() / 2;
+    patches
+        .select_nth_unstable_by(half, |&a, &b| centre(a)[axis].total_cmp(&centre(b)[axis]).then(a.cmp(&b)));
+    let (left, right) = patches.split_at_mut(half);
+    cut_into_tiles(mesh, left, offset, cuts);
+    cut_into_tiles(mesh, right, offset + half, cuts);
 }
 
 /// Σ |unshot power| over `patches`' elements.
@@ -660,6 +746,35 @@ mod tests {
             Object { name: "globe".into(), material: 0, shape: Shape::Mesh(globe), sides: Sides::One };
         let scene = Scene::try_new("globe", None, vec![white], vec![object]).unwrap();
         Mesh::build(&scene, &MeshParams::try_new(1.0, 1.0).unwrap()).unwrap()
+    }
+
+    /// A group's tiles cover its elements once, in runs of at most [`TILE_FACETS`] patches,
+    /// each within its own radius of its centre and smaller than the group.
+    #[test]
+    fn tiles_cut_each_group_into_small_runs_that_cover_it() {
+        let mesh = globe(96, 192);
+        let clusters = Clusters::new(&mesh, true);
+        let mut cut = 0;
+        for g in 0..clusters.len() {
+            let group = clusters.group(g);
+            let mut next = 0;
+            for t in group.tiles.clone().map(|t| t as usize) {
+                let tile = clusters.tile(t);
+                assert_eq!(tile.elements.start, next, "group {g}: tiles in order, no gaps");
+                next = tile.elements.end;
+                assert!(tile.patches as usize <= TILE_FACETS && tile.patches > 0);
+                assert!(tile.radius <= group.radius + 1e-12);
+                for &e in &group.elements[tile.elements.start as usize..tile.elements.end as usize] {
+                    assert_eq!(clusters.tile_of(e as usize), t);
+                    for c in mesh.element_corners(e as usize) {
+                        assert!(c.distance(tile.centre) <= tile.radius + 1e-12);
+                    }
+                }
+            }
+            assert_eq!(next as usize, group.elements.len());
+            cut += usize::from(group.tiles.len() > 1);
+        }
+        assert!(cut > 0, "some group larger than a tile");
     }
 
     /// Polygon scenes have no facets to group; a tessellated sphere's facets fall into groups

@@ -126,8 +126,9 @@ impl Solver {
         let emits = super::clusters::patch_emits(&mesh, shooter);
         self.scratch.sharing.choose(&self.clusters, patch.centre, shooter_radius, emits, share, None);
         if self.rows.plans(shooter).is_none() {
-            let (sharing, clusters) = (&self.scratch.sharing, &self.clusters);
-            let shares = |q: usize| sharing.shares(clusters, q);
+            let (sharing, clusters, patch_elements) =
+                (&self.scratch.sharing, &self.clusters, &self.tables.patch_elements);
+            let shares = |q: usize| sharing.member(clusters, patch_elements[q].start).is_some();
             let reference = self.params.reference_path;
             plan_patches(&mesh, shooter, &self.tables, reference, shares, &mut self.scratch.plans);
         }
@@ -279,7 +280,7 @@ fn penumbra_pass(
     let flags: &[bool] = flags;
     for_each_maybe_parallel(factors, |e, out| {
         // A sharing group's members take its visibility, not rays of their own.
-        if flags[e] && shot.sharing.element_group(shot.clusters, e).is_none() {
+        if flags[e] && shot.sharing.member(shot.clusters, e).is_none() {
             let plan = &plans[tables.element_patch[e] as usize];
             let (visible, traced) = trace(shot, plan, e, Rays::Penumbra);
             out.visible += visible;
@@ -299,8 +300,8 @@ fn receive_shared(shot: &Shot, plans: &[PatchPlan], element_area: &[f64], factor
     }
     let Shot { mesh, shooter, clusters, sharing, .. } = *shot;
     let corners = shooter.corners();
-    let factors_of = |g: usize| -> Vec<f64> {
-        let receivers = &clusters.group(g).receivers;
+    let factors_of = |g: usize, range: std::ops::Range<usize>| -> Vec<f64> {
+        let receivers = &clusters.group(g).receivers[range];
         let mut out = vec![0.0; receivers.len()];
         // Strictly facing members, batched four at a time.
         let (mut batch, mut n) = ([0usize; 4], 0);
@@ -343,10 +344,10 @@ fn receive_shared(shot: &Shot, plans: &[PatchPlan], element_area: &[f64], factor
             trace(shot, plan_of(e), e, Rays::Pilot)
         });
     for_each_maybe_parallel(factors, |e, r| {
-        if let Some(g) = sharing.element_group(clusters, e) {
-            let f = received[g].factors[clusters.slot(e)];
+        if let Some((u, k)) = sharing.member(clusters, e) {
+            let f = received[u].factors[k];
             (r.unoccluded, r.unweighted) = (f, f);
-            (r.visible, r.traced) = if f > 0.0 { received[g].seen } else { (0, 0) };
+            (r.visible, r.traced) = if f > 0.0 { received[u].seen } else { (0, 0) };
         }
     });
     rays

@@ -18,6 +18,12 @@
 //! own unoccluded form factor. Sharing for every shooter that was not bright (≥ 1 % of the
 //! first shot) instead gave the same object means on the 30 k and 120 k rooms (within
 //! 0.3 %) and took 11 % longer on the 120 k one.
+//!
+//! A group too near the shooter to share whole (a floor patch under a scanned statue) may
+//! still be far from each of its tiles, the runs of at most 64 facets that lie together
+//! (`clusters::Tile`): those share on their own, by the same test against their own radius.
+//! On a 834 k-triangle room most of a row's time went to the facets of such near groups,
+//! each with its own plan, quadrature and rays.
 
 use rayon::prelude::*;
 
@@ -25,8 +31,8 @@ use super::clusters::Clusters;
 use crate::sampling::Rng;
 use glam::DVec3;
 
-/// A receiving group shares its visibility when its centre is at least this many times the
-/// sum of its radius and the shooter's away from the shooter's centre.
+/// A receiving group or tile shares its visibility when its centre is at least this many
+/// times the sum of its radius and the shooter's away from the shooter's centre.
 const SHARE_DISTANCE: f64 = 2.5;
 
 /// Rays a sharing group traces (from members drawn by power, stratified).
@@ -35,17 +41,40 @@ const SHARED_RAYS: u32 = 16;
 /// Random streams of the draws are keyed apart from elements' and groups' own.
 const SHARED_STREAM: u64 = 0x7368_6172_6564_0000;
 
-/// Which receiving groups share their visibility in one row.
+/// A tile's draws are keyed apart from whole groups'.
+const TILE_KEY: u64 = 1 << 40;
+
+/// Not sharing.
+const NONE: u32 = u32::MAX;
+
+/// A group that does not share whole, some of whose tiles do.
+const TILED: u32 = u32::MAX - 1;
+
+/// Which receiving groups and tiles share their visibility in one row.
 #[derive(Default)]
 pub(super) struct Sharing {
-    /// Per group, whether it shares.
-    groups: Vec<bool>,
+    /// Per group: the unit it shares as whole, [`TILED`], or [`NONE`].
+    group_unit: Vec<u32>,
+    /// Per tile: the unit it shares as, or [`NONE`] (read for [`TILED`] groups only).
+    tile_unit: Vec<u32>,
+    /// The units that share: a whole group or one tile.
+    units: Vec<Unit>,
 }
 
-/// What one sharing group received from a shot.
+/// A run of one group's elements that shares one visibility estimate.
+struct Unit {
+    /// Its group.
+    group: usize,
+    /// Its elements: a range of the group's `elements`.
+    elements: std::ops::Range<usize>,
+    /// Its random stream's key.
+    key: u64,
+}
+
+/// What one sharing unit received from a shot.
 #[derive(Default)]
 pub(super) struct Shared {
-    /// Its member elements' unoccluded form factors, in the group's element order.
+    /// Its member elements' unoccluded form factors, in the unit's element order.
     pub(super) factors: Vec<f64>,
     /// (unblocked, traced) of its shared rays, a draw that needed no ray counted as one
     /// unblocked; (0, 0) when nothing of it receives.
@@ -62,11 +91,11 @@ impl Shared {
 }
 
 impl Sharing {
-    /// Chooses the sharing groups for a shooter centred at `centre` with circumradius
-    /// `radius`: none when it `emits` or when sharing is off, else those at least
-    /// [`SHARE_DISTANCE`] radii away with more members than [`SHARED_RAYS`]; `shooter_group`
-    /// is the shooting group, which never shares (its members receive from each other up
-    /// close).
+    /// Chooses what shares for a shooter centred at `centre` with circumradius `radius`:
+    /// nothing when it `emits` or when sharing is off, else the groups with more members
+    /// than [`SHARED_RAYS`] at least [`SHARE_DISTANCE`] radii away, and of the others, the
+    /// tiles that are; `shooter_group` is the shooting group, which never shares (its
+    /// members receive from each other up close).
     pub(super) fn choose(
         &mut self,
         clusters: &Clusters,
@@ -76,68 +105,80 @@ impl Sharing {
         enabled: bool,
         shooter_group: Option<usize>,
     ) {
-        self.groups.clear();
-        self.groups.extend((0..clusters.len()).map(|g| {
+        self.group_unit.clear();
+        self.group_unit.resize(clusters.len(), NONE);
+        self.tile_unit.clear();
+        self.tile_unit.resize(clusters.tile_count(), NONE);
+        self.units.clear();
+        if !enabled || emits {
+            return;
+        }
+        let far = |c: DVec3, r: f64, members: usize| {
+            members > SHARED_RAYS as usize && c.distance(centre) > SHARE_DISTANCE * (r + radius)
+        };
+        for g in (0..clusters.len()).filter(|&g| Some(g) != shooter_group) {
             let group = clusters.group(g);
-            enabled
-                && !emits
-                && Some(g) != shooter_group
-                && group.patches.len() > SHARED_RAYS as usize
-                && group.centre.distance(centre) > SHARE_DISTANCE * (group.radius + radius)
-        }));
+            if far(group.centre, group.radius, group.patches.len()) {
+                self.group_unit[g] = self.units.len() as u32;
+                self.units.push(Unit { group: g, elements: 0..group.elements.len(), key: g as u64 });
+                continue;
+            }
+            for t in group.tiles.clone().map(|t| t as usize) {
+                let tile = clusters.tile(t);
+                if far(tile.centre, tile.radius, tile.patches as usize) {
+                    self.group_unit[g] = TILED;
+                    self.tile_unit[t] = self.units.len() as u32;
+                    let elements = tile.elements.start as usize..tile.elements.end as usize;
+                    self.units.push(Unit { group: g, elements, key: TILE_KEY | t as u64 });
+                }
+            }
+        }
     }
 
-    /// Whether any group shares.
+    /// Whether anything shares.
     pub(super) fn any(&self) -> bool {
-        self.groups.iter().any(|&s| s)
+        !self.units.is_empty()
     }
 
-    /// Whether patch `q`'s elements take their group's shared visibility.
-    pub(super) fn shares(&self, clusters: &Clusters, q: usize) -> bool {
-        self.group_of(clusters, q).is_some()
+    /// Element `e`'s sharing unit and its place in the unit's elements, when it shares.
+    pub(super) fn member(&self, clusters: &Clusters, e: usize) -> Option<(usize, usize)> {
+        let g = clusters.group_of_element(e)?;
+        let unit = match self.group_unit[g] {
+            NONE => return None,
+            TILED => self.tile_unit[clusters.tile_of(e)],
+            u => u,
+        };
+        (unit != NONE).then(|| (unit as usize, clusters.slot(e) - self.units[unit as usize].elements.start))
     }
 
-    /// Element `e`'s group, when it shares.
-    pub(super) fn element_group(&self, clusters: &Clusters, e: usize) -> Option<usize> {
-        clusters.group_of_element(e).filter(|&g| self.groups[g])
-    }
-
-    /// Patch `q`'s group, when it shares.
-    pub(super) fn group_of(&self, clusters: &Clusters, q: usize) -> Option<usize> {
-        clusters.group_of(q).filter(|&g| self.groups[g])
-    }
-
-    /// Each sharing group's receiving: `factors(g)` gives group `g`'s member elements'
-    /// unoccluded form factors (in the group's element order), then [`SHARED_RAYS`] members
+    /// Each sharing unit's receiving: `factors(g, range)` gives the unoccluded form factors
+    /// of group `g`'s members in `range` of its elements, then [`SHARED_RAYS`] members
     /// drawn by area × factor, stratified, trace `ray(e)` (the (unblocked, traced) of
-    /// element `e`'s own first ray; drawn twice, the same ray). Returns, per group, its
-    /// factors and what its rays saw (empty and (0, 0) when it does not share), and the
-    /// rays traced. Each group draws from its own stream, so the threads change nothing.
+    /// element `e`'s own first ray; drawn twice, the same ray). Returns, per unit (see
+    /// [`Sharing::member`]), its factors and what its rays saw, and the rays traced. Each
+    /// unit draws from its own stream, so the threads change nothing.
     pub(super) fn receive(
         &self,
         clusters: &Clusters,
         area: &[f64],
         (seed, stream): (u64, u64),
-        factors: impl Fn(usize) -> Vec<f64> + Sync,
+        factors: impl Fn(usize, std::ops::Range<usize>) -> Vec<f64> + Sync,
         ray: impl Fn(usize) -> (u32, u32) + Sync,
     ) -> (Vec<Shared>, u64) {
-        let one = |g: usize| -> Shared {
-            if !self.groups[g] {
-                return Shared::default();
-            }
-            let elements = &clusters.group(g).elements;
-            let factors = factors(g);
+        let one = |unit: &Unit| -> Shared {
+            let elements = &clusters.group(unit.group).elements[unit.elements.clone()];
+            let factors = factors(unit.group, unit.elements.clone());
             let weight = |k: usize| area[elements[k] as usize] * factors[k];
             let total: f64 = (0..elements.len()).map(weight).sum();
             if !(total > 0.0 && total.is_finite()) {
                 return Shared { factors, ..Shared::default() };
             }
-            let mut rng = Rng::for_task(seed, stream ^ SHARED_STREAM, g as u64);
+            let mut rng = Rng::for_task(seed, stream ^ SHARED_STREAM, unit.key);
             let (mut visible, mut drawn, mut rays) = (0, 0, 0);
             let (mut walked, mut k) = (0.0, 0);
             for j in 0..SHARED_RAYS {
                 // Stratified over the cumulative weights: the j-th draw lands in the j-th
-                // slice of the group's power.
+                // slice of the unit's power.
                 let t = (f64::from(j) + rng.next_f64()) / f64::from(SHARED_RAYS) * total;
                 while k + 1 < elements.len() && walked + weight(k) < t {
                     walked += weight(k);
@@ -152,7 +193,7 @@ impl Sharing {
             }
             Shared { factors, seen: (visible, drawn), rays }
         };
-        let received: Vec<Shared> = (0..self.groups.len()).into_par_iter().map(one).collect();
+        let received: Vec<Shared> = self.units.par_iter().map(one).collect();
         let rays = received.iter().map(|r| u64::from(r.rays)).sum();
         (received, rays)
     }

@@ -110,7 +110,7 @@ impl Shot<'_> {
     /// Whether patch `q`'s elements take their group's shared visibility instead of rays
     /// of their own.
     pub(super) fn shares(&self, q: usize) -> bool {
-        self.sharing.shares(self.clusters, q)
+        self.sharing.member(self.clusters, self.patch_elements[q].start).is_some()
     }
 
     /// The pilot-ray strata of element `e`'s patch.
