@@ -17,7 +17,10 @@
 //! differ in steps start a new surface: a shading seam there, the price of keeping every
 //! lattice exact without subdividing small triangles far below the element size.
 
-use std::collections::{HashMap, HashSet};
+// Fx hashing: the mesher's maps hold millions of small integer keys (a vertex's bits, an
+// edge's two indices), where SipHash was a third of the meshing time of a 834 k-triangle
+// model; nothing here is keyed by untrusted input an attacker could collide.
+use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
 use std::ops::Range;
 
 use glam::DVec3;
@@ -170,7 +173,7 @@ impl Refinement {
     /// An element on the back of a two-sided surface names its front twin (the back is
     /// a copy of the front's mesh). Returns how many elements the level names.
     pub fn add_level(&mut self, mesh: &Mesh, elements: impl IntoIterator<Item = usize>) -> usize {
-        let mut level: HashMap<u32, HashSet<[u64; 3]>> = HashMap::new();
+        let mut level: HashMap<u32, HashSet<[u64; 3]>> = HashMap::default();
         let mut count = 0;
         for e in elements {
             let e = if mesh.element_is_back(e) { mesh.element_twin(e).unwrap_or(e) } else { e };
@@ -385,37 +388,44 @@ impl Smoothing {
         let (lo, hi) = mesh.bounds();
         let diagonal = (hi - lo).length().max(f64::MIN_POSITIVE);
         let grid = 1e-7 * diagonal;
-        let mut places: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
-        for v in (0..mesh.positions.len()).filter(|&v| vertex_surface[v] != u32::MAX) {
-            let p = mesh.positions[v];
-            places.entry([p.x, p.y, p.z].map(|c| (c / grid).round() as i64)).or_default().push(v as u32);
-        }
+        // Vertices sorted by place, those in one place side by side (sorting millions of them
+        // is faster than a map of lists, which allocated a list per place).
+        let mut places: Vec<([i64; 3], u32)> = (0..mesh.positions.len())
+            .filter(|&v| vertex_surface[v] != u32::MAX)
+            .map(|v| (mesh.positions[v].to_array().map(|c| (c / grid).round() as i64), v as u32))
+            .collect();
+        places.sort_unstable();
         let mut pairs: Vec<(u32, u32, f32)> = Vec::new();
-        for group in places.values().filter(|g| g.len() > 1) {
-            for &a in group {
-                pairs.extend(group.iter().filter(|&&b| compatible(a, b)).map(|&b| (a, b, 1.0)));
+        for group in places.chunk_by(|x, y| x.0 == y.0).filter(|g| g.len() > 1) {
+            for &(_, a) in group {
+                pairs.extend(group.iter().filter(|&&(_, b)| compatible(a, b)).map(|&(_, b)| (a, b, 1.0)));
             }
         }
         t_junctions(mesh, &vertex_surface, 1e-6 * diagonal, &compatible, &mut pairs);
         if pairs.is_empty() {
             return Self::default();
         }
-        pairs.sort_unstable_by_key(|&(a, b, _)| (a, b));
-        let mut offsets = Vec::with_capacity(mesh.positions.len() + 1);
-        let mut partners = Vec::with_capacity(pairs.len());
-        let mut weights = Vec::with_capacity(pairs.len());
-        let mut next = pairs.iter().peekable();
-        for v in 0..mesh.positions.len() as u32 {
-            offsets.push(partners.len() as u32);
-            while let Some(&&(a, b, w)) = next.peek()
-                && a == v
-            {
-                partners.push(b);
-                weights.push(w);
-                next.next();
-            }
+        // Bucketed by vertex (a counting sort: a scanned model pools each of its millions of
+        // vertices with several others), then each vertex's few partners in order.
+        let mut offsets = vec![0u32; mesh.positions.len() + 1];
+        for &(a, _, _) in &pairs {
+            offsets[a as usize + 1] += 1;
         }
-        offsets.push(partners.len() as u32);
+        for v in 0..mesh.positions.len() {
+            offsets[v + 1] += offsets[v];
+        }
+        let mut filled = offsets.clone();
+        let mut by_vertex = vec![(0u32, 0.0f32); pairs.len()];
+        for &(a, b, w) in &pairs {
+            by_vertex[filled[a as usize] as usize] = (b, w);
+            filled[a as usize] += 1;
+        }
+        drop(pairs);
+        for v in 0..mesh.positions.len() {
+            by_vertex[offsets[v] as usize..offsets[v + 1] as usize]
+                .sort_unstable_by_key(|&(b, w)| (b, w.to_bits()));
+        }
+        let (partners, weights) = by_vertex.into_iter().unzip();
         Self { offsets, partners, weights }
     }
 }
@@ -434,23 +444,23 @@ fn t_junctions(
     compatible: &dyn Fn(u32, u32) -> bool,
     pairs: &mut Vec<(u32, u32, f32)>,
 ) {
-    let mut uses: HashMap<(u32, u32), u32> = HashMap::new();
-    for el in &mesh.elements {
-        let v = el.vertex_indices();
-        for k in 0..v.len() {
-            let (a, b) = (v[k], v[(k + 1) % v.len()]);
-            *uses.entry((a.min(b), a.max(b))).or_default() += 1;
-        }
-    }
-    let mut outline: Vec<(u32, u32)> = uses.into_iter().filter(|&(_, n)| n == 1).map(|(e, _)| e).collect();
-    // In index order: the hash map's order would make the pairs' order vary from run to run.
-    outline.sort_unstable();
+    // Every element edge, sorted: an edge used once within its surface stands alone.
+    let mut edges: Vec<(u32, u32)> = (mesh.elements.iter())
+        .flat_map(|el| {
+            let v = el.vertex_indices();
+            (0..v.len()).map(move |k| (v[k].min(v[(k + 1) % v.len()]), v[k].max(v[(k + 1) % v.len()])))
+        })
+        .collect();
+    edges.sort_unstable();
+    let outline: Vec<(u32, u32)> =
+        edges.chunk_by(|x, y| x == y).filter(|run| run.len() == 1).map(|run| run[0]).collect();
+    drop(edges);
     // Copies: the facets of a model repeat each corner and edge of their neighbours, and the
     // two faces of a two-sided object each other's; every place and every segment is tested
     // once, its copies only on a hit (on a million facets, testing each copy was 143 M tests
     // and most of the meshing time).
     let bits = |p: DVec3| p.to_array().map(f64::to_bits);
-    let mut segment_of: HashMap<([u64; 3], [u64; 3]), u32> = HashMap::new();
+    let mut segment_of: HashMap<([u64; 3], [u64; 3]), u32> = HashMap::default();
     let mut segments: Vec<(DVec3, DVec3)> = Vec::new(); // start, direction
     let mut edge_copies: Vec<(u32, u32, u32)> = Vec::with_capacity(outline.len()); // segment, from, to
     for &(a, b) in &outline {
@@ -482,7 +492,7 @@ fn t_junctions(
         return;
     }
     let cell = |p: DVec3| (p / size).floor().as_i64vec3().to_array();
-    let mut cells: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+    let mut cells: HashMap<[i64; 3], Vec<u32>> = HashMap::default();
     let mut touched = Vec::new();
     for (i, &(pa, d)) in segments.iter().enumerate() {
         let pb = pa + d;
@@ -644,7 +654,7 @@ fn mesh_triangle_lattice(
 ) {
     let n = np * ne;
     let coarse = |i: usize, j: usize| at(i * ne, j * ne);
-    let mut patch_of: HashMap<(usize, usize, bool), usize> = HashMap::new();
+    let mut patch_of: HashMap<(usize, usize, bool), usize> = HashMap::default();
     let mut label = |b: &mut SurfaceBuilder, x3: usize, y3: usize| {
         // Centroid in lattice units times 3, to stay in integers.
         let (pp, qq) = (x3 / (3 * ne), y3 / (3 * ne));
@@ -774,7 +784,7 @@ fn group_mesh_faces(m: &PolygonMesh, params: &MeshParams) -> Vec<Vec<u32>> {
     let polys = m.polygons();
     let is_tri = |f: usize| faces[f].len() == 3;
     // Edge → the (up to two) triangles using it, and how many faces use it at all.
-    let mut edges: HashMap<(u32, u32), (u32, u32, u32)> = HashMap::new();
+    let mut edges: HashMap<(u32, u32), (u32, u32, u32)> = HashMap::default();
     for (f, face) in faces.iter().enumerate() {
         for k in 0..face.len() {
             let (a, b) = (face[k], face[(k + 1) % face.len()]);
@@ -837,7 +847,7 @@ fn group_mesh_faces(m: &PolygonMesh, params: &MeshParams) -> Vec<Vec<u32>> {
             same_steps.union(a, b);
         }
     }
-    let mut group_of: HashMap<u32, usize> = HashMap::new();
+    let mut group_of: HashMap<u32, usize> = HashMap::default();
     let mut groups: Vec<Vec<u32>> = Vec::new();
     for f in 0..faces.len() as u32 {
         let r = same_steps.find(f);
@@ -989,7 +999,7 @@ impl Mesh {
         let contacts = (params.contacts || params.corner_refinement > 0).then(|| Contacts::new(scene));
         // The back face of an emitting material that emits from its front only: the same
         // reflectance, no emission (one per material, made when first needed).
-        let mut dark_back = HashMap::new();
+        let mut dark_back = HashMap::default();
         for (oi, o) in scene.objects.iter().enumerate() {
             let first_surface = mesh.surfaces.len() as u32;
             // A polygon of this object, cut around what stands on it, graded and refined.
@@ -1414,7 +1424,7 @@ mod tests {
                 assert!(((*p - s.center).normalize() * sign - *n).length() < 1e-9);
             }
             // Closed: every edge is shared by exactly two facets.
-            let mut count = HashMap::new();
+            let mut count = HashMap::default();
             for e in &mesh.elements {
                 let v = e.vertex_indices();
                 for k in 0..v.len() {
@@ -1649,8 +1659,8 @@ mod tests {
             let patches = surface.patches.start as usize..surface.patches.end as usize;
             let elements = m.patches[patches.start].elements.start as usize
                 ..m.patches[patches.end - 1].elements.end as usize;
-            let mut vertices = HashSet::new();
-            let mut sides = HashSet::new();
+            let mut vertices = HashSet::default();
+            let mut sides = HashSet::default();
             for e in elements.clone() {
                 let v = m.elements[e].vertex_indices();
                 for k in 0..v.len() {
