@@ -77,15 +77,10 @@ pub(super) struct Clusters {
     members: Vec<bool>,
     /// Per element of a group's patch, its place in the group's `elements`.
     slot: Vec<u32>,
-    /// Per element, its patch's group, or [`NONE`] (read in element order: the elements
-    /// themselves are 168 bytes each).
-    of_element: Vec<u32>,
     /// The groups, in order of their first member.
     groups: Vec<Group>,
     /// The groups' tiles, group after group.
     tiles: Vec<Tile>,
-    /// Per element of a group's patch, its tile, or [`NONE`].
-    tile_of: Vec<u32>,
     /// Per group, Σ |unshot power| over its members, kept up to date by [`Clusters::update`].
     power: Vec<f64>,
     /// The patches in no group, in index order.
@@ -238,34 +233,14 @@ impl Clusters {
             }
         }
         let members = of_patch.iter().map(|&g| g != NONE).collect();
-        let (mut slot, mut of_element) = (vec![NONE; mesh.elements.len()], vec![NONE; mesh.elements.len()]);
-        let mut tile_of = vec![NONE; mesh.elements.len()];
-        for (g, group) in groups.iter().enumerate() {
+        let mut slot = vec![NONE; mesh.elements.len()];
+        for group in &groups {
             for (k, &e) in group.elements.iter().enumerate() {
                 slot[e as usize] = k as u32;
-                of_element[e as usize] = g as u32;
-            }
-            for t in group.tiles.clone() {
-                for &e in &group.elements[tiles[t as usize].elements.start as usize..]
-                    [..tiles[t as usize].elements.len()]
-                {
-                    tile_of[e as usize] = t;
-                }
             }
         }
         let singles = (0..of_patch.len() as u32).filter(|&q| of_patch[q as usize] == NONE).collect();
-        Self {
-            of_patch,
-            members,
-            slot,
-            of_element,
-            power: vec![0.0; groups.len()],
-            singles,
-            since_sum: 0,
-            groups,
-            tiles,
-            tile_of,
-        }
+        Self { of_patch, members, slot, power: vec![0.0; groups.len()], singles, since_sum: 0, groups, tiles }
     }
 
     /// Tile `t`.
@@ -273,25 +248,14 @@ impl Clusters {
         &self.tiles[t]
     }
 
-    /// Number of tiles.
-    pub(super) fn tile_count(&self) -> usize {
-        self.tiles.len()
-    }
-
-    /// Element `e`'s tile (meaningless for elements in no group).
-    pub(super) fn tile_of(&self, e: usize) -> usize {
-        self.tile_of[e] as usize
+    /// Number of elements in the mesh the groups were made for.
+    pub(super) fn element_count(&self) -> usize {
+        self.slot.len()
     }
 
     /// Per patch, whether it is in a group.
     pub(super) fn members(&self) -> &[bool] {
         &self.members
-    }
-
-    /// Element `e`'s group, if its patch is in one.
-    pub(super) fn group_of_element(&self, e: usize) -> Option<usize> {
-        let g = self.of_element[e];
-        (g != NONE).then_some(g as usize)
     }
 
     /// Element `e`'s place in its group's `elements` (meaningless for elements in no group).
@@ -452,7 +416,7 @@ impl Clusters {
         let traced = AtomicU64::new(0);
         // Elements in no sharing group, with their own rays; the sharing groups' below.
         for_each_maybe_parallel(factors, |e, out| {
-            if sharing.member(self, e).is_some() {
+            if sharing.shares(e) {
                 return;
             }
             let el = &mesh.elements[e];
@@ -765,7 +729,7 @@ mod tests {
                 assert!(tile.patches as usize <= TILE_FACETS && tile.patches > 0);
                 assert!(tile.radius <= group.radius + 1e-12);
                 for &e in &group.elements[tile.elements.start as usize..tile.elements.end as usize] {
-                    assert_eq!(clusters.tile_of(e as usize), t);
+                    assert!(tile.elements.contains(&(clusters.slot(e as usize) as u32)));
                     for c in mesh.element_corners(e as usize) {
                         assert!(c.distance(tile.centre) <= tile.radius + 1e-12);
                     }

@@ -126,9 +126,8 @@ impl Solver {
         let emits = super::clusters::patch_emits(&mesh, shooter);
         self.scratch.sharing.choose(&self.clusters, patch.centre, shooter_radius, emits, share, None);
         if self.rows.plans(shooter).is_none() {
-            let (sharing, clusters, patch_elements) =
-                (&self.scratch.sharing, &self.clusters, &self.tables.patch_elements);
-            let shares = |q: usize| sharing.member(clusters, patch_elements[q].start).is_some();
+            let (sharing, patch_elements) = (&self.scratch.sharing, &self.tables.patch_elements);
+            let shares = |q: usize| sharing.shares(patch_elements[q].start);
             let reference = self.params.reference_path;
             plan_patches(&mesh, shooter, &self.tables, reference, shares, &mut self.scratch.plans);
         }
@@ -280,7 +279,7 @@ fn penumbra_pass(
     let flags: &[bool] = flags;
     for_each_maybe_parallel(factors, |e, out| {
         // A sharing group's members take its visibility, not rays of their own.
-        if flags[e] && shot.sharing.member(shot.clusters, e).is_none() {
+        if flags[e] && !shot.sharing.shares(e) {
             let plan = &plans[tables.element_patch[e] as usize];
             let (visible, traced) = trace(shot, plan, e, Rays::Penumbra);
             out.visible += visible;

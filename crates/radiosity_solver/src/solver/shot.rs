@@ -110,7 +110,7 @@ impl Shot<'_> {
     /// Whether patch `q`'s elements take their group's shared visibility instead of rays
     /// of their own.
     pub(super) fn shares(&self, q: usize) -> bool {
-        self.sharing.member(self.clusters, self.patch_elements[q].start).is_some()
+        self.sharing.shares(self.patch_elements[q].start)
     }
 
     /// The pilot-ray strata of element `e`'s patch.
