@@ -56,7 +56,8 @@ pub enum GatherArg {
     None,
     /// Direct light by shadow rays per pixel; indirect light from the solution.
     Direct,
-    /// Direct light by shadow rays; indirect by one bounce of gathering rays.
+    /// Direct light by shadow rays; indirect by one bounce of gathering rays at the records
+    /// of an irradiance cache, interpolated between them.
     Full,
 }
 
@@ -112,15 +113,18 @@ pub struct RenderArgs {
     #[arg(long, value_enum, default_value_t = ShadingArg::Smooth)]
     pub shading: ShadingArg,
     /// Final gather: `direct` (direct light by shadow rays per pixel: shadows as sharp as the
-    /// lamp makes them whatever the mesh; the default: on the Cornell box 3.2 % RMS error per
-    /// pixel against the path-traced reference in 2.5 s), `none` (the radiosity mesh as the
-    /// viewer shows it: 3.8 % in 1.5 s), `full` (also one bounce of gathering rays: noisier).
+    /// lamp makes them whatever the mesh; the default: on the Cornell box 2.8 % RMS error per
+    /// pixel against the path-traced reference, rendered in about 2.5 s), `none` (the radiosity
+    /// mesh as the viewer shows it: 3.3 %), `full` (the indirect light too gathered by rays,
+    /// at an irradiance cache's records, instead of taken from the mesh: 2.5 %, about 10 s).
     #[arg(long, value_enum, default_value_t = GatherArg::Direct)]
     pub gather: GatherArg,
     /// Shadow rays per sample towards the emitters, with a gather.
     #[arg(long, default_value_t = RenderParams::default().shadow_rays)]
     pub shadow_rays: u32,
-    /// Gathering rays per sample with `--gather full`.
+    /// Gathering rays with `--gather full`: a picture's irradiance-cache records take 64 times
+    /// this many each (more where a record spans many pixels); a lightmap's texels this many
+    /// per sample.
     #[arg(long, default_value_t = RenderParams::default().gather_rays)]
     pub gather_rays: u32,
     /// Pixels on an outline (their corners and centre do not all see the same object) take

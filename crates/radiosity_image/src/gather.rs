@@ -29,7 +29,9 @@
 //!     solution up where they land and take its *reflected* radiosity B − E there (the
 //!     emission is the direct part, already sampled): H_indirect ≈ π · mean(L) = mean(B − E).
 //!     This removes the mesh from everything one bounce away from the eye: contact shadows
-//!     and corners come out as sharp as the direct light.
+//!     and corners come out as sharp as the direct light. A picture gathers at the records of
+//!     an irradiance cache (the `cache` module) and interpolates between them, so the
+//!     indirect light carries no per-pixel noise; a lightmap's texels gather per sample.
 
 use std::f64::consts::PI;
 
@@ -48,7 +50,7 @@ pub enum Gather {
     /// solution.
     Direct,
     /// Direct light by shadow rays, indirect light by one bounce of gathering rays that look
-    /// the solution up where they land.
+    /// the solution up where they land (in a picture, at an irradiance cache's records).
     Full,
 }
 
@@ -299,6 +301,56 @@ pub(crate) fn cosine_direction(n: DVec3, u: f64, v: f64) -> DVec3 {
     (t * (r * phi.cos()) + b * (r * phi.sin()) + n * z).normalize()
 }
 
+/// The translational gradient of the irradiance gathered by `columns × rows` cosine-weighted
+/// rays about `n`, one per cell of the stratified grid [`cosine_direction`] maps (cell
+/// `(j, k)`, index `k · columns + j`: `u` in stratum `j` of `columns`, so sin² θ is, and
+/// `v` in stratum `k` of `rows`, so φ is), from the reflected radiosity `values` (π × the
+/// radiance) each ray found and the `distances` it travelled (∞ for a miss). Ward &
+/// Heckbert 1992, "Irradiance gradients", eq. 8 (as restated in Křivánek et al. 2008,
+/// "Practical global illumination with irradiance caching", §2.3): how the cells' boundaries
+/// move, as the point moves, between cells of different radiance. Per channel, in
+/// W/unit² per unit of distance, in the plane of `n`.
+pub(crate) fn irradiance_gradient(
+    n: DVec3,
+    columns: u32,
+    rows: u32,
+    values: &[Rgb],
+    distances: &[f64],
+) -> [DVec3; 3] {
+    let (t, b) = n.any_orthonormal_pair();
+    let (m, big_n) = (columns as usize, rows as usize);
+    let cell = |j: usize, k: usize| k * m + j;
+    // θ at the boundary between θ strata j − 1 and j: sin² θ = j / M.
+    let sin_edge = |j: usize| (j as f64 / m as f64).sqrt();
+    let cos_edge = |j: usize| (1.0 - j as f64 / m as f64).max(0.0).sqrt();
+    let mut gradient = [DVec3::ZERO; 3];
+    let mut add = |direction: DVec3, weight: f64, difference: Rgb| {
+        for (g, d) in gradient.iter_mut().zip(difference.to_array()) {
+            *g += direction * (weight * d / PI);
+        }
+    };
+    for k in 0..big_n {
+        let phi = 2.0 * PI * (k as f64 + 0.5) / big_n as f64;
+        let u_k = t * phi.cos() + b * phi.sin();
+        let phi_edge = 2.0 * PI * k as f64 / big_n as f64;
+        let v_edge = b * phi_edge.cos() - t * phi_edge.sin();
+        let previous = (k + big_n - 1) % big_n;
+        for j in 0..m {
+            let here = cell(j, k);
+            if j > 0 {
+                let below = cell(j - 1, k);
+                let r = distances[here].min(distances[below]);
+                let (s, c) = (sin_edge(j), cos_edge(j));
+                add(u_k, 2.0 * PI / big_n as f64 * s * c * c / r, values[here] - values[below]);
+            }
+            let beside = cell(j, previous);
+            let r = distances[here].min(distances[beside]);
+            add(v_edge, (sin_edge(j + 1) - sin_edge(j)) / r, values[here] - values[beside]);
+        }
+    }
+    gradient
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -397,6 +449,42 @@ mod tests {
         assert!(!emitters.probe(&open, DVec3::ZERO, up, 1e-6).small, "1 m under a 1 m lamp");
         // From 20 m: p_light ≈ 400, p_cosine ≈ 1/π.
         assert!(emitters.probe(&open, DVec3::new(0.0, 0.0, -19.0), up, 1e-6).small, "20 m under it");
+    }
+
+    /// Beside a wall of height h at distance a (uniform radiance L, infinitely long), a point
+    /// of the floor receives E = (πL/2)(1 − a/√(a² + h²)) (the view factor of a perpendicular
+    /// strip), which grows towards the wall as (πL/2) h²/(a² + h²)^(3/2). The gradient from
+    /// one stratified gather of 128 × 128 rays agrees within 3 % and points at the wall
+    /// (measured +2 % at a = h; the nearer of two cells' distances stands for the edge's
+    /// between them, a little short, so coarser grids read high: +5 % at 64 × 64).
+    #[test]
+    fn irradiance_gradient_beside_a_wall_matches_the_closed_form() {
+        let (a, h, radiance) = (1.0, 1.0, 2.0);
+        let n = DVec3::Z;
+        let (columns, rows) = (128u32, 128u32);
+        let mut rng = Rng::for_task(7, 7, 7);
+        let mut values = Vec::new();
+        let mut distances = Vec::new();
+        for j in 0..columns * rows {
+            let u = (f64::from(j % columns) + rng.next_f64()) / f64::from(columns);
+            let v = (f64::from(j / columns) + rng.next_f64()) / f64::from(rows);
+            let d = cosine_direction(n, u, v);
+            let t = if d.x > 0.0 { a / d.x } else { f64::INFINITY };
+            if t.is_finite() && t * d.z <= h {
+                values.push(Rgb::splat(PI * radiance));
+                distances.push(t);
+            } else {
+                values.push(Rgb::ZERO);
+                distances.push(f64::INFINITY);
+            }
+        }
+        let e: f64 = values.iter().map(|v| v.r).sum::<f64>() / values.len() as f64;
+        let expected_e = PI * radiance / 2.0 * (1.0 - a / (a * a + h * h).sqrt());
+        assert!((e / expected_e - 1.0).abs() < 0.01, "E {e} vs {expected_e}");
+        let g = irradiance_gradient(n, columns, rows, &values, &distances)[0];
+        let expected = PI * radiance / 2.0 * h * h / (a * a + h * h).powf(1.5);
+        assert!((g.x / expected - 1.0).abs() < 0.03, "gradient {g} vs {expected} along x");
+        assert!(g.y.abs() < 0.03 * expected && g.z.abs() < 1e-9, "gradient {g}");
     }
 
     /// Cosine-weighted directions lie in the upper hemisphere and have mean cos θ = 2/3

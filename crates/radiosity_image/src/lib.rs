@@ -22,6 +22,7 @@
 #![warn(missing_docs)]
 #![forbid(unsafe_code)]
 
+mod cache;
 mod files;
 mod gather;
 mod hdr;
@@ -37,7 +38,9 @@ pub use files::{
 pub use gather::Gather;
 pub use hdr::HdrImage;
 pub use metrics::{ObjectPixels, difference_image, object_mean_radiance};
-pub use render::{RenderError, RenderParams, Renderer, Rendering, Shading, SurfaceHit};
+pub use render::{
+    RECORD_RAYS_PER_GATHER_RAY, RenderError, RenderParams, Renderer, Rendering, Shading, SurfaceHit,
+};
 pub use tonemap::{
     AUTO_EXPOSURE_KEY, Exposure, SrgbImage, ToneOperator, ToneParams, ToneParseError, auto_exposure_ev,
     tone_map, tone_map_image,

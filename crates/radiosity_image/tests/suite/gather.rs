@@ -17,10 +17,11 @@ use radiosity_solver::{Solution, SolverParams};
 /// losing it, 25 % too little.
 ///
 /// Tolerances: the picture's mean within 1 % (the solution is within ~0.2 %, and 48 × 40
-/// pixels × 64 direct-light samples average their noise to ~0.1 %; measured −0.09 % with
-/// `direct`, −0.02 % with `full`); each pixel within 8 %: one pixel's 32 emitter points and
-/// 32 (or 128) cosine directions over a box whose 1/r² kernel peaks at the corners leave a
-/// few % of noise (measured worst pixel 4.7 % with `direct`, 2.3 % with `full`).
+/// pixels × 64 direct-light samples average their noise to ~0.1 %; measured −0.06 % with
+/// `direct`, −0.03 % with `full` and its irradiance cache); each pixel within 8 %: one
+/// pixel's 32 emitter points and 32 cosine directions over a box whose 1/r² kernel peaks at
+/// the corners leave a few % of noise (measured worst pixel 4.8 % with `direct`, 1.6 % with
+/// `full`).
 #[test]
 fn gathered_furnace_counts_direct_light_once() {
     let (rho, emission) = (0.5, 1.0);
@@ -56,8 +57,8 @@ fn direct_gather_needs_the_direct_part() {
 /// every object's mean radiance in the picture agrees: within 2 % for the large surfaces
 /// (what differs is only where shadows fall inside elements, and shadow-ray noise averaged
 /// over thousands of pixels). A direct part counted twice or dropped moves the floor by
-/// ~50 %. Measured: within 1.0 % (walls +0.5 to +1.0 %, the ceiling +0.02 % direct, +0.9 %
-/// full).
+/// ~50 %. Measured: within 0.5 % (direct: −0.01 to +0.41 %; full, through its irradiance
+/// cache: +0.04 to +0.42 %).
 #[test]
 fn gathered_cornell_box_agrees_with_the_mesh_per_object() {
     let scene = radiosity_core::cornell_box();

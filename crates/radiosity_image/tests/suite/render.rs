@@ -187,7 +187,7 @@ fn smooth_shading_is_continuous_across_element_edges() {
     }
 }
 
-/// Any number of threads gives the same picture, bit for bit.
+/// Any number of threads gives the same picture, bit for bit, with or without a gather.
 #[test]
 fn rendering_is_deterministic_across_thread_counts() {
     let scene = corner_scene(false);
@@ -196,12 +196,17 @@ fn rendering_is_deterministic_across_thread_counts() {
     let camera =
         Camera::try_new(DVec3::new(0.8, 0.5, 0.9), DVec3::new(0.0, 0.5, 0.0), DVec3::Y, 70.0).unwrap();
     let params = RenderParams { width: 40, height: 30, samples_per_pixel: 5, ..RenderParams::default() };
-    let render_with = |threads| {
+    let render_with = |threads, params: &RenderParams| {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-        pool.install(|| renderer.render(&solution, &camera, &params).unwrap())
+        pool.install(|| renderer.render(&solution, &camera, params).unwrap())
     };
-    let one = render_with(1);
-    assert_eq!(one, render_with(3));
+    let one = render_with(1, &params);
+    assert_eq!(one, render_with(3, &params));
+    // The gathers too: the irradiance cache's records are placed and gathered alike.
+    for gather in [Gather::Direct, Gather::Full] {
+        let gathered = RenderParams { gather, ..params };
+        assert_eq!(render_with(1, &gathered), render_with(3, &gathered), "{gather:?}");
+    }
     // A different seed moves the jitter, so edge pixels change.
     let other = renderer.render(&solution, &camera, &RenderParams { seed: 1, ..params }).unwrap();
     assert_ne!(one.radiance, other.radiance);
