@@ -482,6 +482,11 @@ impl Renderer {
                     let (e, point, distance, front) =
                         self.surface_point(camera.position, centre_dir(i), centre_hits[i].as_ref()?);
                     let reflects = self.mesh.element_material(e).reflectance.max_channel() > 0.0;
+                    // A thousandth of the way to the element's centre: a centre ray that
+                    // meets a corner's edge (within the single-precision hit) would otherwise
+                    // gather from the edge itself, half its rays slipping past the other
+                    // surface — one dark record as large as its far-travelled rays say.
+                    let point = point + (self.mesh.elements[e].centre - point) * 1e-3;
                     (front && reflects).then(|| Site {
                         point,
                         normal: self.shading_normal(e, point),

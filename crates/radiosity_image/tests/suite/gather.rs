@@ -170,3 +170,29 @@ fn penumbra_points_take_more_shadow_rays_without_bias() {
     assert!((m4 / m1 - 1.0).abs() < 0.005, "floor means {m4} with penumbrae sampled more, {m1} without");
     assert!(after < before / 1.4, "noise {after} with penumbrae sampled more, {before} without");
 }
+
+/// A record whose pixel centre falls on the edge where two walls meet gathers from the
+/// edge itself unless its point is drawn into its element: half its rays then slip past the
+/// other wall, and the record, dark and as large as those far-travelled rays make it, darkens
+/// everything around. Looking straight at the Cornell box's ceiling–back wall edge (the
+/// middle pixel's centre ray meets it), the 7 × 7 pixels around it agree between `full` and
+/// `direct` within 5 % on average (measured 0.99; with the record on the edge, 0.66).
+#[test]
+fn a_record_on_a_corner_edge_is_not_dark() {
+    let scene = radiosity_core::cornell_box();
+    let (mesh, solution) = common::solve(&scene, SolverParams::default());
+    let renderer = Renderer::new(mesh);
+    let eye = scene.camera_or_framing().position;
+    let camera = Camera::try_new(eye, DVec3::new(278.0, 548.8, 559.2), DVec3::Y, 10.0).unwrap();
+    let params = |gather| RenderParams { width: 41, height: 41, gather, ..RenderParams::default() };
+    let picture = |gather| renderer.render(&solution, &camera, &params(gather)).unwrap().radiance;
+    let (direct, full) = (picture(Gather::Direct), picture(Gather::Full));
+    let window = |image: &radiosity_image::HdrImage| {
+        (17..24)
+            .flat_map(|y| (17..24).map(move |x| (x, y)))
+            .map(|(x, y)| image.pixel(x, y).luminance())
+            .sum::<f64>()
+    };
+    let ratio = window(&full) / window(&direct);
+    assert!((ratio - 1.0).abs() < 0.05, "full / direct around the edge: {ratio}");
+}
