@@ -61,14 +61,14 @@ pub const SCENE_HELP: &str = "A scene file (.toml), a model file (.obj with its 
 /// overrides the scene file. `info` takes only these: it counts, it does not solve.
 #[derive(Args, Clone, Debug)]
 pub struct MeshOpts {
-    /// Longest patch edge, scene units (overrides the scene's [mesh]).
+    /// Longest patch edge, scene units (overrides the scene's `[mesh]`).
     #[arg(long, allow_negative_numbers = true)]
     pub patch_size: Option<f64>,
-    /// Longest element edge, scene units (overrides the scene's [mesh]).
+    /// Longest element edge, scene units (overrides the scene's `[mesh]`).
     #[arg(long, allow_negative_numbers = true)]
     pub element_size: Option<f64>,
     /// Smooth shading joins the facets of one object whose normals differ by less than this,
-    /// degrees in [0, 180); 0 shades every facet on its own [default: the scene's [mesh]
+    /// degrees in [0, 180); 0 shades every facet on its own [default: the scene's `[mesh]`
     /// crease_angle, else 40].
     #[arg(long, allow_negative_numbers = true, value_name = "DEGREES")]
     pub crease_angle: Option<f64>,
@@ -78,17 +78,17 @@ pub struct MeshOpts {
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=2), value_name = "1|2")]
     pub sides: Option<u8>,
     /// Cut surfaces along the outlines of solids standing on them (a block on the floor) and
-    /// leave the covered part out of the solve [default: the scene's [mesh] contacts, else
+    /// leave the covered part out of the solve [default: the scene's `[mesh]` contacts, else
     /// true].
     #[arg(long, value_name = "true|false")]
     pub contacts: Option<bool>,
     /// Halve the elements along inside corners (a wall meeting the floor, a block on it) this
-    /// many times towards the corner, 0 to 6; 0 grades nothing [default: the scene's [mesh]
+    /// many times towards the corner, 0 to 6; 0 grades nothing [default: the scene's `[mesh]`
     /// corner_refinement, else 2].
     #[arg(long, value_name = "LEVELS")]
     pub corner_refinement: Option<u32>,
     /// Quarter the elements where the light changes steeply (shadow edges), found by a quick
-    /// probe solve, this many times, 0 to 4; 0: none [default: the scene's [mesh]
+    /// probe solve, this many times, 0 to 4; 0: none [default: the scene's `[mesh]`
     /// adaptive_levels, else 2].
     #[arg(long, value_name = "LEVELS")]
     pub adaptive_levels: Option<u32>,
@@ -100,7 +100,7 @@ pub struct SolveOpts {
     #[command(flatten)]
     pub mesh: MeshOpts,
     /// Stop when unshot power / emitted power falls to this, in (0, 1) [default: the scene's
-    /// [solver], else the solver's default, 1e-3].
+    /// `[solver]`, else the solver's default, 1e-3].
     #[arg(long, allow_negative_numbers = true)]
     pub unshot_threshold: Option<f64>,
     /// Stop after this many shots.

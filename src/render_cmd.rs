@@ -136,7 +136,7 @@ pub struct RenderArgs {
     /// many times --shadow-rays, 1 to 64; 1: as many as any pixel.
     #[arg(long, default_value_t = RenderParams::default().penumbra_factor, value_name = "N")]
     pub penumbra_factor: u32,
-    /// Eye position `x,y,z` (default: the scene's [camera], or one framing the scene).
+    /// Eye position `x,y,z` (default: the scene's `[camera]`, or one framing the scene).
     #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
     pub camera_position: Option<DVec3>,
     /// Point looked at, `x,y,z`.

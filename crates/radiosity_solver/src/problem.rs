@@ -99,8 +99,8 @@ impl Problem {
     ///
     /// With [`MeshParams::adaptive_levels`] > 0 the mesh is then refined where the light
     /// changes steeply: probe solves find the elements whose radiosity differs from a
-    /// neighbour's by more than [`STEEP`], and the scene is meshed again with those quartered
-    /// (adaptive subdivision, see `refined` in the source).
+    /// neighbour's by more than 30 % (`STEEP`), and the scene is meshed again with those
+    /// quartered (adaptive subdivision, see `refined` in the source).
     ///
     /// # Errors
     /// [`MeshError`] when the scene cannot be meshed with these sizes (too many elements, …).
