@@ -263,17 +263,30 @@ mod tests {
             .collect()
     }
 
+    /// A cache over a `w × h` plane whose records all find `irradiance` (a function of the
+    /// record's point) and `harmonic_distance`, with `slope` as the gradient of every channel.
+    fn cache_over(
+        w: usize,
+        h: usize,
+        irradiance: impl Fn(DVec3) -> f64 + Sync,
+        harmonic_distance: f64,
+        slope: DVec3,
+    ) -> (Vec<Option<Site>>, IrradianceCache) {
+        let sites = flat_sites(w, h);
+        let cache = IrradianceCache::build(w, h, &sites, |_, site, _| Gathered {
+            irradiance: Rgb::splat(irradiance(site.point)),
+            harmonic_distance,
+            gradient: [slope; 3],
+        });
+        (sites, cache)
+    }
+
     /// Far from everything (rays that travel far), records are as large as allowed and few;
     /// every pixel centre is covered, and a lookup returns the (here uniform) irradiance.
     #[test]
     fn open_surfaces_take_few_large_records() {
         let (w, h) = (64, 48);
-        let sites = flat_sites(w, h);
-        let cache = IrradianceCache::build(w, h, &sites, |_, _, _| Gathered {
-            irradiance: Rgb::splat(2.0),
-            harmonic_distance: f64::INFINITY,
-            gradient: [DVec3::ZERO; 3],
-        });
+        let (sites, cache) = cache_over(w, h, |_| 2.0, f64::INFINITY, DVec3::ZERO);
         assert!(cache.len() <= (w / 8 + 1) * (h / 8 + 1), "{} records", cache.len());
         for (i, site) in sites.iter().enumerate() {
             let site = site.unwrap();
@@ -282,23 +295,30 @@ mod tests {
         }
     }
 
+    /// Records carry their irradiance along their gradients: where the light grows linearly
+    /// (1 + x/100, gentle enough for the limit to leave it whole), every lookup between
+    /// records is exact, not the records' blend.
+    #[test]
+    fn gradients_make_linear_light_exact_between_records() {
+        let (w, h) = (64, 48);
+        let light = |p: DVec3| 1.0 + 0.01 * p.x;
+        let (_, cache) = cache_over(w, h, light, f64::INFINITY, DVec3::new(0.01, 0.0, 0.0));
+        let p = DVec3::new(37.3, 21.6, 0.0);
+        let got = cache.lookup(37, 21, p, DVec3::Z).expect("covered").r;
+        assert!((got - light(p)).abs() < 1e-12, "{got} against {}", light(p));
+        let (_, flat) = cache_over(w, h, light, f64::INFINITY, DVec3::ZERO);
+        let blended = flat.lookup(37, 21, p, DVec3::Z).expect("covered").r;
+        assert!((blended - light(p)).abs() > 1e-3, "without gradients the records blend: {blended}");
+    }
+
     /// Records whose rays travel a short way (a contact nearby) are small, so the cache holds
     /// many more of them; a point whose normal turns away from every record's, or that lies
     /// off their plane, is not covered.
     #[test]
     fn near_surfaces_take_dense_records_and_other_planes_none() {
         let (w, h) = (32, 32);
-        let sites = flat_sites(w, h);
-        let far = IrradianceCache::build(w, h, &sites, |_, _, _| Gathered {
-            irradiance: Rgb::splat(1.0),
-            harmonic_distance: f64::INFINITY,
-            gradient: [DVec3::ZERO; 3],
-        });
-        let near = IrradianceCache::build(w, h, &sites, |_, _, _| Gathered {
-            irradiance: Rgb::splat(1.0),
-            harmonic_distance: 2.0 / ACCURACY,
-            gradient: [DVec3::ZERO; 3],
-        });
+        let (_, far) = cache_over(w, h, |_| 1.0, f64::INFINITY, DVec3::ZERO);
+        let (_, near) = cache_over(w, h, |_| 1.0, 2.0 / ACCURACY, DVec3::ZERO);
         assert!(near.len() > 10 * far.len(), "{} against {}", near.len(), far.len());
         let p = DVec3::new(10.0, 10.0, 0.0);
         assert!(far.lookup(10, 10, p, DVec3::Z).is_some());
