@@ -304,7 +304,11 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let solution = solver.solution();
     let start = Instant::now();
     let renderer = Renderer::new(prepared.problem.mesh().clone());
-    let progress = RowProgress::new(u64::from(params.height), "rendering");
+    // The irradiance cache is gathered before the first row: say so, and keep the spinner
+    // turning meanwhile, so a long gather does not look like a hang.
+    let what = if params.gather == Gather::Full { "rendering (irradiance cache first)" } else { "rendering" };
+    let progress = RowProgress::new(u64::from(params.height), what);
+    progress.bar.enable_steady_tick(std::time::Duration::from_millis(120));
     let rendering = renderer.render_with_progress(&solution, &camera, &params, &|| progress.inc())?;
     progress.bar.finish_and_clear();
     let render_secs = start.elapsed().as_secs_f64();
