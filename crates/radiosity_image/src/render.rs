@@ -487,10 +487,14 @@ impl Renderer {
                     // gather from the edge itself, half its rays slipping past the other
                     // surface — one dark record as large as its far-travelled rays say.
                     let point = point + (self.mesh.elements[e].centre - point) * 1e-3;
-                    (front && reflects).then(|| Site {
+                    // A record's radius is clamped between multiples of this: it must be a
+                    // positive number (an eye on a surface would make it 0).
+                    let pixel_size = distance * pixel_angle;
+                    let sized = pixel_size.is_finite() && pixel_size > 0.0;
+                    (front && reflects && sized).then(|| Site {
                         point,
                         normal: self.shading_normal(e, point),
-                        pixel_size: distance * pixel_angle,
+                        pixel_size,
                     })
                 })
                 .collect();
