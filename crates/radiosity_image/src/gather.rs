@@ -305,10 +305,15 @@ pub(crate) fn cosine_direction(n: DVec3, u: f64, v: f64) -> DVec3 {
 /// rays about `n`, one per cell of the stratified grid [`cosine_direction`] maps (cell
 /// `(j, k)`, index `k · columns + j`: `u` in stratum `j` of `columns`, so sin² θ is, and
 /// `v` in stratum `k` of `rows`, so φ is), from the reflected radiosity `values` (π × the
-/// radiance) each ray found and the `distances` it travelled (∞ for a miss). Ward &
-/// Heckbert 1992, "Irradiance gradients", eq. 8 (as restated in Křivánek et al. 2008,
-/// "Practical global illumination with irradiance caching", §2.3): how the cells' boundaries
-/// move, as the point moves, between cells of different radiance. Per channel, in
+/// radiance) each ray found and the `distances` it travelled (∞ for a miss). After Ward &
+/// Heckbert 1992, "Irradiance gradients" (restated in Křivánek et al. 2008, "Practical
+/// global illumination with irradiance caching", §2.3): as the point moves, the cells'
+/// boundaries sweep across the objects at the nearer of the two cells' distances, and the
+/// irradiance changes by the radiance difference times the cos θ-weighted solid angle swept.
+/// Between θ strata that is sin θ cos² θ Δφ / r per unit of motion towards φ (their
+/// formula); between φ strata it is ∫ cos θ dθ / r = (sin θ₊ − sin θ₋) / r, derived here so
+/// (the cos θ weight included) and checked against a closed form in the tests. The frame
+/// must be the one [`cosine_direction`] uses (`any_orthonormal_pair`). Per channel, in
 /// W/unit² per unit of distance, in the plane of `n`.
 pub(crate) fn irradiance_gradient(
     n: DVec3,

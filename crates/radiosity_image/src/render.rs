@@ -693,10 +693,10 @@ impl Renderer {
     }
 
     /// `mis.cosines` cosine-weighted rays from `x` (normal `n`), stratified over the pixel's
-    /// samples when `whole`, else over these rays alone: returns their half of the direct irradiance (emission where they land, MIS
-    /// weighted) and, when `reflect`, the irradiance from the light the solution reflects
-    /// (B − E where they land: ∫ L cos θ dω with pdf cos θ / π is π · mean(L), and
-    /// L = (B − E)/π).
+    /// samples when `whole`, else over these rays alone: returns their half of the direct
+    /// irradiance (emission where they land, MIS weighted) and, when `reflect`, the
+    /// irradiance from the light the solution reflects (B − E where they land: ∫ L cos θ dω
+    /// with pdf cos θ / π is π · mean(L), and L = (B − E)/π).
     #[allow(clippy::too_many_arguments)]
     fn cosine_rays(
         &self,
