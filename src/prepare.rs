@@ -82,6 +82,11 @@ pub struct MeshOpts {
     /// true].
     #[arg(long, value_name = "true|false")]
     pub contacts: Option<bool>,
+    /// Cut surfaces along the outlines of the penumbrae and umbrae that convex solids (a
+    /// block, a box) cast from the bright emitters, so shadow edges fall on element edges
+    /// [default: the scene's `[mesh]` shadow_outlines, else true].
+    #[arg(long, value_name = "true|false")]
+    pub shadow_outlines: Option<bool>,
     /// Halve the elements along inside corners (a wall meeting the floor, a block on it) this
     /// many times towards the corner, 0 to 6; 0 grades nothing [default: the scene's `[mesh]`
     /// corner_refinement, else 2].
@@ -279,6 +284,7 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
     let mesh_params = MeshParams::try_new(patch, element)
         .and_then(|m| m.with_crease_angle(o.mesh.crease_angle.unwrap_or(base.crease_angle_deg)))
         .map(|m| m.with_contacts(o.mesh.contacts.unwrap_or(base.contacts)))
+        .map(|m| m.with_shadow_outlines(o.mesh.shadow_outlines.unwrap_or(base.shadow_outlines)))
         .and_then(|m| m.with_corner_refinement(o.mesh.corner_refinement.unwrap_or(base.corner_refinement)))
         .and_then(|m| m.with_adaptive_levels(o.mesh.adaptive_levels.unwrap_or(base.adaptive_levels)))
         .map_err(|e| input(format!("mesh options: {e}")))?;
@@ -480,6 +486,7 @@ mod tests {
             crease_angle: Some(0.0),
             sides: Some(1),
             contacts: None,
+            shadow_outlines: None,
             corner_refinement: None,
             adaptive_levels: None,
         };

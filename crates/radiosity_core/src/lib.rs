@@ -15,8 +15,10 @@ mod film;
 mod grading;
 mod mesh;
 mod one_line;
+mod planar;
 pub mod random;
 mod scene;
+mod shadows;
 mod srgb;
 
 pub use canonical::{

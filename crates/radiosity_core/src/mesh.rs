@@ -30,6 +30,7 @@ use crate::Material;
 use crate::contacts::{Contacts, PolygonId};
 use crate::grading;
 use crate::scene::{Facing, Polygon, PolygonMesh, Scene, SceneError, Shape, Sides, Sphere};
+use crate::shadows::ShadowOutlines;
 
 /// Subdivision of surfaces (the source document's "discrétisation", S10).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -47,6 +48,9 @@ pub struct MeshParams {
     /// Cut surfaces along the footprints of solids standing on them and leave the covered
     /// part out (see the `contacts` module). Default true.
     pub contacts: bool,
+    /// Cut surfaces along the outlines of the penumbrae and umbrae that convex solids cast
+    /// from the bright emitters (see the `shadows` module). Default true.
+    pub shadow_outlines: bool,
     /// How many times elements along inside corners (a wall meeting the floor, a block
     /// standing on it) are halved towards the corner, in [0, [`MAX_CORNER_REFINEMENT`]]; 0
     /// grades nothing (see the `grading` module). Default [`DEFAULT_CORNER_REFINEMENT`].
@@ -94,6 +98,7 @@ impl MeshParams {
             element_size: element_size.min(patch_size),
             crease_angle_deg: DEFAULT_CREASE_ANGLE_DEG,
             contacts: true,
+            shadow_outlines: true,
             corner_refinement: DEFAULT_CORNER_REFINEMENT,
             adaptive_levels: DEFAULT_ADAPTIVE_LEVELS,
         })
@@ -102,6 +107,11 @@ impl MeshParams {
     /// The same parameters with contact cutting on or off.
     pub fn with_contacts(self, contacts: bool) -> Self {
         Self { contacts, ..self }
+    }
+
+    /// The same parameters with shadow outlines cut or not.
+    pub fn with_shadow_outlines(self, shadow_outlines: bool) -> Self {
+        Self { shadow_outlines, ..self }
     }
 
     /// The same parameters with elements halved `levels` times towards inside corners.
@@ -146,6 +156,7 @@ impl MeshParams {
             element_size: d / 32.0,
             crease_angle_deg: DEFAULT_CREASE_ANGLE_DEG,
             contacts: true,
+            shadow_outlines: true,
             corner_refinement: DEFAULT_CORNER_REFINEMENT,
             adaptive_levels: DEFAULT_ADAPTIVE_LEVELS,
         }
@@ -155,6 +166,13 @@ impl MeshParams {
     pub fn scaled(self, factor: f64) -> Self {
         Self { patch_size: self.patch_size * factor, element_size: self.element_size * factor, ..self }
     }
+}
+
+/// What cuts a polygon before it is meshed.
+#[derive(Clone, Copy)]
+struct Cutters<'a, 'b> {
+    contacts: Option<&'a Contacts<'b>>,
+    shadows: Option<&'a ShadowOutlines>,
 }
 
 /// Elements to quarter when a scene is meshed again, level after level (see
@@ -997,6 +1015,7 @@ impl Mesh {
             ..Mesh::default()
         };
         let contacts = (params.contacts || params.corner_refinement > 0).then(|| Contacts::new(scene));
+        let shadows = params.shadow_outlines.then(|| ShadowOutlines::new(scene)).filter(|s| !s.is_empty());
         // The back face of an emitting material that emits from its front only: the same
         // reflectance, no emission (one per material, made when first needed).
         let mut dark_back = HashMap::default();
@@ -1004,7 +1023,8 @@ impl Mesh {
             let first_surface = mesh.surfaces.len() as u32;
             // A polygon of this object, cut around what stands on it, graded and refined.
             let cut = |mesh: &mut Mesh, p: &Polygon, id: Option<PolygonId>| {
-                mesh.mesh_cut_polygon(contacts.as_ref(), p, id, oi, o.material, params, refinement);
+                let cutters = Cutters { contacts: contacts.as_ref(), shadows: shadows.as_ref() };
+                mesh.mesh_cut_polygon(cutters, p, id, oi, o.material, params, refinement);
             };
             match &o.shape {
                 Shape::Polygons(ps) => {
@@ -1084,14 +1104,14 @@ impl Mesh {
         Ok(mesh)
     }
 
-    /// Meshes polygon `p` of object `object` as one surface, or, where solids stand on it,
-    /// as one surface per piece of it around their footprints (the covered area counted in
-    /// [`Mesh::hidden_area`]); each surface graded and refined as `params` and `refinement`
-    /// say.
+    /// Meshes polygon `p` of object `object` as one surface, or, where solids stand on it or
+    /// cast shadows on it, as one surface per piece of it around their footprints (the
+    /// covered area counted in [`Mesh::hidden_area`]) and shadow outlines; each surface graded
+    /// and refined as `params` and `refinement` say.
     #[allow(clippy::too_many_arguments)]
     fn mesh_cut_polygon(
         &mut self,
-        contacts: Option<&Contacts>,
+        Cutters { contacts, shadows }: Cutters,
         p: &Polygon,
         id: Option<PolygonId>,
         object: usize,
@@ -1110,6 +1130,10 @@ impl Mesh {
             }
             None => std::slice::from_ref(p),
         };
+        let shadowed = shadows
+            .filter(|_| large)
+            .and_then(|s| s.cut(p, pieces, |q| estimate_polygon_elements(q, params)));
+        let pieces = shadowed.as_deref().unwrap_or(pieces);
         for piece in pieces {
             let mut b = SurfaceBuilder::default();
             mesh_polygon(&mut b, piece, params);

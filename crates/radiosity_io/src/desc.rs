@@ -198,6 +198,8 @@ pub(crate) struct MeshDesc {
     pub(crate) crease_angle: Option<Spanned<f64>>,
     /// Cut surfaces along the footprints of solids standing on them (default true).
     pub(crate) contacts: Option<bool>,
+    /// Cut surfaces along the shadow outlines of convex solids (default true).
+    pub(crate) shadow_outlines: Option<bool>,
     /// Halve elements along inside corners this many times, 0 to 6 (default 2).
     pub(crate) corner_refinement: Option<Spanned<u32>>,
     /// Levels of adaptive subdivision, 0 to 4 (default 2).

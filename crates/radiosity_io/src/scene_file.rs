@@ -730,6 +730,7 @@ fn mesh_params(loc: &Locator, d: &MeshDesc) -> Result<MeshParams, LoadError> {
         loc.at(span, format!("mesh.{field}"), e.to_string())
     })?;
     let params = params.with_contacts(d.contacts.unwrap_or(true));
+    let params = params.with_shadow_outlines(d.shadow_outlines.unwrap_or(true));
     let params = match &d.corner_refinement {
         Some(levels) => params
             .with_corner_refinement(*levels.get_ref())

@@ -352,7 +352,8 @@ fn the_crease_angle_comes_from_the_mesh_table() {
 }
 
 /// `[mesh] corner_refinement` sets the grading towards inside corners, `adaptive_levels` the
-/// adaptive subdivision; past 6 and 4 they are errors at their lines.
+/// adaptive subdivision; past 6 and 4 they are errors at their lines. `shadow_outlines` turns
+/// the shadow outlines off (on by default) and takes only a boolean.
 #[test]
 fn the_corner_refinement_comes_from_the_mesh_table() {
     let base = SPHERE_WITH_MESH;
@@ -369,4 +370,9 @@ fn the_corner_refinement_comes_from_the_mesh_table() {
     assert_eq!(default.mesh.unwrap().adaptive_levels, radiosity_core::DEFAULT_ADAPTIVE_LEVELS);
     let err = parse_scene(&format!("{base}adaptive_levels = 5\n"), "b.toml").unwrap_err().to_string();
     assert!(err.starts_with("b.toml:14:") && err.contains("mesh.adaptive_levels"), "{err}");
+    assert!(default.mesh.unwrap().shadow_outlines);
+    let scene = parse_scene(&format!("{base}shadow_outlines = false\n"), "s.toml").unwrap().scene;
+    assert!(!scene.mesh.unwrap().shadow_outlines);
+    let err = parse_scene(&format!("{base}shadow_outlines = 2\n"), "t.toml").unwrap_err().to_string();
+    assert!(err.starts_with("t.toml:") && err.contains("shadow_outlines"), "{err}");
 }
