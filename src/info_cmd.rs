@@ -58,6 +58,12 @@ pub fn run(a: InfoArgs) -> Result<()> {
             let _ = writeln!(out, "hidden     {hidden:.6e} units² of '{name}' under solids standing on it");
         }
     }
+    for (name, &pieces) in mesh.object_names.iter().zip(&mesh.shadow_pieces) {
+        if pieces > 0 {
+            let _ =
+                writeln!(out, "shadows    '{name}' cut along shadow outlines into {pieces} more surfaces");
+        }
+    }
     let _ = writeln!(out, "area       {:.6e}", mesh.total_area());
     let emitted: Rgb =
         (0..mesh.elements.len()).map(|e| mesh.element_material(e).emission * mesh.elements[e].area).sum();

@@ -145,6 +145,13 @@ fn info_prints_counts_and_power() {
     let plain = String::from_utf8_lossy(&plain.stdout).into_owned();
     assert!(!plain.contains("adaptive"), "{plain}");
     assert!(plain.contains(&format!("elements   {before}\n")), "{plain}");
+    // The floor is cut along the blocks' shadow outlines, and not with them off.
+    assert!(out.contains("shadows    'floor' cut along shadow outlines into"), "{out}");
+    assert!(!out.contains("shadows    'ceiling'"), "{out}");
+    let uncut = radiosity(&["info", "cornell", "--shadow-outlines", "false"]);
+    let uncut = String::from_utf8_lossy(&uncut.stdout).into_owned();
+    assert!(!uncut.contains("shadows "), "{uncut}");
+    assert!(leading_count(&uncut, "surfaces") < leading_count(&out, "surfaces"), "{uncut}");
 }
 
 /// `info` counts and does not solve: it takes the mesh options and the light scale, which

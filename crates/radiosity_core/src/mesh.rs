@@ -339,6 +339,9 @@ pub struct Mesh {
     /// Per object, the area left out of the mesh because a solid stands on it or it lies
     /// flat against another surface ([`MeshParams::contacts`]), scene units².
     pub hidden_area: Vec<f64>,
+    /// Per object, how many more surfaces its polygons were cut into along shadow outlines
+    /// ([`MeshParams::shadow_outlines`]).
+    pub shadow_pieces: Vec<u32>,
     /// True when the scene had too many large faces to look for contacts on all of them:
     /// some were meshed whole.
     pub contacts_incomplete: bool,
@@ -1012,6 +1015,7 @@ impl Mesh {
             object_names: scene.objects.iter().map(|o| o.name.clone()).collect(),
             materials: scene.materials.clone(),
             hidden_area: vec![0.0; scene.objects.len()],
+            shadow_pieces: vec![0; scene.objects.len()],
             ..Mesh::default()
         };
         let contacts = (params.contacts || params.corner_refinement > 0).then(|| Contacts::new(scene));
@@ -1133,6 +1137,9 @@ impl Mesh {
         let shadowed = shadows
             .filter(|_| large)
             .and_then(|s| s.cut(p, pieces, |q| estimate_polygon_elements(q, params)));
+        if let Some(cut) = &shadowed {
+            self.shadow_pieces[object] += (cut.len() - pieces.len()) as u32;
+        }
         let pieces = shadowed.as_deref().unwrap_or(pieces);
         for piece in pieces {
             let mut b = SurfaceBuilder::default();
