@@ -21,7 +21,7 @@ use std::collections::HashMap;
 use glam::DVec3;
 
 use crate::planar::{
-    area, area_signed, bounds, clean, contains_within, lexicographic, plane, split, tolerance,
+    area, area_signed, bounds, clean, contains_within, key, lexicographic, plane, split, tolerance,
 };
 use crate::scene::{Polygon, Scene, Shape};
 
@@ -370,10 +370,6 @@ impl<'a> Contacts<'a> {
 /// An edge of a face standing on a surface: its two corners on the surface's plane, the
 /// face's normal and the face's vertex mean.
 type Edge = (DVec3, DVec3, DVec3, DVec3);
-
-fn key(p: DVec3) -> [u64; 3] {
-    [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]
-}
 
 /// Closed loops of `edges` (matched by exact corner positions; faces of one solid share
 /// them) around which every edge's face turns its lit side outwards: the outline of a solid

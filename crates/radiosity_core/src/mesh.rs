@@ -769,11 +769,17 @@ fn triangle_steps(t: &[DVec3; 3], params: &MeshParams) -> (usize, usize) {
     (np, divisions(longest / np as f64, params.element_size))
 }
 
-/// Disjoint sets over triangle numbers, to group triangles into surfaces.
-struct UnionFind(Vec<u32>);
+/// Disjoint sets over face numbers, to group triangles into surfaces and faces into solids.
+pub(crate) struct UnionFind(Vec<u32>);
 
 impl UnionFind {
-    fn find(&mut self, mut x: u32) -> u32 {
+    /// `n` sets of one each.
+    pub(crate) fn new(n: usize) -> Self {
+        Self((0..n as u32).collect())
+    }
+
+    /// The root of `x`'s set: its smallest member.
+    pub(crate) fn find(&mut self, mut x: u32) -> u32 {
         while self.0[x as usize] != x {
             // Path halving keeps the trees flat without recursion.
             self.0[x as usize] = self.0[self.0[x as usize] as usize];
@@ -782,7 +788,8 @@ impl UnionFind {
         x
     }
 
-    fn union(&mut self, a: u32, b: u32) {
+    /// Joins the sets of `a` and `b`.
+    pub(crate) fn union(&mut self, a: u32, b: u32) {
         let (ra, rb) = (self.find(a), self.find(b));
         // The smaller root wins, so a group's root is its first triangle: deterministic order.
         if ra != rb {
@@ -842,7 +849,7 @@ fn group_mesh_faces(m: &PolygonMesh, params: &MeshParams) -> Vec<Vec<u32>> {
     pairs.sort_unstable();
     // First pass: every coplanar edge-connected set. A set of exactly two triangles is kept
     // whole (it becomes a quad when convex); larger sets are split where the steps differ.
-    let mut all = UnionFind((0..faces.len() as u32).collect());
+    let mut all = UnionFind::new(faces.len());
     for &(a, b) in &pairs {
         all.union(a, b);
     }
@@ -857,7 +864,7 @@ fn group_mesh_faces(m: &PolygonMesh, params: &MeshParams) -> Vec<Vec<u32>> {
             step_range[r] = (step_range[r].0.min(np * ne), step_range[r].1.max(np * ne));
         }
     }
-    let mut same_steps = UnionFind((0..faces.len() as u32).collect());
+    let mut same_steps = UnionFind::new(faces.len());
     for &(a, b) in &pairs {
         let r = all.find(a) as usize;
         // A set whose triangles need at most twice as many steps as each other is meshed

@@ -6,6 +6,11 @@ use glam::DVec3;
 
 use crate::scene::Polygon;
 
+/// A point's exact position as a hashable key: faces of one solid share corners bit for bit.
+pub(crate) fn key(p: DVec3) -> [u64; 3] {
+    [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]
+}
+
 /// The bounding box of `v` (not empty).
 pub(crate) fn bounds(v: &[DVec3]) -> (DVec3, DVec3) {
     v.iter().fold((v[0], v[0]), |(lo, hi), &q| (lo.min(q), hi.max(q)))

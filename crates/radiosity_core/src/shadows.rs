@@ -27,7 +27,8 @@ use std::collections::HashMap;
 
 use glam::{DVec2, DVec3};
 
-use crate::planar::{area, bounds, clean, clip, lexicographic, plane, split, tolerance};
+use crate::mesh::UnionFind;
+use crate::planar::{area, bounds, clean, clip, key, lexicographic, plane, split, tolerance};
 use crate::scene::{Polygon, Scene, Shape};
 
 /// Least share of the scene's emitted power an emitter needs to cast outlines: the dim ones'
@@ -74,10 +75,6 @@ fn polygons_of(shape: &Shape) -> &[Polygon] {
         Shape::Mesh(m) if m.polygons().len() <= MAX_MODEL_FACES => m.polygons(),
         _ => &[],
     }
-}
-
-fn key(p: DVec3) -> [u64; 3] {
-    [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]
 }
 
 impl ShadowOutlines {
@@ -255,26 +252,17 @@ fn solids(scene: &Scene) -> Vec<Vec<DVec3>> {
         .flat_map(|o| polygons_of(&o.shape))
         .collect();
     // Union–find over faces: a face joins the first face met at each of its corners.
-    let mut parent: Vec<usize> = (0..faces.len()).collect();
-    fn root(parent: &mut [usize], mut x: usize) -> usize {
-        while parent[x] != x {
-            parent[x] = parent[parent[x]];
-            x = parent[x];
-        }
-        x
-    }
-    let mut first_at: HashMap<[u64; 3], usize> = HashMap::new();
-    for (f, p) in faces.iter().enumerate() {
+    let mut sets = UnionFind::new(faces.len());
+    let mut first_at: HashMap<[u64; 3], u32> = HashMap::new();
+    for (f, p) in (0u32..).zip(&faces) {
         for &q in p.vertices() {
             let other = *first_at.entry(key(q)).or_insert(f);
-            let (a, b) = (root(&mut parent, f), root(&mut parent, other));
-            parent[a.max(b)] = a.min(b);
+            sets.union(f, other);
         }
     }
     let mut members: Vec<Vec<usize>> = vec![Vec::new(); faces.len()];
     for f in 0..faces.len() {
-        let r = root(&mut parent, f);
-        members[r].push(f);
+        members[sets.find(f as u32) as usize].push(f);
     }
     let mut out = Vec::new();
     for group in members.into_iter().filter(|g| g.len() >= 3) {
