@@ -70,6 +70,8 @@ pub(crate) struct Site {
     pub point: DVec3,
     /// Its shading normal (unit).
     pub normal: DVec3,
+    /// Where its gathering rays leave from: the point, lifted off its surface.
+    pub origin: DVec3,
     /// The width of one pixel at the point's distance from the eye, scene units.
     pub pixel_size: f64,
 }
@@ -258,7 +260,7 @@ mod tests {
         (0..width * height)
             .map(|i| {
                 let point = DVec3::new((i % width) as f64, (i / width) as f64, 0.0);
-                Some(Site { point, normal: DVec3::Z, pixel_size: 1.0 })
+                Some(Site { point, normal: DVec3::Z, origin: point, pixel_size: 1.0 })
             })
             .collect()
     }

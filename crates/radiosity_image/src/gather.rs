@@ -166,9 +166,9 @@ impl Emitters {
     }
 
     /// What `x` (unit normal `n`) sees of the emitters, from [`PROBES`] fixed points on them
-    /// (rays apart from any estimate's, so a choice made from them biases none).
-    pub(crate) fn probe(&self, rays: &dyn RayQuery, x: DVec3, n: DVec3, lift: f64) -> Seen {
-        let origin = x + n * lift;
+    /// (rays apart from any estimate's, so a choice made from them biases none), by shadow
+    /// rays that leave from `origin` (`x`, lifted off its surface).
+    pub(crate) fn probe(&self, rays: &dyn RayQuery, x: DVec3, n: DVec3, origin: DVec3) -> Seen {
         let (mut seen, mut hidden, mut small) = (false, false, true);
         for s in &self.probes {
             let d = s.point - x;
@@ -256,21 +256,21 @@ impl DirectMis {
 /// The emitter-area half of the direct irradiance at `x` (unit normal `n`): `mis.lights`
 /// shadow rays whose emitter coordinates are stratified in `strata` cells starting at
 /// `first` (so the samples of one pixel share one stratification), jittered by `rng`, each
-/// weighted by [`DirectMis::term`]. `lift` moves the shadow ray's origin off the surface.
+/// weighted by [`DirectMis::term`]. The shadow rays leave from `origin` (`x`, lifted off its
+/// surface).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn emitter_samples(
     emitters: &Emitters,
     rays: &dyn RayQuery,
     x: DVec3,
     n: DVec3,
-    lift: f64,
+    origin: DVec3,
     first: u32,
     strata: u32,
     mis: DirectMis,
     rng: &mut Rng,
 ) -> Rgb {
     let mut sum = Rgb::ZERO;
-    let origin = x + n * lift;
     for i in first..first + mis.lights {
         let u = (f64::from(i % strata) + rng.next_f64()) / f64::from(strata);
         let Some(s) = emitters.sample(u, rng.next_f64()) else {
@@ -405,7 +405,8 @@ mod tests {
         let mut rng = Rng::for_task(0, 0, 0);
         let n = 4096;
         let mis = DirectMis { lights: n, cosines: 0 };
-        let h_est = emitter_samples(&emitters, &rays, DVec3::ZERO, DVec3::Z, 1e-6, 0, n, mis, &mut rng);
+        let h_est =
+            emitter_samples(&emitters, &rays, DVec3::ZERO, DVec3::Z, DVec3::Z * 1e-6, 0, n, mis, &mut rng);
         // Point on the axis of a parallel square of side a at height h: the view factor is
         // 4 × that of a rectangle a/2 × a/2 with a corner above the point (Howell C-? for a
         // differential area to a parallel rectangle): F = (1/2π) Σ [X/√(1+X²) atan(Y/√(1+X²)) + …].
@@ -435,25 +436,23 @@ mod tests {
         let emitters = Emitters::new(&mesh);
         let open = radiosity_accel::BruteForce::new(&[]);
         let up = DVec3::Z;
-        assert!(!emitters.probe(&open, DVec3::ZERO, up, 1e-6).partly, "in full view");
-        assert!(
-            emitters.probe(&open, DVec3::new(0.0, 0.0, 0.5), DVec3::X, 1e-6).partly,
-            "half behind the horizon"
-        );
-        assert!(!emitters.probe(&open, DVec3::new(0.0, 0.0, 2.0), up, 1e-6).partly, "above the lamp's back");
+        let probe = |rays: &dyn RayQuery, x: DVec3, n: DVec3| emitters.probe(rays, x, n, x + n * 1e-6);
+        assert!(!probe(&open, DVec3::ZERO, up).partly, "in full view");
+        assert!(probe(&open, DVec3::new(0.0, 0.0, 0.5), DVec3::X).partly, "half behind the horizon");
+        assert!(!probe(&open, DVec3::new(0.0, 0.0, 2.0), up).partly, "above the lamp's back");
         // A sheet at half height over x < 0 hides the half of the lamp beyond it.
         let v = |x: f32, y: f32| glam::Vec3::new(x, y, 0.5);
         // Single triangles: no shared edge for a probe ray to slip through.
         let half = [[v(0.0, -5.0), v(0.0, 5.0), v(-5.0, 0.0)]];
         let blocked_half = radiosity_accel::BruteForce::new(&half);
-        assert!(emitters.probe(&blocked_half, DVec3::ZERO, up, 1e-6).partly, "half hidden");
+        assert!(probe(&blocked_half, DVec3::ZERO, up).partly, "half hidden");
         let whole = [[v(-5.0, -5.0), v(5.0, -5.0), v(0.0, 5.0)]];
         let blocked = radiosity_accel::BruteForce::new(&whole);
-        assert!(!emitters.probe(&blocked, DVec3::ZERO, up, 1e-6).partly, "all hidden");
+        assert!(!probe(&blocked, DVec3::ZERO, up).partly, "all hidden");
         // The 1 m lamp from 1 m below: p_light = r² / (A cos θ_y) ≈ 1, p_cosine ≈ 1/π.
-        assert!(!emitters.probe(&open, DVec3::ZERO, up, 1e-6).small, "1 m under a 1 m lamp");
+        assert!(!probe(&open, DVec3::ZERO, up).small, "1 m under a 1 m lamp");
         // From 20 m: p_light ≈ 400, p_cosine ≈ 1/π.
-        assert!(emitters.probe(&open, DVec3::new(0.0, 0.0, -19.0), up, 1e-6).small, "20 m under it");
+        assert!(probe(&open, DVec3::new(0.0, 0.0, -19.0), up).small, "20 m under it");
     }
 
     /// Beside a wall of height h at distance a (uniform radiance L, infinitely long), a point

@@ -398,10 +398,18 @@ impl Renderer {
     where
         T: Copy + std::ops::Mul<f64, Output = T> + std::ops::Add<Output = T>,
     {
+        let idx = self.mesh.elements[e].vertex_indices();
+        let w = self.corner_weights(e, p);
+        (1..idx.len())
+            .fold(vertex_values[idx[0] as usize] * w[0], |sum, k| sum + vertex_values[idx[k] as usize] * w[k])
+    }
+
+    /// The weights of element `e`'s corners at point `p` of its plane: barycentric on a
+    /// triangle, bilinear on a quad (unused ones 0).
+    fn corner_weights(&self, e: usize, p: DVec3) -> [f64; 4] {
         let el = &self.mesh.elements[e];
         let idx = el.vertex_indices();
         let pos = |k: usize| self.mesh.positions[idx[k] as usize];
-        let val = |k: usize| vertex_values[idx[k] as usize];
         // Work in 2D on the element's plane, in units of the element's size, so that the
         // tolerances below are relative.
         let origin = pos(0);
@@ -412,14 +420,32 @@ impl Renderer {
         let p2 = to_2d(p);
         if idx.len() == 3 {
             let w = barycentric(p2, to_2d(pos(1)), to_2d(pos(2)));
-            val(0) * w[0] + val(1) * w[1] + val(2) * w[2]
+            [w[0], w[1], w[2], 0.0]
         } else {
             let (s, t) = inverse_bilinear(p2, DVec2::ZERO, to_2d(pos(1)), to_2d(pos(2)), to_2d(pos(3)));
-            val(0) * ((1.0 - s) * (1.0 - t))
-                + val(1) * (s * (1.0 - t))
-                + val(2) * (s * t)
-                + val(3) * ((1.0 - s) * t)
+            [(1.0 - s) * (1.0 - t), s * (1.0 - t), s * t, (1.0 - s) * t]
         }
+    }
+
+    /// Where secondary rays leave point `x` of element `e` (shading normal `n`): lifted off
+    /// the surface by `lift` along `n`, and first, on a facet shaded with interpolated
+    /// normals, moved out to the curved surface those normals describe. Each corner's
+    /// tangent plane that `x` lies below pushes it up to that plane, and the pushes are
+    /// blended with the corners' weights (Hanika 2021, "Hacking the shadow terminator", Ray
+    /// Tracing Gems II ch. 4). Without it, shadow rays from a facet of a tessellated sphere
+    /// near its terminator hit the neighbouring facets, which the smooth normals say are
+    /// not there: a band of dark speckles where the light grazes the surface.
+    fn ray_origin(&self, e: usize, x: DVec3, n: DVec3) -> DVec3 {
+        let el = &self.mesh.elements[e];
+        if self.shading_normals.is_empty() || is_flat(el, &self.shading_normals) {
+            return x + n * self.lift;
+        }
+        let w = self.corner_weights(e, x);
+        let push = el.vertex_indices().iter().zip(w).fold(DVec3::ZERO, |push, (&v, w)| {
+            let (corner, normal) = (self.mesh.positions[v as usize], self.shading_normals[v as usize]);
+            push - normal * ((x - corner).dot(normal).min(0.0) * w)
+        });
+        x + push + n * self.lift
     }
 
     /// Renders `solution` seen from `camera`.
@@ -491,9 +517,11 @@ impl Renderer {
                     // positive number (an eye on a surface would make it 0).
                     let pixel_size = distance * pixel_angle;
                     let sized = pixel_size.is_finite() && pixel_size > 0.0;
+                    let normal = self.shading_normal(e, point);
                     (front && reflects && sized).then(|| Site {
                         point,
-                        normal: self.shading_normal(e, point),
+                        normal,
+                        origin: self.ray_origin(e, point, normal),
                         pixel_size,
                     })
                 })
@@ -619,7 +647,7 @@ impl Renderer {
             return Effort::PLAIN;
         }
         let n = self.shading_normal(e, p);
-        let seen = self.emitters.probe(&self.blockers, p, n, self.lift);
+        let seen = self.emitters.probe(&self.blockers, p, n, self.ray_origin(e, p, n));
         let light_factor = if seen.partly { params.penumbra_factor } else { 1 };
         Effort { light_factor, cosines: !seen.small }
     }
@@ -658,12 +686,13 @@ impl Renderer {
         };
         let mis = DirectMis { lights, cosines };
         let strata = params.samples_per_pixel * lights;
+        let origin = self.ray_origin(e, x, n);
         let mut direct = gather::emitter_samples(
             &self.emitters,
             &self.blockers,
             x,
             n,
-            self.lift,
+            origin,
             sample * lights,
             strata,
             mis,
@@ -672,7 +701,7 @@ impl Renderer {
         // With a cache, samples of one pixel take different numbers of rays.
         let whole = cache.is_none();
         let (cosine_direct, reflected) =
-            self.cosine_rays(solution, x, n, params, sample, mis, gathers, whole, rng);
+            self.cosine_rays(solution, origin, n, params, sample, mis, gathers, whole, rng);
         direct += cosine_direct;
         let indirect = match gather {
             // What the solver's radiosity holds besides emission and direct light, as it is
@@ -692,7 +721,7 @@ impl Renderer {
         material.emission + material.reflectance * direct + indirect
     }
 
-    /// `mis.cosines` cosine-weighted rays from `x` (normal `n`), stratified over the pixel's
+    /// `mis.cosines` cosine-weighted rays leaving from `origin` (normal `n`), stratified over the pixel's
     /// samples when `whole`, else over these rays alone: returns their half of the direct
     /// irradiance (emission where they land, MIS weighted) and, when `reflect`, the
     /// irradiance from the light the solution reflects (B − E where they land: ∫ L cos θ dω
@@ -701,7 +730,7 @@ impl Renderer {
     fn cosine_rays(
         &self,
         solution: &Solution,
-        x: DVec3,
+        origin: DVec3,
         n: DVec3,
         params: &RenderParams,
         sample: u32,
@@ -720,7 +749,6 @@ impl Renderer {
         let (first, strata) =
             if whole { (sample * count, params.samples_per_pixel * count) } else { (0, count) };
         let (columns, rows) = grid(strata);
-        let origin = x + n * self.lift;
         let (mut direct, mut reflected) = (Rgb::ZERO, Rgb::ZERO);
         for j in first..first + count {
             let (cx, cy) = (j % columns, j / columns);
@@ -782,7 +810,7 @@ impl Renderer {
         rng: &mut Rng,
     ) -> Gathered {
         let (columns, rows) = grid(count);
-        let origin = site.point + site.normal * self.lift;
+        let origin = site.origin;
         let mut values = vec![Rgb::ZERO; count as usize];
         let mut distances = vec![f64::INFINITY; count as usize];
         for j in 0..count {
@@ -892,6 +920,7 @@ fn is_flat(el: &radiosity_core::Element, normals: &[DVec3]) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use radiosity_core::{Facing, Material, MeshParams, Object, Polygon, Scene, Shape, Sides, Sphere};
 
     /// A sample that gathers on its own (a cache covers its neighbours, not it) must spread
     /// its rays over the whole hemisphere, not over its share of the pixel's grid, which is
@@ -914,18 +943,70 @@ mod tests {
             .expect("the ceiling");
         let (e, x) = (hit.element as usize, hit.p_world);
         let n = renderer.shading_normal(e, x);
-        let site = Site { point: x, normal: n, pixel_size: 1.0 };
+        let origin = renderer.ray_origin(e, x, n);
+        let site = Site { point: x, normal: n, origin, pixel_size: 1.0 };
         let mut rng = Rng::for_task(1, 2, 3);
         let record = renderer.gather_record(&solution, &site, 4096, Shading::Smooth, &mut rng);
         let params = RenderParams { gather: Gather::Full, ..RenderParams::default() };
         let mis = DirectMis { lights: 0, cosines: params.gather_rays };
         let count = 2000;
         let alone: Rgb = (0..count)
-            .map(|_| renderer.cosine_rays(&solution, x, n, &params, 3, mis, true, false, &mut rng).1)
+            .map(|_| renderer.cosine_rays(&solution, origin, n, &params, 3, mis, true, false, &mut rng).1)
             .sum::<Rgb>()
             / f64::from(count);
         let (got, expected) = (alone.luminance(), record.irradiance.luminance());
         assert!((got / expected - 1.0).abs() < 0.03, "alone {got} against the record's {expected}");
+    }
+
+    /// A tessellated ball under a small lamp: from points whose interpolated normal sees the
+    /// lamp low over the horizon (cosine under 0.25), a shadow ray to the lamp meets nothing,
+    /// as on the round ball those normals describe. Leaving from the facets themselves, 36 of
+    /// the 204 such rays hit the neighbouring facets.
+    #[test]
+    fn shadow_rays_leave_a_smooth_ball_as_a_round_one() {
+        let light = Material::try_new("light", Rgb::ZERO, Rgb::splat(1.0)).unwrap();
+        let white = Material::try_new("white", Rgb::splat(0.5), Rgb::ZERO).unwrap();
+        let lamp = [(-0.05, -0.05), (-0.05, 0.05), (0.05, 0.05), (0.05, -0.05)]
+            .map(|(x, y)| DVec3::new(x, y, 10.0))
+            .to_vec();
+        let objects = vec![
+            Object {
+                name: "lamp".into(),
+                material: 0,
+                shape: Shape::Polygons(vec![Polygon::try_new(lamp).unwrap()]),
+                sides: Sides::One,
+            },
+            Object {
+                name: "ball".into(),
+                material: 1,
+                shape: Shape::Sphere(Sphere::try_new(DVec3::ZERO, 1.0, Facing::Outward).unwrap()),
+                sides: Sides::One,
+            },
+        ];
+        let scene = Scene::try_new("ball", None, vec![light, white], objects).unwrap();
+        let mesh = Arc::new(Mesh::build(&scene, &MeshParams::try_new(0.5, 0.25).unwrap()).unwrap());
+        let renderer = Renderer::new(mesh.clone());
+        let target = DVec3::new(0.0, 0.0, 10.0);
+        let (mut grazing, mut blocked, mut blocked_plain) = (0, 0, 0);
+        for (e, el) in
+            mesh.elements.iter().enumerate().filter(|&(e, _)| mesh.element_material(e).emission == Rgb::ZERO)
+        {
+            for &corner in el.vertex_indices() {
+                let x = el.centre.lerp(mesh.positions[corner as usize], 0.8);
+                let n = renderer.shading_normal(e, x);
+                let cos = n.dot((target - x).normalize());
+                if !(0.0..0.25).contains(&cos) {
+                    continue;
+                }
+                grazing += 1;
+                let hit = |origin: DVec3| renderer.blockers.occluded(origin.as_vec3(), target.as_vec3());
+                blocked += usize::from(hit(renderer.ray_origin(e, x, n)));
+                blocked_plain += usize::from(hit(x + n * renderer.lift));
+            }
+        }
+        assert!(grazing > 100, "{grazing} points near the terminator");
+        assert!(blocked * 100 <= grazing, "{blocked} of {grazing} shadow rays blocked");
+        assert!(blocked_plain * 10 > grazing, "the facets block only {blocked_plain} of {grazing}");
     }
 
     #[test]
