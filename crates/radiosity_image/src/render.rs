@@ -557,6 +557,13 @@ impl Renderer {
                 let effort = centre_hit.map_or(Effort::PLAIN, |hit| {
                     self.effort(camera.position, centre_dir(y * w + x), &hit, p)
                 });
+                // Sample i's place in the pixel is stratum i of the pixel's grid; the strata
+                // of the emitters and of the hemisphere it takes are drawn apart from that, so
+                // that where only some samples see a surface (the pixels along an outline,
+                // all from one side of the pixel) they still sample the whole lamp and not
+                // one end of it: tied together, the floor's front edge read up to 45 % bright
+                // in the short block's penumbra and 55 % dark beside it.
+                let strata = shuffled(n, &mut rng);
                 let mut sum = Rgb::ZERO;
                 for i in 0..n {
                     let dir = rays.jittered_direction(x as u32, y as u32, i, n, &mut rng);
@@ -574,7 +581,7 @@ impl Renderer {
                                     gather,
                                     p,
                                     effort,
-                                    i,
+                                    strata[i as usize],
                                     cached,
                                     &mut rng,
                                 ) / PI
@@ -652,8 +659,9 @@ impl Renderer {
         Effort { light_factor, cosines: !seen.small }
     }
 
-    /// One sample of the radiosity leaving `x` on element `e` with a final gather, sample
-    /// `sample` of its pixel or texel, taking what `effort` asks (see the `gather` module for
+    /// One sample of the radiosity leaving `x` on element `e` with a final gather, taking
+    /// stratum `sample` of its pixel's or texel's emitter points and directions and what
+    /// `effort` asks (see the `gather` module for
     /// the estimators). With [`Gather::Full`], `cache` (and the pixel the sample belongs to)
     /// gives the indirect light where a record covers `x`; elsewhere the sample gathers it.
     #[allow(clippy::too_many_arguments)]
@@ -909,6 +917,16 @@ fn shading_normals(mesh: &Mesh) -> Vec<DVec3> {
         .collect();
     let turned = mesh.elements.iter().any(|el| !is_flat(el, &normals));
     if turned { normals } else { Vec::new() }
+}
+
+/// `0..n` in an order drawn from `rng` (Fisher–Yates; the modulo's bias is below 2⁻⁵⁰).
+fn shuffled(n: u32, rng: &mut Rng) -> Vec<u32> {
+    let mut order: Vec<u32> = (0..n).collect();
+    for i in (1..order.len()).rev() {
+        let j = rng.next_u64() % (i as u64 + 1);
+        order.swap(i, j as usize);
+    }
+    order
 }
 
 /// Whether every vertex normal of `el` is its own normal, within round-off of a normal
