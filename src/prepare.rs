@@ -265,10 +265,19 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
         // A missing light is returned after the warnings are out, not in place of them.
         allow_no_light: true,
     };
-    let radiosity_io::LoadedScene { scene, warnings, no_light } =
+    let radiosity_io::LoadedScene { mut scene, warnings, no_light } =
         radiosity_io::resolve_scene_with(scene_arg, &options)?;
     for w in &warnings {
         crate::output::note(format_args!("warning: {w}"))?;
+    }
+    if o.mesh.sides.is_none() {
+        let sealed = radiosity_core::seal_closed_objects(&mut scene);
+        if !sealed.is_empty() {
+            crate::output::note(format_args!(
+                "note: {} closed and lit from outside: meshed one-sided, no light reaches inside (--sides 2 meshes both faces)",
+                name_list(&scene, &sealed)
+            ))?;
+        }
     }
     if !(o.light_scale.is_finite() && o.light_scale > 0.0) {
         return Err(input(format!("--light-scale must be a finite number > 0, got {}", o.light_scale)));
@@ -338,6 +347,17 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
         ..defaults
     };
     Ok((Settings { scene, mesh_params, solver_params }, no_light))
+}
+
+/// The names of `objects` of `scene`, quoted, the first three and a count of the rest.
+fn name_list(scene: &Scene, objects: &[usize]) -> String {
+    let mut names: Vec<String> =
+        objects.iter().take(3).map(|&i| format!("'{}'", scene.objects[i].name)).collect();
+    if objects.len() > 3 {
+        names.push(format!("{} more", objects.len() - 3));
+    }
+    let verb = if objects.len() == 1 { "is" } else { "are" };
+    format!("{} {verb}", names.join(", "))
 }
 
 /// [`settings`], then the light scale and the [`Problem`] (mesh and ray queries); sets the

@@ -7,7 +7,9 @@ use glam::DVec3;
 use crate::scene::Polygon;
 
 /// A point's exact position as a hashable key: faces of one solid share corners bit for bit.
+/// Adding 0 makes −0 and +0 (a pole of a model's sphere written as `-0` and `0`) one key.
 pub(crate) fn key(p: DVec3) -> [u64; 3] {
+    let p = p + DVec3::ZERO;
     [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]
 }
 

@@ -192,10 +192,13 @@ pub fn default_samples() -> u32 {
 }
 
 /// Loads a scene file or built-in name, the error on one line as the command prints it
-/// ([`radiosity_core::one_line`]). The loader's warnings are dropped: the window has no place
-/// for them yet.
+/// ([`radiosity_core::one_line`]), with closed models lit from outside made one-sided as the
+/// command does ([`radiosity_core::seal_closed_objects`]). The loader's warnings are
+/// dropped: the window has no place for them yet.
 fn load_scene(arg: &str) -> Result<Scene, String> {
-    radiosity_io::resolve_scene(arg).map(|loaded| loaded.scene).map_err(|e| radiosity_core::one_line(&e))
+    let mut scene = radiosity_io::resolve_scene(arg).map_err(|e| radiosity_core::one_line(&e))?.scene;
+    radiosity_core::seal_closed_objects(&mut scene);
+    Ok(scene)
 }
 
 #[cfg(test)]
