@@ -223,6 +223,25 @@ mod tests {
         assert!(load_scene("cornell").is_ok());
     }
 
+    /// A scene opened in the window has its closed models lit from outside made one-sided, as
+    /// the command's: a cube (an OBJ, so two-sided) under a lamp.
+    #[test]
+    fn the_window_seals_closed_models_as_the_command_does() {
+        let dir = std::env::temp_dir().join(format!("radiosity-viewer-sealed-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        // The lamp's corners are vertices 1–4, the cube's 5–12; every face wound outwards.
+        let obj = "mtllib m.mtl\no lamp\nusemtl lamp\nv 0 3 0\nv 1 3 0\nv 1 3 1\nv 0 3 1\nf 1 2 3 4\n\
+                   o cube\nusemtl grey\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
+                   f 5 8 7 6\nf 9 10 11 12\nf 5 6 10 9\nf 8 12 11 7\nf 5 9 12 8\nf 6 7 11 10\n";
+        std::fs::write(dir.join("cube.obj"), obj).unwrap();
+        std::fs::write(dir.join("m.mtl"), "newmtl grey\nKd 0.5 0.5 0.5\nnewmtl lamp\nKd 0 0 0\nKe 5 5 5\n")
+            .unwrap();
+        let scene = load_scene(&dir.join("cube.obj").display().to_string()).unwrap();
+        std::fs::remove_dir_all(&dir).unwrap();
+        let sides: Vec<_> = scene.objects.iter().map(|o| (o.name.as_str(), o.sides)).collect();
+        assert!(sides.contains(&("cube", radiosity_core::Sides::One)), "{sides:?}");
+    }
+
     /// winit's message loses the path into its source, keeps what went wrong.
     #[test]
     fn source_locations_are_left_out_of_window_errors() {
