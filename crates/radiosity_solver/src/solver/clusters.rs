@@ -347,12 +347,22 @@ impl Clusters {
         if by_area {
             total = elements.iter().map(|&e| mesh.elements[e].area).sum();
         }
-        let mut bins = [DVec3::ZERO; BINS * BINS];
+        let mut bins = [(DVec3::ZERO, 0.0); BINS * BINS];
         for &e in &elements {
             let n = mesh.elements[e].normal;
-            bins[normal_bin(n)] += n * (share(e) / total);
+            let bin = &mut bins[normal_bin(n)];
+            bin.0 += n * (share(e) / total);
+            bin.1 += share(e) / total;
         }
-        let axes = bins.into_iter().filter(|a| *a != DVec3::ZERO).collect();
+        // Each bin's summed normal at the length of the bin's share: the clamped lobe of a
+        // vector a sends out π|a| over the sphere, and |Σ w_k n_k| < Σ w_k when the normals
+        // differ, so unscaled the far field lost what a curved group's bins spread (the
+        // members' own lobes send out exactly their shares).
+        let axes = bins
+            .into_iter()
+            .filter(|(a, _)| *a != DVec3::ZERO)
+            .map(|(a, w)| a.normalize_or_zero() * w)
+            .collect();
         let mut cdf = Vec::with_capacity(elements.len());
         let mut acc = 0.0;
         for &e in &elements {
@@ -850,6 +860,38 @@ mod tests {
         abs[group[0] as usize] = 0.0;
         clusters.update(&[(group[0], -0.6)], &abs);
         assert_eq!(clusters.brightest(&abs), Shooter::Patch(single));
+    }
+
+    /// A group's far field sends out all its power: over the sphere of directions,
+    /// ∫ Σ_b (a_b·d)⁺ dω / π = 1, the sum of its members' shares (each member's clamped lobe
+    /// sends out π times its share). Directions on a 400 × 800 grid in (θ, φ), which integrates
+    /// a lobe within 2e-6; asserted within 0.1 %. With each bin's summed normal unscaled, this
+    /// ball's groups sent out 0.15–0.17 % less (a scan's rougher normals spread its bins more).
+    #[test]
+    fn the_far_field_sends_out_the_groups_power() {
+        let mesh = globe(24, 48);
+        let mut clusters = Clusters::new(&mesh, true);
+        let unshot = vec![Rgb::splat(1.0); mesh.elements.len()];
+        let tables = MeshTables::new(&mesh);
+        let params = SolverParams::default();
+        let (rows, columns) = (400, 800);
+        for g in [0, clusters.len() / 3, clusters.len() / 2] {
+            clusters.freeze(g, &mesh, &unshot, &tables, &params, 1.0);
+            let frozen = clusters.groups[g].frozen.as_ref().unwrap();
+            let mut sent = 0.0;
+            for i in 0..rows {
+                let theta = std::f64::consts::PI * (f64::from(i) + 0.5) / f64::from(rows);
+                for j in 0..columns {
+                    let phi = std::f64::consts::TAU * (f64::from(j) + 0.5) / f64::from(columns);
+                    let d = DVec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+                    let lobe: f64 = frozen.axes.iter().map(|a| a.dot(d).max(0.0)).sum();
+                    sent += lobe * theta.sin();
+                }
+            }
+            let cell = std::f64::consts::PI / f64::from(rows) * std::f64::consts::TAU / f64::from(columns);
+            let sent = sent * cell / std::f64::consts::PI;
+            assert!((sent - 1.0).abs() < 0.001, "group {g} sends out {sent} of its power");
+        }
     }
 
     /// Far from a group, its binned normals give the members' own point-to-point sum: a
