@@ -866,7 +866,7 @@ mod tests {
     /// ∫ Σ_b (a_b·d)⁺ dω / π = 1, the sum of its members' shares (each member's clamped lobe
     /// sends out π times its share). Directions on a 400 × 800 grid in (θ, φ), which integrates
     /// a lobe within 2e-6; asserted within 0.1 %. With each bin's summed normal unscaled, this
-    /// ball's groups sent out 0.15–0.17 % less (a scan's rougher normals spread its bins more).
+    /// ball's groups sent out 0.15–0.17 % less.
     #[test]
     fn the_far_field_sends_out_the_groups_power() {
         let mesh = globe(24, 48);
