@@ -12,9 +12,10 @@
 //! A group's shot treats its members as one emitter of its unshot power, spread as it was at
 //! its first shot (frozen, like a patch's, so a kept row stays right):
 //!
-//! * far away (beyond [`FAR`] group radii), by the group's power-weighted normals
-//!   w_b = Σ_k w_k n_k per bin b of similar normals (w_k the members' shares of the unshot
-//!   power): the irradiance at a receiver at distance r in direction d is
+//! * far away (beyond [`FAR`] group radii), by the group's power-weighted normals per bin b
+//!   of similar normals, w_b = (Σ_k w_k) Σ_k w_k n_k / |Σ_k w_k n_k| (w_k the members' shares
+//!   of the unshot power; scaled so that the bin sends out its whole share): the irradiance
+//!   at a receiver at distance r in direction d is
 //!   ΔΦ Σ_b (w_b·d)⁺ cos θ_r / (π r²) — the sum of the members' point-to-point terms with one
 //!   distance and one clamp per bin (face-cluster radiosity keeps one such vector per
 //!   cluster, Willmott, Heckbert & Garland 1999, §4);
