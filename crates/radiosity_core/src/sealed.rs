@@ -71,7 +71,7 @@ fn is_closed(polygons: &[Polygon]) -> bool {
 /// Points just in front of the scene's emitters (and behind those that emit from both
 /// sides), at most [`MAX_EMITTER_POINTS`], spread over every emitting polygon in turn.
 fn emitter_points(scene: &Scene) -> Vec<DVec3> {
-    let (lo, hi) = scene_bounds(scene);
+    let (lo, hi) = scene.bounds();
     let step = 1e-6 * lo.distance(hi).max(f64::MIN_POSITIVE);
     let mut points = Vec::new();
     for o in scene.objects.iter().filter(|o| scene.materials[o.material].is_emitter()) {
@@ -104,20 +104,6 @@ fn push_fronts(points: &mut Vec<DVec3>, polygons: &[Polygon], both: bool, step: 
             points.push(centre - p.normal() * step);
         }
     }
-}
-
-fn scene_bounds(scene: &Scene) -> (DVec3, DVec3) {
-    let mut corners = Vec::new();
-    for o in &scene.objects {
-        match &o.shape {
-            Shape::Sphere(s) => {
-                corners.extend([s.center - DVec3::splat(s.radius), s.center + DVec3::splat(s.radius)])
-            }
-            Shape::Polygons(ps) => corners.extend(ps.iter().flat_map(|p| p.vertices().iter().copied())),
-            Shape::Mesh(m) => corners.extend(m.polygons().iter().flat_map(|p| p.vertices().iter().copied())),
-        }
-    }
-    if corners.is_empty() { (DVec3::ZERO, DVec3::ONE) } else { bounds(&corners) }
 }
 
 /// A closed surface as triangles with their lit-side normals.
