@@ -29,7 +29,7 @@ use thiserror::Error;
 
 use crate::HdrImage;
 use crate::cache::{Gathered, IrradianceCache, Site};
-use crate::gather::{self, DirectMis, Emitters, Gather};
+use crate::gather::{self, DirectMis, Emitters, Gather, Seen};
 
 /// Task key of the pixels' streams (`Rng::for_task(seed, PIXEL_TASK, pixel)`).
 const PIXEL_TASK: u64 = 0x7069_7865_6c73; // "pixels"
@@ -499,6 +499,24 @@ impl Renderer {
         let centre_dir = |i: usize| rays.direction((i % w) as f64 + 0.5, (i / w) as f64 + 0.5);
         let centre_hits: Vec<Option<Hit>> =
             (0..w * h).into_par_iter().map(|i| first_hit(centre_dir(i))).collect();
+        // What each pixel's centre sees of the emitters, neighbours probing with different
+        // sets of points (see `gather::PROBE_SETS`): a pixel is then judged by its 3 × 3
+        // neighbourhood, four sets' worth of points for the price of one.
+        let probed: Vec<Option<Seen>> = (0..w * h)
+            .into_par_iter()
+            .map(|i| {
+                let set = (i % w) % 2 + 2 * ((i / w) % 2);
+                self.probe(camera.position, centre_dir(i), centre_hits[i].as_ref()?, params, set)
+            })
+            .collect();
+        let effort_of = |x: usize, y: usize, p: &RenderParams| {
+            let around = (y.saturating_sub(1)..(y + 2).min(h))
+                .flat_map(|j| (x.saturating_sub(1)..(x + 2).min(w)).map(move |i| j * w + i));
+            match probed[y * w + x] {
+                Some(own) => Self::effort_from(around.filter_map(|i| probed[i]).fold(own, Seen::union), p),
+                None => Effort::PLAIN,
+            }
+        };
         let cache = (params.gather == Gather::Full).then(|| {
             // One pixel's width per unit of distance from the eye.
             let pixel_angle = 2.0 * (camera.fov_y_deg.to_radians() * 0.5).tan() / f64::from(params.height);
@@ -554,9 +572,7 @@ impl Renderer {
                 let on_edge = params.edge_factor > 1 && around.iter().any(|c| *c != centre);
                 let p = if on_edge { &edge } else { &plain };
                 let n = p.samples_per_pixel;
-                let effort = centre_hit.map_or(Effort::PLAIN, |hit| {
-                    self.effort(camera.position, centre_dir(y * w + x), &hit, p)
-                });
+                let effort = effort_of(x, y, p);
                 // Sample i's place in the pixel is stratum i of the pixel's grid; the strata
                 // of the emitters and of the hemisphere it takes are drawn apart from that, so
                 // that where only some samples see a surface (the pixels along an outline,
@@ -625,37 +641,38 @@ impl Renderer {
         }
         let mut rng = Rng::for_task(params.seed, TEXEL_TASK, key);
         let n = params.samples_per_pixel;
-        let effort = self.effort_at(e, p, params);
+        let effort = Self::effort_from(self.probe_at(e, p, 0), params);
         let sum: Rgb = (0..n)
             .map(|i| self.gathered_sample(solution, e, p, params.gather, params, effort, i, None, &mut rng))
             .sum();
         Ok(sum / f64::from(n))
     }
 
-    /// What a pixel asks of its samples: [`Renderer::effort_at`] at the point its centre ray,
-    /// from `eye` along `dir`, sees (`hit`, the BVH's answer for that ray).
-    fn effort(&self, eye: DVec3, dir: DVec3, hit: &Hit, params: &RenderParams) -> Effort {
+    /// What the point a pixel's centre ray (from `eye` along `dir`, meeting `hit`) sees of
+    /// the emitters, by probe set `set`; `None` without a gather or on a surface's back.
+    fn probe(&self, eye: DVec3, dir: DVec3, hit: &Hit, params: &RenderParams, set: usize) -> Option<Seen> {
         if params.gather == Gather::None {
-            return Effort::PLAIN;
+            return None;
         }
         match self.surface_point(eye, dir, hit) {
-            (e, p, _, true) => self.effort_at(e, p, params),
-            _ => Effort::PLAIN,
+            (e, p, _, true) => Some(self.probe_at(e, p, set)),
+            _ => None,
         }
     }
 
-    /// What the samples of point `p` of element `e` take, from probe rays apart from theirs
+    /// What point `p` of element `e` sees of the emitters, by probe set `set`.
+    fn probe_at(&self, e: usize, p: DVec3, set: usize) -> Seen {
+        let n = self.shading_normal(e, p);
+        self.emitters.probe(&self.blockers, p, n, self.ray_origin(e, p, n), set)
+    }
+
+    /// What the samples of a point take, from what probe rays apart from theirs saw there
     /// (so that spending more where it pays does not bias the estimate):
-    /// `params.penumbra_factor` times the shadow rays where `p` sees part of the emitters, and
+    /// `params.penumbra_factor` times the shadow rays where it sees part of the emitters, and
     /// no cosine directions for the direct light where every emitter point it sees is far
     /// and small enough for points drawn on the emitters alone (see [`Emitters::probe`]).
-    fn effort_at(&self, e: usize, p: DVec3, params: &RenderParams) -> Effort {
-        if params.gather == Gather::None {
-            return Effort::PLAIN;
-        }
-        let n = self.shading_normal(e, p);
-        let seen = self.emitters.probe(&self.blockers, p, n, self.ray_origin(e, p, n));
-        let light_factor = if seen.partly { params.penumbra_factor } else { 1 };
+    fn effort_from(seen: Seen, params: &RenderParams) -> Effort {
+        let light_factor = if seen.partly() { params.penumbra_factor } else { 1 };
         Effort { light_factor, cosines: !seen.small }
     }
 
@@ -756,7 +773,7 @@ impl Renderer {
         // sample's share of the pixel's grid is one band of directions, biased alone).
         let (first, strata) =
             if whole { (sample * count, params.samples_per_pixel * count) } else { (0, count) };
-        let (columns, rows) = grid(strata);
+        let (columns, rows) = gather::grid(strata);
         let (mut direct, mut reflected) = (Rgb::ZERO, Rgb::ZERO);
         for j in first..first + count {
             let (cx, cy) = (j % columns, j / columns);
@@ -817,7 +834,7 @@ impl Renderer {
         shading: Shading,
         rng: &mut Rng,
     ) -> Gathered {
-        let (columns, rows) = grid(count);
+        let (columns, rows) = gather::grid(count);
         let origin = site.origin;
         let mut values = vec![Rgb::ZERO; count as usize];
         let mut distances = vec![f64::INFINITY; count as usize];
@@ -844,14 +861,6 @@ impl Renderer {
             gradient: gather::irradiance_gradient(site.normal, columns, rows, &values, &distances),
         }
     }
-}
-
-/// An exact grid for `count` strata: columns × rows = count with the columns the smallest
-/// divisor not below √count (every cell gets exactly one sample: no cell left unsampled).
-fn grid(count: u32) -> (u32, u32) {
-    let count = count.max(1);
-    let columns = (1..=count).find(|&c| c * c >= count && count.is_multiple_of(c)).unwrap_or(count);
-    (columns, count / columns)
 }
 
 /// Barycentric weights of `p` in the triangle `(0, b, c)`, clamped into the triangle.
