@@ -128,7 +128,8 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = RenderParams::default().gather_rays)]
     pub gather_rays: u32,
     /// Pixels on an outline (their corners and centre do not all see the same object) take
-    /// this many times --spp samples, 1 to 64; 1: as many as any pixel.
+    /// this many times --spp samples, 1 to 64; 1: as many as any pixel. On a lamp's outline,
+    /// where the lamp far outshines what lies beside it, its square (at most 64).
     #[arg(long, default_value_t = RenderParams::default().edge_factor, value_name = "N")]
     pub edge_factor: u32,
     /// With a gather, pixels whose point sees part of the lamps and not all (a penumbra, or a

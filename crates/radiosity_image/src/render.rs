@@ -100,7 +100,8 @@ pub struct RenderParams {
     pub gather_rays: u32,
     /// Pixels on a geometric edge (their corners and centre do not all see the same object,
     /// or not all an emitter) take this many times `samples_per_pixel`, in 1..=64; 1 treats
-    /// them as any other. Default 4.
+    /// them as any other; those on an emitter's outline take its square (at most 64).
+    /// Default 4.
     pub edge_factor: u32,
     /// With a gather, pixels (and texels) whose point sees some of the emitters and not all
     /// of them (a penumbra, or a lamp cut by the surface's horizon) take this many times
@@ -556,6 +557,14 @@ impl Renderer {
         let plain = *params;
         let edge =
             RenderParams { samples_per_pixel: params.samples_per_pixel * params.edge_factor, ..*params };
+        // A lamp's outline: the lamp is tens of times brighter than what lies beside it, so
+        // a pixel's share of it, counted in samples, is that much noisier against the
+        // pixel's value. These few pixels (a lamp's perimeter) take the edge factor squared.
+        let lamp_edge = RenderParams {
+            samples_per_pixel: params.samples_per_pixel
+                * (params.edge_factor * params.edge_factor).min(RenderParams::MAX_EDGE_FACTOR),
+            ..*params
+        };
         pixels.par_chunks_mut(w).zip(object_ids.par_chunks_mut(w)).enumerate().for_each(|(y, (row, ids))| {
             for x in 0..w {
                 let index = (y * w + x) as u64;
@@ -570,7 +579,13 @@ impl Renderer {
                 let around =
                     [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)].map(|(i, j)| corners[j * (w + 1) + i]);
                 let on_edge = params.edge_factor > 1 && around.iter().any(|c| *c != centre);
-                let p = if on_edge { &edge } else { &plain };
+                let emits = |c: &Option<(u32, bool)>| c.is_some_and(|(_, emits)| emits);
+                let on_lamp = on_edge && around.iter().chain([&centre]).any(emits);
+                let p = match (on_edge, on_lamp) {
+                    (_, true) => &lamp_edge,
+                    (true, false) => &edge,
+                    (false, false) => &plain,
+                };
                 let n = p.samples_per_pixel;
                 let effort = effort_of(x, y, p);
                 // Sample i's place in the pixel is stratum i of the pixel's grid; the strata
