@@ -283,20 +283,6 @@ impl Renderer {
         Self { mesh, accel, triangle_element, blockers, emitters, lift, shading_normals }
     }
 
-    /// The unit normal a gather uses at `p` on element `e`: its own, or where the mesh
-    /// smooths across facets, the vertex normals interpolated as the radiosity is (Phong
-    /// 1975), so the direct light computed per pixel does not bring back the facets that the
-    /// smoothed indirect part hides.
-    fn shading_normal(&self, e: usize, p: DVec3) -> DVec3 {
-        let el = &self.mesh.elements[e];
-        if self.shading_normals.is_empty() || is_flat(el, &self.shading_normals) {
-            return el.normal;
-        }
-        let n = self.interpolate_values(&self.shading_normals, e, p).normalize_or_zero();
-        // Far from the facet's own normal only on a degenerate fan; keep the facet's there.
-        if n.dot(el.normal) > 0.1 { n } else { el.normal }
-    }
-
     /// The element a ray along `dir` sees at BVH triangle `triangle`: where a two-sided
     /// object puts two elements back to back in one place, the one that faces the ray
     /// (which of the two coplanar triangles the BVH reports first is arbitrary).
@@ -428,25 +414,37 @@ impl Renderer {
         }
     }
 
-    /// Where secondary rays leave point `x` of element `e` (shading normal `n`): lifted off
-    /// the surface by `lift` along `n`, and first, on a facet shaded with interpolated
-    /// normals, moved out to the curved surface those normals describe. Each corner's
-    /// tangent plane that `x` lies below pushes it up to that plane, and the pushes are
-    /// blended with the corners' weights (Hanika 2021, "Hacking the shadow terminator", Ray
-    /// Tracing Gems II ch. 4). Without it, shadow rays from a facet of a tessellated sphere
-    /// near its terminator hit the neighbouring facets, which the smooth normals say are
-    /// not there: a band of dark speckles where the light grazes the surface.
-    fn ray_origin(&self, e: usize, x: DVec3, n: DVec3) -> DVec3 {
+    /// The unit normal a gather uses at point `x` of element `e`, and where its secondary
+    /// rays leave from.
+    ///
+    /// The normal is the element's own, or where the mesh smooths across facets, the vertex
+    /// normals interpolated as the radiosity is (Phong 1975), so the direct light computed
+    /// per pixel does not bring back the facets that the smoothed indirect part hides.
+    ///
+    /// The origin is `x` lifted off the surface by `lift` along that normal, and first, on a
+    /// facet shaded with interpolated normals, moved out to the curved surface those normals
+    /// describe. Each corner's tangent plane that `x` lies below pushes it up to that plane,
+    /// and the pushes are blended with the corners' weights (Hanika 2021, "Hacking the
+    /// shadow terminator", Ray Tracing Gems II ch. 4). Without it, shadow rays from a facet
+    /// of a tessellated sphere near its terminator hit the neighbouring facets, which the
+    /// smooth normals say are not there: a band of dark speckles where the light grazes the
+    /// surface. Both come from one set of corner weights.
+    fn shading_frame(&self, e: usize, x: DVec3) -> (DVec3, DVec3) {
         let el = &self.mesh.elements[e];
         if self.shading_normals.is_empty() || is_flat(el, &self.shading_normals) {
-            return x + n * self.lift;
+            return (el.normal, x + el.normal * self.lift);
         }
         let w = self.corner_weights(e, x);
-        let push = el.vertex_indices().iter().zip(w).fold(DVec3::ZERO, |push, (&v, w)| {
+        let corners = el.vertex_indices().iter().zip(w);
+        let smooth = corners.clone().fold(DVec3::ZERO, |n, (&v, w)| n + self.shading_normals[v as usize] * w);
+        let smooth = smooth.normalize_or_zero();
+        // Far from the facet's own normal only on a degenerate fan; keep the facet's there.
+        let n = if smooth.dot(el.normal) > 0.1 { smooth } else { el.normal };
+        let push = corners.fold(DVec3::ZERO, |push, (&v, w)| {
             let (corner, normal) = (self.mesh.positions[v as usize], self.shading_normals[v as usize]);
             push - normal * ((x - corner).dot(normal).min(0.0) * w)
         });
-        x + push + n * self.lift
+        (n, x + push + n * self.lift)
     }
 
     /// Renders `solution` seen from `camera`.
@@ -536,13 +534,8 @@ impl Renderer {
                     // positive number (an eye on a surface would make it 0).
                     let pixel_size = distance * pixel_angle;
                     let sized = pixel_size.is_finite() && pixel_size > 0.0;
-                    let normal = self.shading_normal(e, point);
-                    (front && reflects && sized).then(|| Site {
-                        point,
-                        normal,
-                        origin: self.ray_origin(e, point, normal),
-                        pixel_size,
-                    })
+                    let (normal, origin) = self.shading_frame(e, point);
+                    (front && reflects && sized).then(|| Site { point, normal, origin, pixel_size })
                 })
                 .collect();
             IrradianceCache::build(w, h, &sites, |i, site, factor| {
@@ -677,8 +670,8 @@ impl Renderer {
 
     /// What point `p` of element `e` sees of the emitters, by probe set `set`.
     fn probe_at(&self, e: usize, p: DVec3, set: usize) -> Seen {
-        let n = self.shading_normal(e, p);
-        self.emitters.probe(&self.blockers, p, n, self.ray_origin(e, p, n), set)
+        let (n, origin) = self.shading_frame(e, p);
+        self.emitters.probe(&self.blockers, p, n, origin, set)
     }
 
     /// What the samples of a point take, from what probe rays apart from theirs saw there
@@ -710,7 +703,7 @@ impl Renderer {
         rng: &mut Rng,
     ) -> Rgb {
         let material = self.mesh.element_material(e);
-        let n = self.shading_normal(e, x);
+        let (n, origin) = self.shading_frame(e, x);
         let lights = if self.emitters.is_empty() { 0 } else { params.shadow_rays * effort.light_factor };
         let cached = match (gather, cache) {
             (Gather::Full, Some((cache, px, py))) => cache.lookup(px, py, x, n),
@@ -726,7 +719,6 @@ impl Renderer {
         };
         let mis = DirectMis { lights, cosines };
         let strata = params.samples_per_pixel * lights;
-        let origin = self.ray_origin(e, x, n);
         let mut direct = gather::emitter_samples(
             &self.emitters,
             &self.blockers,
@@ -984,8 +976,7 @@ mod tests {
             .unwrap()
             .expect("the ceiling");
         let (e, x) = (hit.element as usize, hit.p_world);
-        let n = renderer.shading_normal(e, x);
-        let origin = renderer.ray_origin(e, x, n);
+        let (n, origin) = renderer.shading_frame(e, x);
         let site = Site { point: x, normal: n, origin, pixel_size: 1.0 };
         let mut rng = Rng::for_task(1, 2, 3);
         let record = renderer.gather_record(&solution, &site, 4096, Shading::Smooth, &mut rng);
@@ -1035,14 +1026,14 @@ mod tests {
         {
             for &corner in el.vertex_indices() {
                 let x = el.centre.lerp(mesh.positions[corner as usize], 0.8);
-                let n = renderer.shading_normal(e, x);
+                let (n, origin) = renderer.shading_frame(e, x);
                 let cos = n.dot((target - x).normalize());
                 if !(0.0..0.25).contains(&cos) {
                     continue;
                 }
                 grazing += 1;
                 let hit = |origin: DVec3| renderer.blockers.occluded(origin.as_vec3(), target.as_vec3());
-                blocked += usize::from(hit(renderer.ray_origin(e, x, n)));
+                blocked += usize::from(hit(origin));
                 blocked_plain += usize::from(hit(x + n * renderer.lift));
             }
         }
