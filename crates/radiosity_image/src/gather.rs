@@ -503,11 +503,8 @@ mod tests {
         assert!((got / expected - 1.0).abs() < 5e-3, "irradiance {got} vs closed form {expected}");
     }
 
-    /// A point sees part of a lamp when a blocker hides some of it, or its own horizon cuts
-    /// it; not when it sees all of the lamp or none. The lamp is small beside its distance
-    /// from far away, not from close under it.
-    #[test]
-    fn probes_find_penumbrae_horizons_and_small_lamps() {
+    /// A 1 × 1 lamp at height 1, centred over the origin and facing down, in 0.25 elements.
+    fn lamp_mesh() -> Mesh {
         let light = Material::try_new("light", Rgb::ZERO, Rgb::splat(1.0)).unwrap();
         let polygon = Object {
             name: "lamp".into(),
@@ -516,8 +513,15 @@ mod tests {
             sides: radiosity_core::Sides::One,
         };
         let scene = Scene::try_new("lamp", None, vec![light], vec![polygon]).unwrap();
-        let mesh = Mesh::build(&scene, &MeshParams::try_new(0.5, 0.25).unwrap()).unwrap();
-        let emitters = Emitters::new(&mesh);
+        Mesh::build(&scene, &MeshParams::try_new(0.5, 0.25).unwrap()).unwrap()
+    }
+
+    /// A point sees part of a lamp when a blocker hides some of it, or its own horizon cuts
+    /// it; not when it sees all of the lamp or none. The lamp is small beside its distance
+    /// from far away, not from close under it.
+    #[test]
+    fn probes_find_penumbrae_horizons_and_small_lamps() {
+        let emitters = Emitters::new(&lamp_mesh());
         let open = radiosity_accel::BruteForce::new(&[]);
         let up = DVec3::Z;
         let probe = |rays: &dyn RayQuery, x: DVec3, n: DVec3| emitters.probe(rays, x, n, x + n * 1e-6, 0);
@@ -615,16 +619,7 @@ mod tests {
     /// eighth of the lamp wide or wider (measured: set 0 finds 22 of 44 strips, the four 31).
     #[test]
     fn probe_sets_together_find_slivers_one_set_misses() {
-        let light = Material::try_new("light", Rgb::ZERO, Rgb::splat(1.0)).unwrap();
-        let polygon = Object {
-            name: "lamp".into(),
-            material: 0,
-            shape: Shape::Polygons(vec![Polygon::try_new(square(1.0, 0.5, false)).unwrap()]),
-            sides: radiosity_core::Sides::One,
-        };
-        let scene = Scene::try_new("lamp", None, vec![light], vec![polygon]).unwrap();
-        let mesh = Mesh::build(&scene, &MeshParams::try_new(0.5, 0.25).unwrap()).unwrap();
-        let emitters = Emitters::new(&mesh);
+        let emitters = Emitters::new(&lamp_mesh());
         let (mut one, mut four, mut cases) = (0, 0, 0);
         for tenths in 2..=12 {
             // The strip's width on the lamp; a sheet at half height hides the rest, so its
