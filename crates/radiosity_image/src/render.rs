@@ -535,7 +535,7 @@ impl Renderer {
                     let pixel_size = distance * pixel_angle;
                     let sized = pixel_size.is_finite() && pixel_size > 0.0;
                     let (normal, origin) = self.shading_frame(e, point);
-                    (front && reflects && sized).then(|| Site { point, normal, origin, pixel_size })
+                    (front && reflects && sized).then_some(Site { point, normal, origin, pixel_size })
                 })
                 .collect();
             IrradianceCache::build(w, h, &sites, |i, site, factor| {
