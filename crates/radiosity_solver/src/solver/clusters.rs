@@ -56,7 +56,12 @@ const MIN_FACETS: usize = 32;
 /// Receivers farther than this many group radii from the group's centre take the far field.
 const FAR: f64 = 2.5;
 
-/// Points drawn over a group for its near field and its rays' ends.
+/// Points drawn over a group for its near field and its rays' ends (a square). More points
+/// bring a statue's folds, which light one another through the near field, closer to the
+/// truth: Lucy in McGuire's box against the path tracer read −2.62 % with 64, −2.03 % with
+/// 256 (solve 3.8 → 4.8 s), −1.88 % with 1024 (8.4 s), and −1.29 % with every facet
+/// shooting alone; but 256 cost the 139 k-triangle bunny room 18 % of its solve, and one
+/// point per two elements of a group (64–256) gained Lucy only 0.14 %.
 const POINTS: usize = 64;
 
 /// Draws of a far receiver's ray end before its ray is given up (no point of the group
