@@ -60,9 +60,9 @@ const FAR: f64 = 2.5;
 /// bring a statue's folds, which light one another through the near field, closer to the
 /// truth: Lucy in McGuire's box against the path tracer read −2.62 % with 64, −2.03 % with
 /// 256 (solve 3.8 → 4.8 s), −1.88 % with 1024 (8.4 s), and −1.29 % with every facet
-/// shooting alone; but with 256 the 139 k-triangle bunny room solved in 30.0 s against 25.4 s
-/// (one run each, on a noisy machine), and one
-/// point per two elements of a group (64–256) gained Lucy only 0.14 %.
+/// shooting alone; but with 256 the 139 k-triangle bunny room solved in 30.0 s against
+/// 25.4 s (one run each, on a noisy machine), and one point per two elements of a group
+/// (64–256) gained Lucy only 0.14 %.
 const POINTS: usize = 64;
 
 /// Draws of a far receiver's ray end before its ray is given up (no point of the group
