@@ -41,7 +41,7 @@ const RECORD_TASK: u64 = 0x7265_636f_7264; // "record"
 /// An irradiance-cache record gathers this many times [`RenderParams::gather_rays`].
 pub const RECORD_RAYS_PER_GATHER_RAY: u32 = 64;
 
-/// What the samples of one pixel or texel take (see [`Renderer::effort_at`]).
+/// What the samples of one pixel or texel take (see [`Renderer::effort_from`]).
 #[derive(Clone, Copy, Debug)]
 struct Effort {
     /// Times `shadow_rays`.
