@@ -295,9 +295,10 @@ impl DirectMis {
 
 /// The emitter-area half of the direct irradiance at `x` (unit normal `n`): `mis.lights`
 /// shadow rays whose emitter coordinates are points `first..first + mis.lights` of
-/// `strata` stratified in both coordinates ([`lattice_point`]; the samples of one pixel share
-/// one stratification), jittered by `rng`, each weighted by [`DirectMis::term`]. The shadow
-/// rays leave from `origin` (`x`, lifted off its surface).
+/// `strata` stratified in both coordinates ([`lattice_point`], turned by `rotation`, uniform
+/// in [0, 1) and one for all the samples of a pixel, which share one stratification),
+/// jittered by `rng`, each weighted by [`DirectMis::term`]. The shadow rays leave from
+/// `origin` (`x`, lifted off its surface).
 ///
 /// The first coordinate picks the emitter triangle (in mesh order, so neighbouring strata
 /// fall on neighbouring triangles) and the place across it, the second the place along it.
@@ -314,13 +315,14 @@ pub(crate) fn emitter_samples(
     origin: DVec3,
     first: u32,
     strata: u32,
+    rotation: f64,
     mis: DirectMis,
     rng: &mut Rng,
 ) -> Rgb {
     let mut sum = Rgb::ZERO;
     let step = lattice_step(strata);
     for i in first..first + mis.lights {
-        let (u, v) = lattice_point(i, strata, step, rng);
+        let (u, v) = lattice_point(i, strata, step, rotation, rng);
         let Some(s) = emitters.sample(u, v) else {
             return Rgb::ZERO;
         };
@@ -341,13 +343,19 @@ pub(crate) fn emitter_samples(
 
 /// Point `cell` of `strata` (modulo `strata`) jittered points in [0, 1)² that take one
 /// stratum each of both coordinates (a Latin hypercube): the first coordinate's stratum is
-/// `cell`, the second's `cell · step` modulo `strata` (`step` from [`lattice_step`]).
-pub(crate) fn lattice_point(cell: u32, strata: u32, step: u32, rng: &mut Rng) -> (f64, f64) {
+/// `cell`, the second's `cell · step` modulo `strata` (`step` from [`lattice_step`]), the
+/// second coordinate then turned by `rotation` (modulo 1).
+///
+/// The rotation, uniform in [0, 1) and shared by a pixel's points, is what makes the
+/// estimate unbiased: each point's second coordinate is then uniform over [0, 1) whatever
+/// its first (a random shift, Cranley & Patterson 1976). A fixed lattice integrates over
+/// its `strata` cells only; with 4 points a lamp's light came out 7.7 % low.
+pub(crate) fn lattice_point(cell: u32, strata: u32, step: u32, rotation: f64, rng: &mut Rng) -> (f64, f64) {
     let strata = strata.max(1);
     let cell = cell % strata;
     let row = (u64::from(cell) * u64::from(step) % u64::from(strata)) as u32;
     let u = (f64::from(cell) + rng.next_f64()) / f64::from(strata);
-    let v = (f64::from(row) + rng.next_f64()) / f64::from(strata);
+    let v = ((f64::from(row) + rng.next_f64()) / f64::from(strata) + rotation).fract();
     (u, v)
 }
 
@@ -489,8 +497,18 @@ mod tests {
         let mut rng = Rng::for_task(0, 0, 0);
         let n = 4096;
         let mis = DirectMis { lights: n, cosines: 0 };
-        let h_est =
-            emitter_samples(&emitters, &rays, DVec3::ZERO, DVec3::Z, DVec3::Z * 1e-6, 0, n, mis, &mut rng);
+        let h_est = emitter_samples(
+            &emitters,
+            &rays,
+            DVec3::ZERO,
+            DVec3::Z,
+            DVec3::Z * 1e-6,
+            0,
+            n,
+            0.3,
+            mis,
+            &mut rng,
+        );
         // Point on the axis of a parallel square of side a at height h: the view factor is
         // 4 × that of a rectangle a/2 × a/2 with a corner above the point (Howell C-? for a
         // differential area to a parallel rectangle): F = (1/2π) Σ [X/√(1+X²) atan(Y/√(1+X²)) + …].
@@ -501,6 +519,31 @@ mod tests {
         let expected = emission * 4.0 * corner;
         let got = h_est.to_array()[0];
         assert!((got / expected - 1.0).abs() < 5e-3, "irradiance {got} vs closed form {expected}");
+        // Four points at a time, each set turned by its own rotation: unbiased however few
+        // (a fixed lattice of four read 7.7 % low beside a square lamp).
+        let few = DirectMis { lights: 4, cosines: 0 };
+        let runs = 4000;
+        let mean = (0..runs)
+            .map(|_| {
+                let rotation = rng.next_f64();
+                let origin = DVec3::Z * 1e-6;
+                emitter_samples(
+                    &emitters,
+                    &rays,
+                    DVec3::ZERO,
+                    DVec3::Z,
+                    origin,
+                    0,
+                    4,
+                    rotation,
+                    few,
+                    &mut rng,
+                )
+                .to_array()[0]
+            })
+            .sum::<f64>()
+            / f64::from(runs);
+        assert!((mean / expected - 1.0).abs() < 5e-3, "four points at a time: {mean} vs {expected}");
     }
 
     /// A 1 × 1 lamp at height 1, centred over the origin and facing down, in 0.25 elements.
@@ -582,7 +625,8 @@ mod tests {
     /// Cosine-weighted directions lie in the upper hemisphere and have mean cos θ = 2/3
     /// (∫ cos θ · cos θ/π dω = 2/3).
     /// A pixel's emitter points take every stratum of both coordinates once (a Latin
-    /// hypercube), and spread in two dimensions: no two closer than a fifth of the spacing
+    /// hypercube; the second's strata turned by the pixel's rotation), and spread in two
+    /// dimensions: no two closer than a fifth of the spacing
     /// of a square grid of as many points (the torus' distance; a random second coordinate
     /// would put them anywhere).
     #[test]
@@ -590,10 +634,14 @@ mod tests {
         let mut rng = Rng::for_task(3, 0, 0);
         for n in [1u32, 2, 13, 16, 32, 64, 128, 512] {
             let step = lattice_step(n);
-            let points: Vec<(f64, f64)> = (0..n).map(|i| lattice_point(i, n, step, &mut rng)).collect();
+            let rotation = 0.37;
+            let points: Vec<(f64, f64)> =
+                (0..n).map(|i| lattice_point(i, n, step, rotation, &mut rng)).collect();
             let stratum = |x: f64| (x * f64::from(n)).floor() as usize;
             let mut us: Vec<usize> = points.iter().map(|p| stratum(p.0)).collect();
-            let mut vs: Vec<usize> = points.iter().map(|p| stratum(p.1)).collect();
+            // The second coordinate's strata, turned back.
+            let mut vs: Vec<usize> =
+                points.iter().map(|p| stratum((p.1 - rotation).rem_euclid(1.0))).collect();
             us.sort_unstable();
             vs.sort_unstable();
             let all: Vec<usize> = (0..n as usize).collect();

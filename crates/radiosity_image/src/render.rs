@@ -41,6 +41,18 @@ const RECORD_TASK: u64 = 0x7265_636f_7264; // "record"
 /// An irradiance-cache record gathers this many times [`RenderParams::gather_rays`].
 pub const RECORD_RAYS_PER_GATHER_RAY: u32 = 64;
 
+/// A gathering ray shorter than this many sides of the element it lands on takes the direct
+/// light there by its own rays ([`Renderer::reflected`]). On the Cornell box (`--gather
+/// full`, against the path tracer): error 1.74 → 1.63 %, bias 1.12 → 0.84 %, for 13 % more
+/// render time; 1 or 4 sides instead of 2 moved the error by 0.01–0.02 %, and 2 + 2 rays
+/// where they land instead of 4 + 4 neither the time nor the error.
+const SHORT_RAY: f64 = 2.0;
+
+/// Shadow rays a short gathering ray takes where it lands (stratified over the emitters),
+/// and as many cosine-weighted directions, their estimates combined by the balance
+/// heuristic.
+const LANDING_SHADOW_RAYS: u32 = 4;
+
 /// What the samples of one pixel or texel take (see [`Renderer::effort_from`]).
 #[derive(Clone, Copy, Debug)]
 struct Effort {
@@ -53,6 +65,15 @@ struct Effort {
 impl Effort {
     /// Nothing more than the parameters say.
     const PLAIN: Effort = Effort { light_factor: 1, cosines: true };
+}
+
+/// Which share of its pixel's (or texel's) strata a sample takes: stratum `index` of the
+/// emitter points and directions, the emitter points' lattice turned by the pixel's
+/// `rotation` (see [`gather::lattice_point`]).
+#[derive(Clone, Copy, Debug)]
+struct Stratum {
+    index: u32,
+    rotation: f64,
 }
 
 /// How radiosity is taken at a hit point.
@@ -588,6 +609,7 @@ impl Renderer {
                 // one end of it: tied together, the floor's front edge read up to 45 % bright
                 // in the short block's penumbra and 55 % dark beside it.
                 let strata = shuffled(n, &mut rng);
+                let rotation = rng.next_f64();
                 let mut sum = Rgb::ZERO;
                 for i in 0..n {
                     let dir = rays.jittered_direction(x as u32, y as u32, i, n, &mut rng);
@@ -605,7 +627,7 @@ impl Renderer {
                                     gather,
                                     p,
                                     effort,
-                                    strata[i as usize],
+                                    Stratum { index: strata[i as usize], rotation },
                                     cached,
                                     &mut rng,
                                 ) / PI
@@ -650,8 +672,12 @@ impl Renderer {
         let mut rng = Rng::for_task(params.seed, TEXEL_TASK, key);
         let n = params.samples_per_pixel;
         let effort = Self::effort_from(self.probe_at(e, p, 0), params);
+        let rotation = rng.next_f64();
         let sum: Rgb = (0..n)
-            .map(|i| self.gathered_sample(solution, e, p, params.gather, params, effort, i, None, &mut rng))
+            .map(|index| {
+                let stratum = Stratum { index, rotation };
+                self.gathered_sample(solution, e, p, params.gather, params, effort, stratum, None, &mut rng)
+            })
             .sum();
         Ok(sum / f64::from(n))
     }
@@ -685,9 +711,8 @@ impl Renderer {
     }
 
     /// One sample of the radiosity leaving `x` on element `e` with a final gather, taking
-    /// stratum `sample` of its pixel's or texel's emitter points and directions and what
-    /// `effort` asks (see the `gather` module for
-    /// the estimators). With [`Gather::Full`], `cache` (and the pixel the sample belongs to)
+    /// `stratum` of its pixel's or texel's emitter points and directions and what `effort`
+    /// asks (see the `gather` module for the estimators). With [`Gather::Full`], `cache` (and the pixel the sample belongs to)
     /// gives the indirect light where a record covers `x`; elsewhere the sample gathers it.
     #[allow(clippy::too_many_arguments)]
     fn gathered_sample(
@@ -698,7 +723,7 @@ impl Renderer {
         gather: Gather,
         params: &RenderParams,
         effort: Effort,
-        sample: u32,
+        stratum: Stratum,
         cache: Option<(&IrradianceCache, usize, usize)>,
         rng: &mut Rng,
     ) -> Rgb {
@@ -725,29 +750,19 @@ impl Renderer {
             x,
             n,
             origin,
-            sample * lights,
+            stratum.index * lights,
             strata,
+            stratum.rotation,
             mis,
             rng,
         );
         // With a cache, samples of one pixel take different numbers of rays.
         let whole = cache.is_none();
         let (cosine_direct, reflected) =
-            self.cosine_rays(solution, origin, n, params, sample, mis, gathers, whole, rng);
+            self.cosine_rays(solution, origin, n, params, stratum.index, mis, gathers, whole, rng);
         direct += cosine_direct;
         let indirect = match gather {
-            // What the solver's radiosity holds besides emission and direct light, as it is
-            // at x; clamped because the direct part and the total are interpolated apart.
-            Gather::Direct => {
-                let (total, direct) = match params.shading {
-                    Shading::Flat => (solution.element_radiosity[e], solution.element_direct[e]),
-                    Shading::Smooth => (
-                        self.interpolate(solution, e, x),
-                        self.interpolate_values(&solution.vertex_direct, e, x),
-                    ),
-                };
-                (total - material.emission - direct).map(|c| c.max(0.0))
-            }
+            Gather::Direct => self.indirect_part(solution, e, x, params.shading),
             _ => material.reflectance * cached.unwrap_or(reflected),
         };
         material.emission + material.reflectance * direct + indirect
@@ -799,7 +814,8 @@ impl Renderer {
                 direct += mis.term(emission, n.dot(dir), cos_y, distance * distance, pdf_area);
             }
             if reflect {
-                reflected += self.reflected(solution, e, origin + dir * distance, params.shading);
+                reflected +=
+                    self.reflected(solution, e, origin + dir * distance, distance, params.shading, rng);
             }
         }
         (direct, reflected / f64::from(count))
@@ -819,14 +835,73 @@ impl Renderer {
         Some((e, distance, cos_y))
     }
 
-    /// The radiosity point `y` of element `e` reflects, B − E (its emission is direct light,
-    /// sampled apart).
-    fn reflected(&self, solution: &Solution, e: usize, y: DVec3, shading: Shading) -> Rgb {
-        let b = match shading {
-            Shading::Flat => solution.element_radiosity[e],
-            Shading::Smooth => self.interpolate(solution, e, y),
+    /// The radiosity point `y` of element `e` reflects as a gathering ray that travelled
+    /// `distance` sees it: B − E from the solution (its emission is direct light, sampled
+    /// apart). A ray shorter than [`SHORT_RAY`] times the element's side lands where the mesh
+    /// is too coarse for it, beside a contact or a shadow's edge: there the direct part is
+    /// taken by [`LANDING_SHADOW_RAYS`] rays from `y` and only the rest, B − E −
+    /// B_direct, from the solution (as [`Gather::Direct`] does at a pixel). The foot of the
+    /// Cornell box's short block gathered from the floor's penumbra, smoothed over its
+    /// elements, and read 30–145 % bright within 3 mm of the floor.
+    fn reflected(
+        &self,
+        solution: &Solution,
+        e: usize,
+        y: DVec3,
+        distance: f64,
+        shading: Shading,
+        rng: &mut Rng,
+    ) -> Rgb {
+        let material = self.mesh.element_material(e);
+        let short = distance < SHORT_RAY * self.mesh.elements[e].area.sqrt();
+        if !short || self.emitters.is_empty() || !self.has_direct_part(solution) {
+            let b = match shading {
+                Shading::Flat => solution.element_radiosity[e],
+                Shading::Smooth => self.interpolate(solution, e, y),
+            };
+            return (b - material.emission).map(|c| c.max(0.0));
+        }
+        let (n, origin) = self.shading_frame(e, y);
+        // Both strategies, as at a pixel: points on a large emitter alone blow up beside it
+        // (a corner of a furnace).
+        let lights = LANDING_SHADOW_RAYS;
+        let mis = DirectMis { lights, cosines: lights };
+        let rotation = rng.next_f64();
+        let mut direct = gather::emitter_samples(
+            &self.emitters,
+            &self.blockers,
+            y,
+            n,
+            origin,
+            0,
+            lights,
+            rotation,
+            mis,
+            rng,
+        );
+        for _ in 0..lights {
+            let dir = gather::cosine_direction(n, rng.next_f64(), rng.next_f64());
+            if let Some((hit, distance, cos_y)) = self.land(origin, dir) {
+                let emission = self.mesh.element_material(hit).emission;
+                if cos_y > 0.0 && emission.max_channel() > 0.0 {
+                    let pdf_area = self.emitters.pdf_area_of(emission);
+                    direct += mis.term(emission, n.dot(dir), cos_y, distance * distance, pdf_area);
+                }
+            }
+        }
+        material.reflectance * direct + self.indirect_part(solution, e, y, shading)
+    }
+
+    /// What the solution holds at point `y` of element `e` besides emission and direct light,
+    /// B − E − B_direct, clamped because the direct part and the total are interpolated apart.
+    fn indirect_part(&self, solution: &Solution, e: usize, y: DVec3, shading: Shading) -> Rgb {
+        let (total, direct) = match shading {
+            Shading::Flat => (solution.element_radiosity[e], solution.element_direct[e]),
+            Shading::Smooth => {
+                (self.interpolate(solution, e, y), self.interpolate_values(&solution.vertex_direct, e, y))
+            }
         };
-        (b - self.mesh.element_material(e).emission).map(|c| c.max(0.0))
+        (total - self.mesh.element_material(e).emission - direct).map(|c| c.max(0.0))
     }
 
     /// Gathers one irradiance-cache record at `site`: `count` cosine-weighted rays on a
@@ -854,7 +929,8 @@ impl Renderer {
             };
             distances[j as usize] = distance.max(self.lift);
             if cos_y > 0.0 {
-                values[j as usize] = self.reflected(solution, e, origin + dir * distance, shading);
+                values[j as usize] =
+                    self.reflected(solution, e, origin + dir * distance, distance, shading, rng);
             }
         }
         let inverse_distances: f64 = distances.iter().map(|d| 1.0 / d).sum();
@@ -989,6 +1065,87 @@ mod tests {
             / f64::from(count);
         let (got, expected) = (alone.luminance(), record.irradiance.luminance());
         assert!((got / expected - 1.0).abs() < 0.03, "alone {got} against the record's {expected}");
+    }
+
+    /// A gathering ray that lands a hair's width away, on a floor element half in a blocker's
+    /// shadow, takes the light of the point it lands on and not the element's mean: under
+    /// the blocker (where nothing lights the floor, the rest of the scene being black) about
+    /// none; in the open, the lamp's direct light (the closed form of a point under a
+    /// square). A long ray still takes the element's mean.
+    #[test]
+    fn short_gathering_rays_see_the_light_where_they_land() {
+        let light = Material::try_new("light", Rgb::ZERO, Rgb::splat(1.0)).unwrap();
+        let grey = Material::try_new("grey", Rgb::splat(0.5), Rgb::ZERO).unwrap();
+        let black = Material::try_new("black", Rgb::ZERO, Rgb::ZERO).unwrap();
+        let square = |x0: f64, x1: f64, y0: f64, y1: f64, z: f64, up: bool| {
+            let mut v = vec![
+                DVec3::new(x0, y0, z),
+                DVec3::new(x1, y0, z),
+                DVec3::new(x1, y1, z),
+                DVec3::new(x0, y1, z),
+            ];
+            if !up {
+                v.reverse();
+            }
+            Polygon::try_new(v).unwrap()
+        };
+        let object = |name: &str, material: usize, polygon: Polygon, sides: Sides| Object {
+            name: name.into(),
+            material,
+            shape: Shape::Polygons(vec![polygon]),
+            sides,
+        };
+        let objects = vec![
+            object("lamp", 0, square(-0.25, 0.25, -0.25, 0.25, 1.0, false), Sides::One),
+            object("floor", 1, square(-2.0, 2.0, -2.0, 2.0, 0.0, true), Sides::One),
+            // Over x < 0.1 at half height: the floor's x < 0 is in full shadow.
+            object("sheet", 2, square(-3.0, 0.1, -3.0, 3.0, 0.5, true), Sides::Two { emits_back: false }),
+        ];
+        let scene = Scene::try_new("half shadow", None, vec![light, grey, black], objects).unwrap();
+        // One element for the whole floor, no cut along the shadow: the mesh's worst case.
+        let mut params = MeshParams::try_new(8.0, 8.0).unwrap();
+        params.shadow_outlines = false;
+        params.contacts = false;
+        params.corner_refinement = 0;
+        params.adaptive_levels = 0;
+        let problem = radiosity_solver::Problem::new(&scene, &params).unwrap();
+        let mut solver = problem.solver(radiosity_solver::SolverParams::default()).unwrap();
+        solver.solve();
+        let solution = solver.solution();
+        let renderer = Renderer::new(problem.mesh().clone());
+        let mesh = renderer.mesh().clone();
+        let floor = mesh.object_names.iter().position(|n| n == "floor").unwrap();
+        let elements: Vec<usize> =
+            (0..mesh.elements.len()).filter(|&e| mesh.element_object(e) == floor).collect();
+        assert_eq!(elements.len(), 1, "the floor is one element");
+        let e = elements[0];
+        let mean = solution.element_radiosity[e].to_array()[0];
+        let mut rng = Rng::for_task(1, 0, 0);
+        let mut at = |x: f64, distance: f64| {
+            let y = DVec3::new(x, 0.0, 0.0);
+            (0..256)
+                .map(|_| renderer.reflected(&solution, e, y, distance, Shading::Flat, &mut rng).to_array()[0])
+                .sum::<f64>()
+                / 256.0
+        };
+        let (shadow, open, far) = (at(-1.0, 1e-3), at(0.6, 1e-3), at(-1.0, 100.0));
+        // ρ E F from a point 1 below a square lamp of side 0.5, 0.6 off its axis; F summed
+        // over the four rectangles the point's foot cuts the lamp into (Howell B-3, a
+        // differential area to a parallel rectangle from a corner).
+        let corner = |a: f64, b: f64| {
+            let (x, y) = (a.abs(), b.abs());
+            let f = (x / (1.0 + x * x).sqrt() * (y / (1.0 + x * x).sqrt()).atan()
+                + y / (1.0 + y * y).sqrt() * (x / (1.0 + y * y).sqrt()).atan())
+                / (2.0 * PI);
+            f * a.signum() * b.signum()
+        };
+        let f = corner(0.25 - 0.6, 0.25) - corner(-0.25 - 0.6, 0.25) - corner(0.25 - 0.6, -0.25)
+            + corner(-0.25 - 0.6, -0.25);
+        let expected = 0.5 * f;
+        assert!(mean > 0.05 * expected, "the element's mean {mean} against {expected} in the open");
+        assert!(shadow < 0.02 * mean, "under the sheet: {shadow}, the element's mean {mean}");
+        assert!((open / expected - 1.0).abs() < 0.05, "in the open: {open}, closed form {expected}");
+        assert_eq!(far, mean, "a long ray takes the element's mean");
     }
 
     /// A tessellated ball under a small lamp: from points whose interpolated normal sees the
