@@ -116,7 +116,7 @@ pub struct RenderArgs {
     /// lamp makes them whatever the mesh; the default: on the Cornell box 1.9 % RMS error per
     /// pixel against the path-traced reference, rendered in about 2.8 s), `none` (the radiosity
     /// mesh as the viewer shows it: 2.8 %), `full` (the indirect light too gathered by rays,
-    /// at an irradiance cache's records, instead of taken from the mesh: 1.7 %, about 12 s).
+    /// at an irradiance cache's records, instead of taken from the mesh: 1.6 %, about 14 s).
     #[arg(long, value_enum, default_value_t = GatherArg::Direct)]
     pub gather: GatherArg,
     /// Shadow rays per sample towards the emitters, with a gather.
