@@ -808,17 +808,24 @@ impl Renderer {
             if cos_y <= 0.0 {
                 continue; // the back of a one-sided surface: nothing leaves it
             }
-            let emission = self.mesh.element_material(e).emission;
-            if emission.max_channel() > 0.0 {
-                let pdf_area = self.emitters.pdf_area_of(emission);
-                direct += mis.term(emission, n.dot(dir), cos_y, distance * distance, pdf_area);
-            }
+            direct += self.emitted(e, n.dot(dir), cos_y, distance, mis);
             if reflect {
                 reflected +=
                     self.reflected(solution, e, origin + dir * distance, distance, params.shading, rng);
             }
         }
         (direct, reflected / f64::from(count))
+    }
+
+    /// A cosine-weighted direction's share of the direct irradiance (MIS weighted, see
+    /// [`DirectMis::term`]) when it lands on element `e` at `distance`, cosines `cos_x` at
+    /// its origin and `cos_y` at `e`: nothing unless `e` emits.
+    fn emitted(&self, e: usize, cos_x: f64, cos_y: f64, distance: f64, mis: DirectMis) -> Rgb {
+        let emission = self.mesh.element_material(e).emission;
+        if emission.max_channel() <= 0.0 {
+            return Rgb::ZERO;
+        }
+        mis.term(emission, cos_x, cos_y, distance * distance, self.emitters.pdf_area_of(emission))
     }
 
     /// Where a secondary ray from `origin` along unit `dir` lands: the element that faces it,
@@ -882,11 +889,7 @@ impl Renderer {
         for _ in 0..lights {
             let dir = gather::cosine_direction(n, rng.next_f64(), rng.next_f64());
             if let Some((hit, distance, cos_y)) = self.land(origin, dir) {
-                let emission = self.mesh.element_material(hit).emission;
-                if cos_y > 0.0 && emission.max_channel() > 0.0 {
-                    let pdf_area = self.emitters.pdf_area_of(emission);
-                    direct += mis.term(emission, n.dot(dir), cos_y, distance * distance, pdf_area);
-                }
+                direct += self.emitted(hit, n.dot(dir), cos_y, distance, mis);
             }
         }
         material.reflectance * direct + self.indirect_part(solution, e, y, shading)

@@ -330,6 +330,14 @@ fn a_tessellated_sphere_shades_without_facets() {
     assert!(exact < 0.5 * faceted, "a sphere under the direct gather: {exact}, faceted mesh {faceted}");
 }
 
+/// The Cornell box solved, its renderer, its camera and the lamp's object index.
+fn solved_cornell() -> (Renderer, radiosity_solver::Solution, radiosity_core::Camera, u32) {
+    let scene = radiosity_core::cornell_box();
+    let (mesh, solution) = crate::common::solve(&scene, radiosity_solver::SolverParams::default());
+    let lamp = mesh.object_names.iter().position(|n| n == "light").expect("the lamp") as u32;
+    (Renderer::new(mesh), solution, scene.camera_or_framing(), lamp)
+}
+
 /// Pixels on an outline take `edge_factor` times the samples, decided by rays apart from the
 /// pixel's own samples, so the picture stays unbiased and its outlines get quieter. The
 /// Cornell box without a gather (the mesh alone, no other noise) at 96 × 72, 4 samples a
@@ -342,11 +350,7 @@ fn a_tessellated_sphere_shades_without_facets() {
 /// 0.8 % from seed to seed (six seeds), which no bias this test looks for would show through.
 #[test]
 fn outline_pixels_take_more_samples_without_bias() {
-    let scene = radiosity_core::cornell_box();
-    let (mesh, solution) = crate::common::solve(&scene, radiosity_solver::SolverParams::default());
-    let camera = scene.camera_or_framing();
-    let lamp = mesh.object_names.iter().position(|n| n == "light").expect("the lamp") as u32;
-    let renderer = Renderer::new(mesh);
+    let (renderer, solution, camera, lamp) = solved_cornell();
     let (w, h) = (96, 72);
     let render = |edge_factor, seed| {
         let params = RenderParams {
@@ -397,11 +401,7 @@ fn outline_pixels_take_more_samples_without_bias() {
 /// noise, and stratified it falls faster than 1/√samples. Noise from four pairs of seeds.
 #[test]
 fn lamp_outline_pixels_take_the_edge_factor_squared() {
-    let scene = radiosity_core::cornell_box();
-    let (mesh, solution) = crate::common::solve(&scene, radiosity_solver::SolverParams::default());
-    let camera = scene.camera_or_framing();
-    let lamp = mesh.object_names.iter().position(|n| n == "light").expect("the lamp") as u32;
-    let renderer = Renderer::new(mesh);
+    let (renderer, solution, camera, lamp) = solved_cornell();
     let (w, h) = (160usize, 120usize);
     let render = |edge_factor, seed| {
         let params = RenderParams {

@@ -869,6 +869,20 @@ mod tests {
         assert_eq!(clusters.brightest(&abs), Shooter::Patch(single));
     }
 
+    /// The 24 × 48 globe grouped, unit unshot radiosity everywhere, and the groups `pick`
+    /// chooses from the number of groups frozen (returned with the mesh and the clusters).
+    fn frozen_globe(pick: impl Fn(usize) -> Vec<usize>) -> (Mesh, Clusters, Vec<usize>) {
+        let mesh = globe(24, 48);
+        let mut clusters = Clusters::new(&mesh, true);
+        let unshot = vec![Rgb::splat(1.0); mesh.elements.len()];
+        let tables = MeshTables::new(&mesh);
+        let groups = pick(clusters.len());
+        for &g in &groups {
+            clusters.freeze(g, &mesh, &unshot, &tables, &SolverParams::default(), 1.0);
+        }
+        (mesh, clusters, groups)
+    }
+
     /// A group's far field sends out all its power: over the sphere of directions,
     /// ∫ Σ_b (a_b·d)⁺ dω / π = 1, the sum of its members' shares (each member's clamped lobe
     /// sends out π times its share). Directions on a 400 × 800 grid in (θ, φ), which integrates
@@ -876,14 +890,9 @@ mod tests {
     /// ball's groups sent out 0.15–0.17 % less.
     #[test]
     fn the_far_field_sends_out_the_groups_power() {
-        let mesh = globe(24, 48);
-        let mut clusters = Clusters::new(&mesh, true);
-        let unshot = vec![Rgb::splat(1.0); mesh.elements.len()];
-        let tables = MeshTables::new(&mesh);
-        let params = SolverParams::default();
+        let (_, clusters, groups) = frozen_globe(|n| vec![0, n / 3, n / 2]);
         let (rows, columns) = (400, 800);
-        for g in [0, clusters.len() / 3, clusters.len() / 2] {
-            clusters.freeze(g, &mesh, &unshot, &tables, &params, 1.0);
+        for g in groups {
             let frozen = clusters.groups[g].frozen.as_ref().unwrap();
             let mut sent = 0.0;
             for i in 0..rows {
@@ -906,13 +915,8 @@ mod tests {
     /// across the group, ±10 %, mostly cancels).
     #[test]
     fn the_far_field_is_the_members_sum() {
-        let mesh = globe(24, 48);
-        let mut clusters = Clusters::new(&mesh, true);
-        let unshot = vec![Rgb::splat(1.0); mesh.elements.len()];
-        let tables = MeshTables::new(&mesh);
-        let params = SolverParams::default();
-        for g in [0, clusters.len() / 2] {
-            clusters.freeze(g, &mesh, &unshot, &tables, &params, 1.0);
+        let (mesh, clusters, groups) = frozen_globe(|n| vec![0, n / 2]);
+        for g in groups {
             let (group, frozen) = (clusters.group(g), clusters.groups[g].frozen.as_ref().unwrap());
             let axis = frozen.axes.iter().sum::<DVec3>().normalize();
             for tilt in [DVec3::ZERO, DVec3::X * 0.5, DVec3::Z * 0.5] {
