@@ -106,23 +106,24 @@ pub struct RenderArgs {
     /// Picture height in pixels.
     #[arg(long, default_value_t = RenderParams::default().height)]
     pub height: u32,
-    /// Jittered samples per pixel (seeded by --seed).
-    #[arg(long, default_value_t = RenderParams::default().samples_per_pixel)]
-    pub spp: u32,
+    /// Jittered samples per pixel (seeded by --seed) [default: 16; 64 with `--gather full`].
+    #[arg(long)]
+    pub spp: Option<u32>,
     /// Radiosity at a hit point: interpolated from vertices, or per element.
     #[arg(long, value_enum, default_value_t = ShadingArg::Smooth)]
     pub shading: ShadingArg,
     /// Final gather: `direct` (direct light by shadow rays per pixel: shadows as sharp as the
-    /// lamp makes them whatever the mesh; the default: on the Cornell box 1.9 % RMS error per
-    /// pixel against the path-traced reference, rendered in about 2.8 s), `none` (the radiosity
-    /// mesh as the viewer shows it: 2.8 %), `full` (the indirect light too gathered by rays,
-    /// at an irradiance cache's records, instead of taken from the mesh: 1.6 %, about 14 s).
+    /// lamp makes them whatever the mesh; the default: on the Cornell box 1.8 % RMS error per
+    /// pixel against the path-traced reference, rendered in about 2.9 s), `none` (the radiosity
+    /// mesh as the viewer shows it: 2.6 %), `full` (the indirect light too gathered by rays,
+    /// at an irradiance cache's records, instead of taken from the mesh, and 64 samples per
+    /// pixel: 0.9 %, about 35 s).
     #[arg(long, value_enum, default_value_t = GatherArg::Direct)]
     pub gather: GatherArg,
     /// Shadow rays per sample towards the emitters, with a gather.
     #[arg(long, default_value_t = RenderParams::default().shadow_rays)]
     pub shadow_rays: u32,
-    /// Gathering rays with `--gather full`: a picture's irradiance-cache records take 64 times
+    /// Gathering rays with `--gather full`: a picture's irradiance-cache records take 128 times
     /// this many each (more where a record spans many pixels); a lightmap's texels this many
     /// per sample.
     #[arg(long, default_value_t = RenderParams::default().gather_rays)]
@@ -248,7 +249,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let params = RenderParams {
         width: a.width,
         height: a.height,
-        samples_per_pixel: a.spp,
+        samples_per_pixel: a.spp.unwrap_or_else(|| Gather::from(a.gather).default_samples()),
         shading: match a.shading {
             ShadingArg::Smooth => Shading::Smooth,
             ShadingArg::Flat => Shading::Flat,

@@ -595,3 +595,26 @@ fn a_tessellated_model_shoots_in_groups() {
     assert!((grouped / unshared - 1.0).abs() < 0.01, "shared {grouped} vs unshared {unshared}");
     assert!(grouped_shots < alone_shots, "{grouped_shots} vs {alone_shots} shots");
 }
+
+/// Without `--spp`, a `--gather full` picture takes 64 samples per pixel (its noise is the
+/// direct light's at 16) and the others 16; `--spp` still decides when given.
+#[test]
+fn full_gather_pictures_default_to_64_samples_per_pixel() {
+    let dir = tempfile::tempdir().unwrap();
+    let pfm = dir.path().join("s.pfm");
+    let summary = |extra: &[&str]| {
+        let base = ["render", "cornell", "--max-shots", "5", "--width", "16", "--height", "12", "--force"];
+        let o = radiosity(&[&base[..], extra, &["--pfm", pfm.to_str().unwrap()]].concat());
+        assert!(o.status.success(), "{extra:?}: {}", stderr(&o));
+        format!("{}{}", String::from_utf8_lossy(&o.stdout), stderr(&o))
+    };
+    for (args, said) in [
+        (&["--gather", "full"][..], "at 64 spp (gather full)"),
+        (&["--gather", "direct"], "at 16 spp (gather direct)"),
+        (&["--gather", "none"], "at 16 spp (gather none)"),
+        (&["--gather", "full", "--spp", "2"], "at 2 spp (gather full)"),
+    ] {
+        let out = summary(args);
+        assert!(out.contains(said), "{args:?}: wanted {said:?} in {out}");
+    }
+}

@@ -38,8 +38,12 @@ const TEXEL_TASK: u64 = 0x7465_7865_6c73; // "texels"
 /// Task key of irradiance-cache records' streams (keyed by the record's pixel).
 const RECORD_TASK: u64 = 0x7265_636f_7264; // "record"
 
-/// An irradiance-cache record gathers this many times [`RenderParams::gather_rays`].
-pub const RECORD_RAYS_PER_GATHER_RAY: u32 = 64;
+/// An irradiance-cache record gathers this many times [`RenderParams::gather_rays`] (1 024
+/// rays at the default). A record speaks for the pixels around it, so its noise shows as a
+/// blotch that more samples per pixel do not average out: on the Cornell box at 64 samples
+/// per pixel, records of 512 rays left 0.64 % of noise per pixel, as much as the direct
+/// light's, and 1 024 rays 0.45 %.
+pub const RECORD_RAYS_PER_GATHER_RAY: u32 = 128;
 
 /// A gathering ray shorter than this many sides of the element it lands on takes the direct
 /// light there by its own rays ([`Renderer::reflected`]). On the Cornell box (`--gather
