@@ -105,6 +105,11 @@ impl Grid {
         grid
     }
 
+    /// The length of the grid's diagonal: no two candidates lie farther apart.
+    fn diagonal(&self) -> f64 {
+        (self.cell * DVec3::new(self.dims[0] as f64, self.dims[1] as f64, self.dims[2] as f64)).length()
+    }
+
     /// The cell holding `p`, clamped into the grid.
     fn cell_of(&self, p: DVec3) -> [usize; 3] {
         let t = ((p - self.lo) / self.cell).floor();
@@ -305,8 +310,12 @@ impl<'a> Contacts<'a> {
         let height = |q: DVec3| n.dot(q) - d;
         let mut edges: Vec<Edge> = Vec::new();
         // A solid that stands partly over the edge is seen whole: faces up to the target's
-        // size beyond it count.
-        for &(other, p, _, _) in self.near(lo, hi, lo.distance(hi)) {
+        // size beyond it count. Only faces with an edge on the plane matter, so the box is
+        // widened along the plane only: a floor's query then lists what stands near the
+        // floor, not the whole room above it.
+        let reach = lo.distance(hi);
+        let (lo, hi) = slab_box(lo, hi, n, reach, eps);
+        for &(other, p, _, _) in self.near(lo, hi, 0.0) {
             if Some(other) == id {
                 continue;
             }
@@ -343,9 +352,12 @@ impl<'a> Contacts<'a> {
     /// whose face that is.
     fn enclosed(&self, p: DVec3, n: DVec3, eps: f64) -> bool {
         let origin = p + n * eps;
-        let far = DVec3::splat(f64::INFINITY);
+        // Only faces whose boxes meet the ray straight above can be met: the box from the
+        // point to the far side of every candidate (one column of cells when the plane is
+        // square to an axis, as floors and table tops are).
+        let end = origin + n * self.grid.diagonal();
         let mut first: Option<(f64, bool)> = None;
-        for &(_, poly, _, _) in self.near(-far, far, 0.0) {
+        for &(_, poly, _, _) in self.near(origin.min(end), origin.max(end), eps) {
             let pn = poly.normal();
             let denominator = pn.dot(n);
             if denominator.abs() < 1e-12 {
@@ -365,6 +377,19 @@ impl<'a> Contacts<'a> {
         }
         first.is_some_and(|(_, from_behind)| from_behind)
     }
+}
+
+/// The bounding box of the points within `eps` of the plane through the box `[lo, hi]` (of
+/// a polygon in that plane, unit normal `n`) that lie within `reach` of the box along the
+/// plane. Along axis k a step t in the plane moves by at most |t| √(1 − n_k²), so an axis the
+/// plane is square to is widened by `eps` alone.
+fn slab_box(lo: DVec3, hi: DVec3, n: DVec3, reach: f64, eps: f64) -> (DVec3, DVec3) {
+    // Steps in the plane within the widened box are at most its diagonal long.
+    let span = lo.distance(hi) + 2.0 * 3f64.sqrt() * reach;
+    let widen = DVec3::from_array(
+        n.to_array().map(|c| (eps + span * (1.0 - c * c).max(0.0).sqrt()).min(reach + eps)),
+    );
+    (lo - widen, hi + widen)
 }
 
 /// An edge of a face standing on a surface: its two corners on the surface's plane, the
