@@ -20,7 +20,6 @@
 // Fx hashing: the mesher's maps hold millions of small integer keys (a vertex's bits, an
 // edge's two indices), where SipHash was a third of the meshing time of a 834 k-triangle
 // model; nothing here is keyed by untrusted input an attacker could collide.
-use rayon::prelude::*;
 use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
 use std::ops::Range;
 
@@ -416,7 +415,7 @@ impl Smoothing {
             .filter(|&v| vertex_surface[v] != u32::MAX)
             .map(|v| (mesh.positions[v].to_array().map(|c| (c / grid).round() as i64), v as u32))
             .collect();
-        places.par_sort_unstable();
+        places.sort_unstable();
         let mut pairs: Vec<(u32, u32, f32)> = Vec::new();
         for group in places.chunk_by(|x, y| x.0 == y.0).filter(|g| g.len() > 1) {
             for &(_, a) in group {
@@ -463,17 +462,17 @@ fn t_junctions(
     mesh: &Mesh,
     vertex_surface: &[u32],
     tolerance: f64,
-    compatible: &(dyn Fn(u32, u32) -> bool + Sync),
+    compatible: &dyn Fn(u32, u32) -> bool,
     pairs: &mut Vec<(u32, u32, f32)>,
 ) {
     // Every element edge, sorted: an edge used once within its surface stands alone.
-    let mut edges: Vec<(u32, u32)> = (mesh.elements.par_iter())
-        .flat_map_iter(|el| {
+    let mut edges: Vec<(u32, u32)> = (mesh.elements.iter())
+        .flat_map(|el| {
             let v = el.vertex_indices();
             (0..v.len()).map(move |k| (v[k].min(v[(k + 1) % v.len()]), v[k].max(v[(k + 1) % v.len()])))
         })
         .collect();
-    edges.par_sort_unstable();
+    edges.sort_unstable();
     let outline: Vec<(u32, u32)> =
         edges.chunk_by(|x, y| x == y).filter(|run| run.len() == 1).map(|run| run[0]).collect();
     drop(edges);
@@ -481,16 +480,16 @@ fn t_junctions(
     // two faces of a two-sided object each other's; every place and every segment is tested
     // once, its copies only on a hit (on a million facets, testing each copy was 143 M tests
     // and most of the meshing time). Copies are found by sorting (ends as bits, lower end
-    // first), which unlike a map of millions of entries runs on every core.
+    // first): a sort of millions of entries beats a map of them.
     let bits = |p: DVec3| p.to_array().map(f64::to_bits);
     let mut copies: Vec<([u64; 3], [u64; 3], u32, u32)> = outline
-        .par_iter()
+        .iter()
         .map(|&(a, b)| {
             let (pa, pb) = (mesh.positions[a as usize], mesh.positions[b as usize]);
             if bits(pa) <= bits(pb) { (bits(pa), bits(pb), a, b) } else { (bits(pb), bits(pa), b, a) }
         })
         .collect();
-    copies.par_sort_unstable();
+    copies.sort_unstable();
     let mut segments: Vec<(DVec3, DVec3)> = Vec::new(); // start, direction
     let mut edge_start = vec![0usize];
     for run in copies.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
@@ -512,79 +511,67 @@ fn t_junctions(
     let cell = |p: DVec3| (p / size).floor().as_i64vec3().to_array();
     // (cell, segment) for every cell a segment passes near, sorted by cell: a cell's segments
     // are one run, found by binary search.
-    let mut cells: Vec<([i64; 3], u32)> = segments
-        .par_iter()
-        .enumerate()
-        .flat_map_iter(|(i, &(pa, d))| {
-            let pb = pa + d;
-            let (lo, hi) =
-                (cell(pa.min(pb) - DVec3::splat(tolerance)), cell(pa.max(pb) + DVec3::splat(tolerance)));
-            let mut touched = Vec::new();
-            let box_cells = (0..3).map(|k| (hi[k] - lo[k] + 1) as u64).product::<u64>();
-            if box_cells <= 27 {
-                for x in lo[0]..=hi[0] {
-                    for y in lo[1]..=hi[1] {
-                        for z in lo[2]..=hi[2] {
-                            touched.push([x, y, z]);
-                        }
+    let mut cells: Vec<([i64; 3], u32)> = Vec::new();
+    let mut touched = Vec::new();
+    for (i, &(pa, d)) in segments.iter().enumerate() {
+        let pb = pa + d;
+        let (lo, hi) =
+            (cell(pa.min(pb) - DVec3::splat(tolerance)), cell(pa.max(pb) + DVec3::splat(tolerance)));
+        touched.clear();
+        let box_cells = (0..3).map(|k| (hi[k] - lo[k] + 1) as u64).product::<u64>();
+        if box_cells <= 27 {
+            for x in lo[0]..=hi[0] {
+                for y in lo[1]..=hi[1] {
+                    for z in lo[2]..=hi[2] {
+                        touched.push([x, y, z]);
                     }
                 }
-            } else {
-                // A long slanted edge: the cells around points one cell apart along it. A
-                // point within `tolerance` (far below a cell) of the edge is within a cell of
-                // one of them, so in a neighbouring cell.
-                let steps = (d.length() / size).ceil() as usize;
-                for s in 0..=steps {
-                    let c = cell(pa.lerp(pb, s as f64 / steps as f64));
-                    for k in 0..27 {
-                        touched.push([c[0] + k % 3 - 1, c[1] + k / 3 % 3 - 1, c[2] + k / 9 - 1]);
-                    }
-                }
-                touched.sort_unstable();
-                touched.dedup();
             }
-            touched.into_iter().map(move |c| (c, i as u32))
-        })
-        .collect();
-    cells.par_sort_unstable();
+        } else {
+            // A long slanted edge: the cells around points one cell apart along it. A point
+            // within `tolerance` (far below a cell) of the edge is within a cell of one of
+            // them, so in a neighbouring cell.
+            let steps = (d.length() / size).ceil() as usize;
+            for s in 0..=steps {
+                let c = cell(pa.lerp(pb, s as f64 / steps as f64));
+                for k in 0..27 {
+                    touched.push([c[0] + k % 3 - 1, c[1] + k / 3 % 3 - 1, c[2] + k / 9 - 1]);
+                }
+            }
+            touched.sort_unstable();
+            touched.dedup();
+        }
+        cells.extend(touched.iter().map(|&c| (c, i as u32)));
+    }
+    cells.sort_unstable();
     let in_cell = |c: [i64; 3]| {
         let first = cells.partition_point(|&(k, _)| k < c);
         cells[first..].iter().take_while(move |&&(k, _)| k == c).map(|&(_, i)| i)
     };
     // The outline's vertices, copies of one place next to each other.
-    let mut on_outline: Vec<([u64; 3], u32)> = outline
-        .par_iter()
-        .flat_map_iter(|&(a, b)| [a, b])
-        .map(|v| (bits(mesh.positions[v as usize]), v))
-        .collect();
-    on_outline.par_sort_unstable();
+    let mut on_outline: Vec<([u64; 3], u32)> =
+        outline.iter().flat_map(|&(a, b)| [a, b]).map(|v| (bits(mesh.positions[v as usize]), v)).collect();
+    on_outline.sort_unstable();
     on_outline.dedup();
-    let places: Vec<&[([u64; 3], u32)]> = on_outline.chunk_by(|x, y| x.0 == y.0).collect();
-    let found: Vec<(u32, u32, f32)> = places
-        .par_iter()
-        .flat_map_iter(|place| {
-            let p = mesh.positions[place[0].1 as usize];
-            let mut out = Vec::new();
-            for i in in_cell(cell(p)) {
-                let (pa, d) = segments[i as usize];
-                let t = (p - pa).dot(d) / d.length_squared();
-                let end = tolerance / d.length();
-                if !(t > end && t < 1.0 - end && (pa + d * t).distance(p) < tolerance) {
-                    continue;
-                }
-                for &(_, v) in *place {
-                    for &(a, b) in &edge_copies[edge_start[i as usize]..edge_start[i as usize + 1]] {
-                        if vertex_surface[a as usize] != vertex_surface[v as usize] && compatible(v, a) {
-                            out.push((v, a, (1.0 - t) as f32));
-                            out.push((v, b, t as f32));
-                        }
+    for place in on_outline.chunk_by(|x, y| x.0 == y.0) {
+        let p = mesh.positions[place[0].1 as usize];
+        for i in in_cell(cell(p)) {
+            let (pa, d) = segments[i as usize];
+            let t = (p - pa).dot(d) / d.length_squared();
+            let end = tolerance / d.length();
+            if !(t > end && t < 1.0 - end && (pa + d * t).distance(p) < tolerance) {
+                continue;
+            }
+            for &(_, v) in place {
+                for &(a, b) in &edge_copies[edge_start[i as usize]..edge_start[i as usize + 1]] {
+                    if vertex_surface[a as usize] != vertex_surface[v as usize] && compatible(v, a) {
+                        pairs.push((v, a, (1.0 - t) as f32));
+                        pairs.push((v, b, t as f32));
                     }
                 }
             }
-            out
-        })
-        .collect();
-    pairs.extend(found);
+        }
+    }
 }
 
 /// Geometry of one surface before it joins the mesh: local vertices, elements labelled by a

@@ -682,10 +682,10 @@ mod tests {
     fn probe_sets_together_find_slivers_one_set_misses() {
         let emitters = Emitters::new(&lamp_mesh());
         let (mut one, mut four, mut cases) = (0, 0, 0);
-        for tenths in 2..=12 {
+        for eightieths in 2..=12 {
             // The strip's width on the lamp; a sheet at half height hides the rest, so its
             // edge stands at half the lamp's coordinate.
-            let width = f64::from(tenths) / 80.0;
+            let width = f64::from(eightieths) / 80.0;
             for (axis, sign) in [(0, 1.0), (0, -1.0), (1, 1.0), (1, -1.0)] {
                 let edge = (0.5 - width) * sign * 0.5;
                 let at = |a: f64, b: f64| {
