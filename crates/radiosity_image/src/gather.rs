@@ -635,13 +635,10 @@ mod tests {
         assert!(g.y.abs() < 0.03 * expected && g.z.abs() < 1e-9, "gradient {g}");
     }
 
-    /// Cosine-weighted directions lie in the upper hemisphere and have mean cos θ = 2/3
-    /// (∫ cos θ · cos θ/π dω = 2/3).
     /// A pixel's emitter points take every stratum of both coordinates once (a Latin
     /// hypercube; the second's strata turned by the pixel's rotation), and spread in two
-    /// dimensions: no two closer than a fifth of the spacing
-    /// of a square grid of as many points (the torus' distance; a random second coordinate
-    /// would put them anywhere).
+    /// dimensions: no two closer than a fifth of the spacing of a square grid of as many
+    /// points (the torus' distance; a random second coordinate would put them anywhere).
     #[test]
     fn emitter_points_take_every_stratum_of_both_coordinates() {
         let mut rng = Rng::for_task(3, 0, 0);
@@ -707,6 +704,8 @@ mod tests {
         assert!(four > one, "one set found {one} of {cases} strips, four sets {four}");
     }
 
+    /// Cosine-weighted directions lie in the upper hemisphere and have mean cos θ = 2/3
+    /// (∫ cos θ · cos θ/π dω = 2/3).
     #[test]
     fn cosine_directions_have_the_right_mean() {
         let n = DVec3::new(0.3, -0.4, 0.5).normalize();
