@@ -108,8 +108,9 @@ fn kept_rows_change_nothing_whatever_the_budget() {
 }
 
 /// One thread or two give bit-identical solutions on a mesh large enough for every parallel
-/// part of a shot (the receiving patches' first pass, penumbra rays, and applying the shot
-/// span by span, which only runs in parallel above 32 k elements).
+/// part of a shot (the receiving patches' first pass, penumbra rays, and, above 32 k
+/// elements only, gathering the row, the uneven shooters' power sums and applying the shot,
+/// block by block of patches).
 #[test]
 fn one_and_two_threads_agree_on_a_large_cornell_box() {
     let scene = radiosity_io::builtin_scene("cornell").unwrap();

@@ -480,13 +480,15 @@ impl Clusters {
                 }
             });
         }
-        let mut row = Row::new();
-        for range in &tables.patch_elements {
+        let factors: &[f32] = factors;
+        let (row, _) = Row::by_blocks(tables, |q, row| {
+            let range = tables.patch_elements[q].clone();
             let span = &factors[range.clone()];
             if span.iter().any(|&f| f > 0.0) {
-                row.push(range.clone(), span.iter().copied());
+                row.push(range, span.iter().copied());
             }
-        }
+            0
+        });
         (row, traced)
     }
 }

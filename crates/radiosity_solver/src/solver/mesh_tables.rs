@@ -30,6 +30,9 @@ pub(super) struct MeshTables {
     /// Per patch, its elements' range, packed (the loops over every patch of a row touch
     /// these and not the patches' corners: a model's rows span 200 k patches).
     pub(super) patch_elements: Vec<std::ops::Range<usize>>,
+    /// Consecutive patches in fixed blocks, for the passes over every patch of a row (see
+    /// [`super::parallel::patch_blocks`]).
+    pub(super) patch_blocks: Vec<std::ops::Range<usize>>,
     /// Per patch, its reflectance (a patch's elements share its surface's material).
     pub(super) patch_reflectance: Vec<Rgb>,
     /// Per patch, the largest circumradius of its elements (about their centres).
@@ -82,6 +85,8 @@ impl MeshTables {
             .collect();
         let (neighbour_start, neighbours) = element_neighbours(mesh);
         let ray_offset = 1e-6 * (hi - lo).length();
+        let patch_elements: Vec<std::ops::Range<usize>> =
+            mesh.patches.iter().map(|p| p.elements.start as usize..p.elements.end as usize).collect();
         Self {
             vertex_area,
             rim_fits: RimFits::new(mesh),
@@ -92,11 +97,8 @@ impl MeshTables {
             element_patch: mesh.elements.iter().map(|el| el.patch).collect(),
             element_radii,
             lifted_corners: lift_corners(mesh, ray_offset),
-            patch_elements: mesh
-                .patches
-                .iter()
-                .map(|p| p.elements.start as usize..p.elements.end as usize)
-                .collect(),
+            patch_blocks: super::parallel::patch_blocks(&patch_elements),
+            patch_elements,
             patch_reflectance: mesh
                 .patches
                 .iter()

@@ -3,12 +3,14 @@
 //! spread, lay out its ray ends, then two passes over the receivers (form factors and pilot
 //! rays; penumbra rays where the neighbours saw a penumbra) and gather the factors.
 
+use std::ops::Range;
 use std::sync::Arc;
 
 use rayon::prelude::*;
 
 use super::Solver;
-use super::parallel::{PARALLEL_MIN, for_each_maybe_parallel};
+use super::mesh_tables::MeshTables;
+use super::parallel::{for_each_block_mut, for_each_maybe_parallel, map_blocks};
 use super::penumbra::wants_penumbra_rays;
 use super::plans::{PatchPlan, plan_patches};
 use super::ray_ends::draw_ray_ends;
@@ -106,6 +108,31 @@ impl Row {
         self.factors.extend(factors);
     }
 
+    /// The row that `patch(q, row)` pushes patch after patch (returning a count, summed),
+    /// built in the mesh's blocks of patches (see [`super::parallel::patch_blocks`]) and
+    /// joined in order: a span never crosses a block, so the row is the same on one thread
+    /// or many.
+    pub(super) fn by_blocks(
+        tables: &MeshTables,
+        patch: impl Fn(usize, &mut Row) -> u64 + Sync,
+    ) -> (Row, u64) {
+        let parts = map_blocks(&tables.patch_blocks, tables.element_area.len(), |patches| {
+            let mut row = Row::new();
+            let count = patches.map(|q| patch(q, &mut row)).sum::<u64>();
+            (row, count)
+        });
+        let mut row = Row::new();
+        row.spans.reserve_exact(parts.iter().map(|p| p.0.spans.len()).sum());
+        row.factors.reserve_exact(parts.iter().map(|p| p.0.factors.len()).sum());
+        let mut count = 0;
+        for (part, n) in parts {
+            row.spans.extend(part.spans);
+            row.factors.extend(part.factors);
+            count += n;
+        }
+        (row, count)
+    }
+
     /// Heap and inline bytes the row holds.
     pub(super) fn bytes(&self) -> usize {
         std::mem::size_of::<Self>() + 8 * self.spans.len() + 4 * self.factors.len() + self.near.bytes()
@@ -185,15 +212,15 @@ impl Solver {
             penumbra: Strata::new(params.penumbra_rays),
         };
         let plans: &[PatchPlan] = self.rows.plans(shooter).unwrap_or(&scratch.plans);
-        first_pass(&shot, plans, &mut scratch.factors);
+        first_pass(&shot, plans, &tables.patch_blocks, &mut scratch.factors);
         let shared_rays = receive_shared(&shot, plans, &tables.element_area, &mut scratch.factors);
         if params.penumbra_rays > 0 && bright {
             penumbra_pass(&shot, plans, tables, &mut scratch.penumbra, &mut scratch.factors);
         }
         if shot.uneven.is_some() {
-            keep_uneven_power(&tables.element_area, &tables.patch_elements, plans, &mut scratch.factors);
+            keep_uneven_power(tables, plans, &mut scratch.factors);
         }
-        let (mut row, rays) = gather(&tables.patch_elements, plans, &scratch.factors, |q| shot.shares(q));
+        let (mut row, rays) = gather(tables, plans, &scratch.factors, |q| shot.shares(q));
         row.near = near_field(&shot, plans, tables, &row);
         self.progress.rays += rays + shared_rays;
         row
@@ -208,59 +235,54 @@ impl Solver {
 /// scaled to keep the row's total Σ_j A_j F_j what it is without the weighting (by reciprocity A_j F_j is
 /// the shooter's power share going to j). Without this the Cornell ceiling, lit only by
 /// such transfers, came out 1.2 % dark.
-fn keep_uneven_power(
-    element_area: &[f64],
-    patch_elements: &[std::ops::Range<usize>],
-    plans: &[PatchPlan],
-    factors: &mut [Received],
-) {
-    let elements = |q: usize| patch_elements[q].clone();
+fn keep_uneven_power(tables: &MeshTables, plans: &[PatchPlan], factors: &mut [Received]) {
+    let MeshTables { element_area, patch_elements, patch_blocks: blocks, .. } = tables;
     let weighted = |r: &Received| r.unoccluded != r.unweighted;
-    let (mut moved, mut rest) = (0.0, 0.0);
-    for (q, _) in plans.iter().enumerate().filter(|(_, p)| p.live) {
-        for e in elements(q) {
-            let (r, area) = (&factors[e], element_area[e]);
-            if weighted(r) {
-                moved += area * (r.unweighted_factor() - r.factor());
-            } else {
-                rest += area * r.factor();
+    // Sums per block, added in block order: the same on any thread count.
+    let sums = map_blocks(blocks, factors.len(), |patches| {
+        let (mut moved, mut rest) = (0.0, 0.0);
+        for q in patches.filter(|&q| plans[q].live) {
+            for e in patch_elements[q].clone() {
+                let (r, area) = (&factors[e], element_area[e]);
+                if weighted(r) {
+                    moved += area * (r.unweighted_factor() - r.factor());
+                } else {
+                    rest += area * r.factor();
+                }
             }
         }
-    }
+        (moved, rest)
+    });
+    let (moved, rest) = sums.iter().fold((0.0, 0.0), |(m, r), s| (m + s.0, r + s.1));
     if rest <= 0.0 || moved == 0.0 {
         return;
     }
     // Bounded: a shooter seen almost only by its weighted neighbours has little to pass on.
     let scale = ((rest + moved) / rest).clamp(0.5, 2.0);
-    for (q, _) in plans.iter().enumerate().filter(|(_, p)| p.live) {
-        for r in factors[elements(q)].iter_mut().filter(|r| !weighted(r)) {
-            r.unoccluded *= scale;
-            r.unweighted *= scale;
+    for_each_block_mut(blocks, patch_elements, factors, false, |patches, out| {
+        let first = patch_elements[patches.start].start;
+        for q in patches.filter(|&q| plans[q].live) {
+            let range = patch_elements[q].start - first..patch_elements[q].end - first;
+            for r in out[range].iter_mut().filter(|r| !weighted(r)) {
+                r.unoccluded *= scale;
+                r.unweighted *= scale;
+            }
         }
-    }
+    });
 }
 
 /// First pass, patch by patch: each receiving patch writes its own elements' slice of
-/// `factors` (their form factors without visibility and their pilot rays).
-fn first_pass(shot: &Shot, plans: &[PatchPlan], factors: &mut [Received]) {
-    let mesh = shot.mesh;
-    let mut slices: Vec<&mut [Received]> = Vec::with_capacity(mesh.patches.len());
-    let mut rest = factors;
-    for range in shot.patch_elements {
-        let (own, after) = rest.split_at_mut(range.len());
-        slices.push(own);
-        rest = after;
-    }
-    let receive_one = |q: usize, out: &mut &mut [Received]| {
-        receive_patch(shot, &plans[q], q, shot.patch_elements[q].start, out)
-    };
-    if mesh.elements.len() < PARALLEL_MIN || rayon::current_num_threads() == 1 {
-        slices.iter_mut().enumerate().for_each(|(q, out)| receive_one(q, out));
-    } else {
-        // About 64 elements per task, as `for_each_maybe_parallel` takes them.
-        let per_task = (PARALLEL_MIN * mesh.patches.len() / mesh.elements.len()).max(1);
-        slices.par_iter_mut().enumerate().with_min_len(per_task).for_each(|(q, out)| receive_one(q, out));
-    }
+/// `factors` (their form factors without visibility and their pilot rays), the mesh's
+/// blocks of patches in parallel.
+fn first_pass(shot: &Shot, plans: &[PatchPlan], blocks: &[Range<usize>], factors: &mut [Received]) {
+    let patch_elements = shot.patch_elements;
+    for_each_block_mut(blocks, patch_elements, factors, true, |patches, mut out| {
+        for q in patches {
+            let (own, rest) = std::mem::take(&mut out).split_at_mut(patch_elements[q].len());
+            receive_patch(shot, &plans[q], q, patch_elements[q].start, own);
+            out = rest;
+        }
+    });
 }
 
 /// Penumbrae: more rays where the neighbours' pilot rays disagree (see
@@ -268,7 +290,7 @@ fn first_pass(shot: &Shot, plans: &[PatchPlan], factors: &mut [Received]) {
 fn penumbra_pass(
     shot: &Shot,
     plans: &[PatchPlan],
-    tables: &super::mesh_tables::MeshTables,
+    tables: &MeshTables,
     flags: &mut [bool],
     factors: &mut [Received],
 ) {
@@ -367,12 +389,7 @@ pub(super) fn in_near_field(shot: &Shot, e: usize) -> bool {
 /// has tens of thousands of facets whose planes cut it (a bunny on a floor patch: 71 k): a
 /// 139 k-triangle room solved in 26.4 s with them, 24.3 s without, 23.5 s before any near
 /// field.
-fn near_field(
-    shot: &Shot,
-    plans: &[PatchPlan],
-    tables: &super::mesh_tables::MeshTables,
-    row: &Row,
-) -> NearField {
+fn near_field(shot: &Shot, plans: &[PatchPlan], tables: &MeshTables, row: &Row) -> NearField {
     let mut near = NearField::default();
     let elements = shot.shooter_elements;
     let first_shooter = shot.shooter.elements.start;
@@ -457,31 +474,27 @@ fn near_field(
 /// The row of the live patches' factors (those that receive anything), and the rays traced
 /// for them (none counted for patches whose group `shares` its rays).
 fn gather(
-    patch_elements: &[std::ops::Range<usize>],
+    tables: &MeshTables,
     plans: &[PatchPlan],
     factors: &[Received],
-    shares: impl Fn(usize) -> bool,
+    shares: impl Fn(usize) -> bool + Sync,
 ) -> (Row, u64) {
-    let mut row = Row::new();
-    let mut rays = 0;
-    for (q, plan) in plans.iter().enumerate() {
-        if !plan.live {
-            continue;
+    Row::by_blocks(tables, |q, row| {
+        if !plans[q].live {
+            return 0;
         }
-        let range = patch_elements[q].clone();
+        let range = tables.patch_elements[q].clone();
         let factors = &factors[range.clone()];
-        if !shares(q) {
-            rays += factors.iter().map(|r| u64::from(r.traced)).sum::<u64>();
-        }
+        let rays = if shares(q) { 0 } else { factors.iter().map(|r| u64::from(r.traced)).sum() };
         // A patch that receives nothing (facing, but every ray blocked: the inside of a
         // model, a face in shadow) is left out: applying zeros changes no sum, and a model's
         // rows shrink by about half.
-        if factors.iter().all(|r| r.factor() as f32 == 0.0) {
-            continue;
+        let f32s = factors.iter().map(|r| r.factor() as f32);
+        if f32s.clone().any(|f| f != 0.0) {
+            row.push(range, f32s);
         }
-        row.push(range, factors.iter().map(|r| r.factor() as f32));
-    }
-    (row, rays)
+        rays
+    })
 }
 
 /// Pilot rays from a bright shooter to a facet of a shooter group: a quarter of

@@ -68,9 +68,30 @@ pub(super) const RESUM: u32 = 256;
 /// Below this many elements a shot is applied on one thread (a parallel pass costs more).
 const APPLY_PARALLEL_MIN: usize = 32_768;
 
-/// Consecutive receiving spans of one shot with their factors and their elements' radiosity
-/// and unshot radiosity, and the (patch, Σ F·A) of each patch they cover, filled in order.
-type Chunk<'a> = (&'a [(u32, u32)], &'a [f32], &'a mut [Rgb], &'a mut [Rgb], Vec<(u32, f64)>);
+/// Consecutive receiving spans of one shot with their factors, their elements' radiosity and
+/// unshot radiosity, and their patches' unshot power and |unshot power| (from `patches.0`);
+/// what the chunk's receivers took in is summed into `patches`' [`Received`].
+struct Chunk<'a> {
+    spans: &'a [(u32, u32)],
+    factors: &'a [f32],
+    radiosity: &'a mut [Rgb],
+    unshot: &'a mut [Rgb],
+    patches: (usize, &'a mut [Rgb], &'a mut [f64]),
+    took: Received,
+}
+
+/// What one chunk of a shot's receivers took in, summed in the chunk's patch order.
+#[derive(Default)]
+struct Received {
+    /// Irradiance times area, W.
+    received: Rgb,
+    /// The part of it absorbed, W.
+    absorbed: Rgb,
+    /// The change of Σ |unshot power|.
+    abs_delta: f64,
+    /// (patch, change of its |unshot power|), in patch order.
+    changed: Vec<(u32, f64)>,
+}
 
 /// A shot is applied in about this many chunks of consecutive receiving spans...
 const CHUNKS: usize = 256;
@@ -245,13 +266,14 @@ impl Tally {
         }
         // Each receiving span (whole consecutive patches, see `Row`) takes, patch by patch,
         // ρ × the shot's radiosity times F per element, and each patch its Σ F·A; spans own
-        // disjoint elements, so they may run in parallel, in chunks of consecutive spans
-        // (one task per span cost more than the arithmetic). The sums over patches then run
-        // in span order: the same numbers for any thread count.
+        // disjoint elements and patches, so they may run in parallel, in chunks of
+        // consecutive spans (one task per span cost more than the arithmetic). The chunks'
+        // sums are then added in span order: the same numbers for any thread count.
         let per_chunk = (row.spans.len() / CHUNKS).max(MIN_SPANS_PER_CHUNK);
         let mut chunks: Vec<Chunk> = Vec::with_capacity(row.spans.len().div_ceil(per_chunk));
         let (mut radiosity, mut unshot) = (&mut self.radiosity[..], &mut self.unshot[..]);
-        let (mut at, mut offset) = (0, 0);
+        let (mut power, mut abs) = (&mut self.patch_unshot_power[..], &mut self.patch_abs[..]);
+        let (mut at, mut offset, mut at_patch) = (0, 0, 0);
         for spans in row.spans.chunks(per_chunk) {
             let first = spans[0].0 as usize;
             let (last, count) = spans[spans.len() - 1];
@@ -259,27 +281,52 @@ impl Tally {
             let (r, rest_r) = std::mem::take(&mut radiosity)[first - at..].split_at_mut(end - first);
             let (u, rest_u) = std::mem::take(&mut unshot)[first - at..].split_at_mut(end - first);
             (radiosity, unshot, at) = (rest_r, rest_u, end);
+            let (first_patch, end_patch) =
+                (tables.element_patch[first] as usize, tables.element_patch[end - 1] as usize + 1);
+            let (p, rest_p) =
+                std::mem::take(&mut power)[first_patch - at_patch..].split_at_mut(end_patch - first_patch);
+            let (a, rest_a) =
+                std::mem::take(&mut abs)[first_patch - at_patch..].split_at_mut(end_patch - first_patch);
+            (power, abs, at_patch) = (rest_p, rest_a, end_patch);
             let factors: usize = spans.iter().map(|&(_, c)| c as usize).sum();
-            chunks.push((spans, &row.factors[offset..offset + factors], r, u, Vec::new()));
+            chunks.push(Chunk {
+                spans,
+                factors: &row.factors[offset..offset + factors],
+                radiosity: r,
+                unshot: u,
+                patches: (first_patch, p, a),
+                took: Received::default(),
+            });
             offset += factors;
         }
-        let receive = |(spans, factors, radiosity, unshot, seen): &mut Chunk| {
+        let receive = |chunk: &mut Chunk| {
+            let Chunk { spans, factors, radiosity, unshot, patches: (first_patch, power, abs), took } = chunk;
             let base = spans[0].0 as usize;
             let mut offset = 0;
             for_each_patch(tables, spans, |patch, elements| {
                 let per_factor = tables.patch_reflectance[patch] * b_of(patch);
                 let area = &tables.element_area[elements.clone()];
                 let local = elements.start - base;
-                let mut sum = 0.0;
+                let mut seen = 0.0;
                 for k in 0..elements.len() {
                     let f = f64::from(factors[offset + k]);
                     let reflected = per_factor * f; // ρ × irradiance from this shot, W/unit²
                     radiosity[local + k] += reflected;
                     unshot[local + k] += reflected;
-                    sum += f * area[k];
+                    seen += f * area[k];
                 }
-                seen.push((patch as u32, sum));
                 offset += elements.len();
+                let gained = tables.patch_reflectance[patch] * b_of(patch) * seen;
+                let span_received = b_of(patch) * seen;
+                took.received += span_received;
+                took.absorbed += span_received - gained;
+                let q = patch - *first_patch;
+                power[q] += gained;
+                let new = power[q].abs().sum();
+                let delta = new - abs[q];
+                abs[q] = new;
+                took.abs_delta += delta;
+                took.changed.push((patch as u32, delta));
             });
         };
         if mesh.elements.len() < APPLY_PARALLEL_MIN || rayon::current_num_threads() == 1 {
@@ -287,16 +334,13 @@ impl Tally {
         } else {
             chunks.par_iter_mut().for_each(receive);
         }
-        let seen: Vec<Vec<(u32, f64)>> = chunks.into_iter().map(|c| c.4).collect();
         let mut received = Rgb::ZERO;
-        for &(patch, seen) in seen.iter().flatten() {
-            let patch = patch as usize;
-            let gained = tables.patch_reflectance[patch] * b_of(patch) * seen;
-            let span_received = b_of(patch) * seen;
-            received += span_received;
-            self.absorbed += span_received - gained;
-            self.patch_unshot_power[patch] += gained;
-            self.changed(patch);
+        for chunk in chunks {
+            let took = chunk.took;
+            received += took.received;
+            self.absorbed += took.absorbed;
+            self.abs_total += took.abs_delta;
+            self.changed.extend(took.changed);
         }
         // The near receivers: their own share in place of the (scaled) mean's.
         for (&(e, f, _, _), b) in near.receivers.iter().zip(&near_b) {
