@@ -64,7 +64,7 @@ pub(super) fn patch_blocks(patch_elements: &[Range<usize>]) -> Vec<Range<usize>>
 /// Whether a pass over `elements` elements is worth the thread pool: `costly` passes (form
 /// factors and rays) from [`PARALLEL_MIN`] elements, cheap ones from
 /// [`BLOCKS_PARALLEL_MIN`].
-fn blocks_in_parallel(elements: usize, costly: bool) -> bool {
+pub(super) fn blocks_in_parallel(elements: usize, costly: bool) -> bool {
     let min = if costly { PARALLEL_MIN } else { BLOCKS_PARALLEL_MIN };
     elements >= min && rayon::current_num_threads() > 1
 }

@@ -10,7 +10,7 @@ use rayon::prelude::*;
 
 use super::Solver;
 use super::mesh_tables::MeshTables;
-use super::parallel::{for_each_block_mut, for_each_maybe_parallel, map_blocks};
+use super::parallel::{blocks_in_parallel, for_each_block_mut, for_each_maybe_parallel, map_blocks};
 use super::penumbra::wants_penumbra_rays;
 use super::plans::{PatchPlan, plan_patches};
 use super::ray_ends::draw_ray_ends;
@@ -34,6 +34,9 @@ pub(super) struct Row {
     /// The receivers that touch the shooter, weighted at each shot by the part of it they
     /// see (see [`NearField`]).
     pub(super) near: NearField,
+    /// While the row is built: pushes merge only into a span that starts at this element or
+    /// later (the first of the block of patches being pushed, see [`Row::by_blocks`]).
+    floor: u32,
 }
 
 /// The receiving elements that touch a patch shooter (across or on its plane: a floor strip
@@ -94,7 +97,7 @@ const MAX_RUN: u32 = 1024;
 impl Row {
     /// An empty row.
     pub(super) fn new() -> Self {
-        Self { spans: Vec::new(), factors: Vec::new(), near: NearField::default() }
+        Self { spans: Vec::new(), factors: Vec::new(), near: NearField::default(), floor: 0 }
     }
 
     /// Appends the factors of a receiving patch whose elements are `elements` (after those
@@ -102,25 +105,45 @@ impl Row {
     pub(super) fn push(&mut self, elements: std::ops::Range<usize>, factors: impl IntoIterator<Item = f32>) {
         let (first, count) = (elements.start as u32, elements.len() as u32);
         match self.spans.last_mut() {
-            Some((start, n)) if *start + *n == first && *n + count <= MAX_RUN => *n += count,
+            Some((start, n)) if *start >= self.floor && *start + *n == first && *n + count <= MAX_RUN => {
+                *n += count
+            }
             _ => self.spans.push((first, count)),
         }
         self.factors.extend(factors);
     }
 
     /// The row that `patch(q, row)` pushes patch after patch (returning a count, summed),
-    /// built in the mesh's blocks of patches (see [`super::parallel::patch_blocks`]) and
-    /// joined in order: a span never crosses a block, so the row is the same on one thread
-    /// or many.
+    /// built in the mesh's blocks of patches (see [`super::parallel::patch_blocks`]), on
+    /// the thread pool when the mesh is large, and joined in order. A span never crosses a
+    /// block, so the row is the same on one thread or many.
     pub(super) fn by_blocks(
         tables: &MeshTables,
         patch: impl Fn(usize, &mut Row) -> u64 + Sync,
     ) -> (Row, u64) {
-        let parts = map_blocks(&tables.patch_blocks, tables.element_area.len(), |patches| {
+        let blocks = &tables.patch_blocks;
+        let first_element = |b: &Range<usize>| tables.patch_elements[b.start].start as u32;
+        if !blocks_in_parallel(tables.element_area.len(), false) {
+            // One row grown in place: a small scene's rows need no per-block rows allocated,
+            // grown and copied.
             let mut row = Row::new();
-            let count = patches.map(|q| patch(q, &mut row)).sum::<u64>();
-            (row, count)
-        });
+            let mut count = 0;
+            for b in blocks {
+                row.floor = first_element(b);
+                count += b.clone().map(|q| patch(q, &mut row)).sum::<u64>();
+            }
+            row.floor = 0;
+            return (row, count);
+        }
+        let parts: Vec<(Row, u64)> = blocks
+            .par_iter()
+            .map(|b| {
+                let mut row = Row::new();
+                row.floor = first_element(b);
+                let count = b.clone().map(|q| patch(q, &mut row)).sum::<u64>();
+                (row, count)
+            })
+            .collect();
         let mut row = Row::new();
         row.spans.reserve_exact(parts.iter().map(|p| p.0.spans.len()).sum());
         row.factors.reserve_exact(parts.iter().map(|p| p.0.factors.len()).sum());
