@@ -453,7 +453,8 @@ fn near_field(shot: &Shot, plans: &[PatchPlan], tables: &MeshTables, row: &Row) 
     let ns = shot.shooter.normal;
     let shares_of = |&(e, _): &(usize, f32)| -> Vec<(u32, f32)> {
         let (p, n) = (shot.mesh.elements[e].centre, shot.mesh.elements[e].normal);
-        let mut shares: Vec<(u32, f64)> = Vec::new();
+        // At most one term per shooter element: sized once, never grown.
+        let mut shares: Vec<(u32, f64)> = Vec::with_capacity(elements.len());
         for (c, cluster) in clusters.iter().enumerate() {
             if cluster.centre.distance_squared(p) >= 16.0 * cluster.radius * cluster.radius {
                 let phi = point_to_point(p, n, cluster.centre, ns, cluster.area);
@@ -470,11 +471,10 @@ fn near_field(shot: &Shot, plans: &[PatchPlan], tables: &MeshTables, row: &Row) 
         if sum <= 0.0 {
             return Vec::new();
         }
-        shares
-            .iter()
-            .filter(|s| s.1 >= MIN_SHARE * sum)
-            .map(|&(part, phi)| (part, (phi / sum) as f32))
-            .collect()
+        let kept = shares.iter().filter(|s| s.1 >= MIN_SHARE * sum);
+        let mut terms = Vec::with_capacity(kept.clone().count());
+        terms.extend(kept.map(|&(part, phi)| (part, (phi / sum) as f32)));
+        terms
     };
     let all: Vec<Vec<(u32, f32)>> = if receivers.len() < 64 || rayon::current_num_threads() == 1 {
         receivers.iter().map(shares_of).collect()
