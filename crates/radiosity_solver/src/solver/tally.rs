@@ -69,20 +69,20 @@ pub(super) const RESUM: u32 = 256;
 const APPLY_PARALLEL_MIN: usize = 32_768;
 
 /// Consecutive receiving spans of one shot with their factors, their elements' radiosity and
-/// unshot radiosity, and their patches' unshot power and |unshot power| (from `patches.0`);
-/// what the chunk's receivers took in is summed into `patches`' [`Received`].
+/// unshot radiosity, their patches' unshot power and |unshot power| (patches from
+/// `patches.0` on), and what its receivers took in.
 struct Chunk<'a> {
     spans: &'a [(u32, u32)],
     factors: &'a [f32],
     radiosity: &'a mut [Rgb],
     unshot: &'a mut [Rgb],
     patches: (usize, &'a mut [Rgb], &'a mut [f64]),
-    took: Received,
+    took: Took,
 }
 
 /// What one chunk of a shot's receivers took in, summed in the chunk's patch order.
 #[derive(Default)]
-struct Received {
+struct Took {
     /// Irradiance times area, W.
     received: Rgb,
     /// The part of it absorbed, W.
@@ -295,7 +295,7 @@ impl Tally {
                 radiosity: r,
                 unshot: u,
                 patches: (first_patch, p, a),
-                took: Received::default(),
+                took: Took::default(),
             });
             offset += factors;
         }
