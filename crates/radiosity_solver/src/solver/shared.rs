@@ -110,7 +110,8 @@ impl Sharing {
         let far = |c: DVec3, r: f64, members: usize| {
             members > SHARED_RAYS as usize && c.distance(centre) > SHARE_DISTANCE * (r + radius)
         };
-        for g in (0..clusters.len()).filter(|&g| Some(g) != shooter_group && enabled && !emits) {
+        let groups = if enabled && !emits { 0..clusters.len() } else { 0..0 };
+        for g in groups.filter(|&g| Some(g) != shooter_group) {
             let group = clusters.group(g);
             if far(group.centre, group.radius, group.patches.len()) {
                 units.push(Unit { group: g, elements: 0..group.elements.len(), key: g as u64 });
