@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 use clap::{Args, ValueEnum};
 use radiosity_image::Exposure;
-use radiosity_viewer::{DisplayMode, Wireframe};
+use radiosity_viewer::{Detail, DisplayMode, Wireframe};
 
 use crate::output::Targets;
 use crate::prepare::{InputError, Settings, SolveOpts, settings};
@@ -33,6 +33,18 @@ pub enum WireframeArg {
     Patches,
     /// Element and patch outlines.
     Elements,
+}
+
+/// How much of a big mesh the window draws, on the command line.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum DetailArg {
+    /// On a CPU rasteriser, a coarse copy of a big mesh (over 400 k triangles) while the camera
+    /// moves or the solve runs, every element once the view rests; on a GPU, every element.
+    Auto,
+    /// Every element, always.
+    Full,
+    /// The coarse copy, always (for a big mesh).
+    Coarse,
 }
 
 /// Arguments of `radiosity view`.
@@ -67,6 +79,9 @@ pub struct ViewArgs {
     /// Subdivision lines at start.
     #[arg(long, value_enum, default_value_t = WireframeArg::Off)]
     pub wireframe: WireframeArg,
+    /// How much of a big mesh is drawn, at start (the panel changes it).
+    #[arg(long, value_enum, default_value_t = DetailArg::Auto)]
+    pub detail: DetailArg,
     #[command(flatten)]
     pub tone: ToneOpts,
     #[command(flatten)]
@@ -109,6 +124,11 @@ pub fn run(a: ViewArgs) -> Result<()> {
         WireframeArg::Off => Wireframe::Off,
         WireframeArg::Patches => Wireframe::Patches,
         WireframeArg::Elements => Wireframe::Elements,
+    };
+    options.detail = match a.detail {
+        DetailArg::Auto => Detail::Auto,
+        DetailArg::Full => Detail::Full,
+        DetailArg::Coarse => Detail::Coarse,
     };
     options.exposure_ev = match a.tone.exposure {
         Exposure::Ev(ev) => Some(ev),

@@ -20,7 +20,7 @@ use radiosity_image::{Exposure, Gather, SrgbImage, ToneOperator, ToneParams, ton
 use crate::ViewerOptions;
 use crate::camera::{FlyCamera, MoveInput, SceneExtent};
 use crate::render::{
-    DisplayMode, FrameParams, RenderTarget, SceneRenderer, Wireframe, auto_exposure_ev, false_colour,
+    Detail, DisplayMode, FrameParams, RenderTarget, SceneRenderer, Wireframe, auto_exposure_ev, false_colour,
     false_colour_range,
 };
 use crate::still::{Still, StillJob, StillPoll};
@@ -57,6 +57,8 @@ pub struct ViewState {
     pub mode: DisplayMode,
     /// Subdivision lines.
     pub wireframe: Wireframe,
+    /// How much of a big mesh is drawn.
+    pub detail: Detail,
 }
 
 /// Frames per second over the last second of drawn frames.
@@ -88,6 +90,9 @@ struct Capture {
     path: PathBuf,
     image: Arc<Mutex<Option<Arc<egui::ColorImage>>>>,
     requested: bool,
+    /// The frame rate just before the capture, with the solver idle: the capture's own frames
+    /// draw every element (and upload their colours), which is not what was being measured.
+    idle_fps: f64,
 }
 
 /// Scene sizes the subdivision sliders work in.
@@ -144,11 +149,22 @@ pub struct ViewerApp {
     still_job: Option<StillJob>,
     /// The last still, tone mapped onto a texture, shown in its own window until closed.
     still: Option<(Still, egui::TextureHandle, SrgbImage)>,
+    /// Whether the view is drawn by a CPU rasteriser (lavapipe, llvmpipe), where
+    /// [`Detail::Auto`] draws a big mesh's coarse copy while things change.
+    software: bool,
+    /// When the camera last moved.
+    last_motion: Option<Instant>,
+    /// Whether the last frame drew the coarse copy.
+    coarse: bool,
 }
 
 /// With continuous redraw, how long a scripted run keeps drawing after its mark before the
 /// screenshot, to measure the frame rate with the solver idle.
 const FPS_MEASURE: Duration = Duration::from_secs(3);
+
+/// How long the view must rest before [`Detail::Auto`] draws every element again: long enough
+/// that the pauses between key presses or drags do not flicker to full detail and back.
+const REST: Duration = Duration::from_millis(300);
 
 /// Time constant of the automatic exposure's adaptation, seconds.
 const ADAPTATION: f64 = 0.3;
@@ -168,6 +184,7 @@ impl ViewerApp {
             .clone()
             .ok_or_else(|| anyhow::anyhow!("the viewer needs eframe's wgpu renderer"))?;
         let info = render_state.adapter.get_info();
+        let software = info.device_type == wgpu::DeviceType::Cpu;
         log::info!("drawing with {} ({:?}, {:?})", info.name, info.backend, info.device_type);
         // The renderer draws inside egui's render pass, so it lives with egui's renderer and
         // is made for egui's target format and sample count.
@@ -203,6 +220,7 @@ impl ViewerApp {
                 operator: options.operator,
                 mode: options.display,
                 wireframe: options.wireframe,
+                detail: options.detail,
             },
             render_state,
             view_size: [1, 1],
@@ -236,6 +254,9 @@ impl ViewerApp {
             mark: None,
             still_job: None,
             still: None,
+            software,
+            last_motion: None,
+            coarse: false,
         })
     }
 
@@ -352,6 +373,36 @@ impl ViewerApp {
         self.shown = Some(snap);
     }
 
+    /// Whether this frame draws the big mesh's coarse copy: see [`Detail`]. A screenshot being
+    /// taken and subdivision lines (which the coarse copy has not) always get every element.
+    fn wants_coarse(&self, now: Instant) -> bool {
+        match self.view.detail {
+            Detail::Full => false,
+            Detail::Coarse => true,
+            Detail::Auto => {
+                let changing = self.last_motion.is_some_and(|t| now.duration_since(t) < REST)
+                    || self.status.state == WorkerState::Running
+                    || self.continuous;
+                self.software && changing && self.view.wireframe == Wireframe::Off && self.capture.is_none()
+            }
+        }
+    }
+
+    /// Tells the renderer which copy to draw; going back to every element uploads the shown
+    /// solution's colours, which only the coarse copy got meanwhile.
+    fn sync_detail(&mut self, coarse: bool) {
+        self.coarse = coarse;
+        let mut egui_renderer = self.render_state.renderer.write();
+        let Some(renderer) = egui_renderer.callback_resources.get_mut::<SceneRenderer>() else { return };
+        renderer.set_coarse(coarse);
+        if !coarse
+            && renderer.full_colours_stale()
+            && let Some(snap) = &self.shown
+        {
+            renderer.set_solution(&self.render_state.queue, &snap.solution, self.view.mode);
+        }
+    }
+
     fn exposure_ev(&self) -> f64 {
         if self.view.auto_exposure { self.auto_ev.unwrap_or(0.0) } else { self.view.exposure_ev }
     }
@@ -449,6 +500,9 @@ impl ViewerApp {
         });
         let path = unique_path(&self.screenshot_dir, &name);
         let frame = self.frame_params(self.view_size);
+        // The picture shows every element, whatever the window draws meanwhile.
+        let coarse = self.coarse;
+        self.sync_detail(false);
         let (device, queue) = (&self.render_state.device, &self.render_state.queue);
         let egui_renderer = self.render_state.renderer.read();
         let Some(renderer) = egui_renderer.callback_resources.get::<SceneRenderer>() else { return };
@@ -459,6 +513,7 @@ impl ViewerApp {
             write_rgb_png(&path, rgb.width(), rgb.height(), rgb.into_raw())
         });
         drop(egui_renderer);
+        self.sync_detail(coarse);
         self.message = Some(match result {
             Ok(()) => format!("wrote {}", path.display()),
             Err(e) => format!("cannot write {}: {e}", path.display()),
@@ -675,6 +730,22 @@ impl ViewerApp {
                     .on_hover_text("outlines of the patches (which shoot) or the elements (which receive)");
             }
         });
+        let counts = {
+            let egui_renderer = self.render_state.renderer.read();
+            egui_renderer.callback_resources.get::<SceneRenderer>().map(SceneRenderer::triangle_counts)
+        };
+        if let Some((full, Some(coarse))) = counts {
+            ui.horizontal(|ui| {
+                ui.label("detail");
+                for d in Detail::ALL {
+                    ui.selectable_value(&mut self.view.detail, d, d.label()).on_hover_text(format!(
+                        "{full} triangles in full, {coarse} in the coarse copy; auto draws the coarse copy \
+                         while the view changes on a CPU rasteriser (now: {})",
+                        if self.coarse { "coarse" } else { "full" }
+                    ));
+                }
+            });
+        }
         ui.add_enabled_ui(!self.view.mode.is_false_colour(), |ui| {
             ui.horizontal(|ui| {
                 ui.checkbox(&mut self.view.auto_exposure, "auto exposure");
@@ -846,7 +917,12 @@ impl ViewerApp {
             // rate printed then is the window's own.
             let measured = !self.continuous || self.mark.is_some_and(|(t, _)| t.elapsed() >= FPS_MEASURE);
             if ready && measured {
-                self.capture = Some(Capture { path: path.clone(), image: Arc::default(), requested: false });
+                self.capture = Some(Capture {
+                    path: path.clone(),
+                    image: Arc::default(),
+                    requested: false,
+                    idle_fps: self.fps.fps(),
+                });
             }
         }
         let Some(capture) = &mut self.capture else { return };
@@ -862,13 +938,13 @@ impl ViewerApp {
         }
         let taken = capture.image.lock().unwrap_or_else(|e| e.into_inner()).take();
         if let Some(img) = taken {
-            let path = capture.path.clone();
+            let (path, measured_idle) = (capture.path.clone(), capture.idle_fps);
             self.capture = None;
             let result = save_color_image(&img, &path);
             if result.is_ok() {
                 let solving_fps = self.mark.map_or(0.0, |m| m.1);
                 let idle_fps =
-                    if self.continuous { format!(", {:.1} fps idle", self.fps.fps()) } else { String::new() };
+                    if self.continuous { format!(", {measured_idle:.1} fps idle") } else { String::new() };
                 eprintln!(
                     "wrote {} ({}×{} px, {} shots; {solving_fps:.1} fps while solving{idle_fps})",
                     path.display(),
@@ -902,6 +978,8 @@ impl eframe::App for ViewerApp {
         self.poll_loading();
         self.sync_snapshot();
         self.poll_still(&ctx);
+        // Before the view is drawn, so that the frame a screenshot takes has every element.
+        self.scripted_capture(&ctx);
 
         egui::Panel::right("radiosity_panel").default_size(300.0).min_size(240.0).show(ui, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| self.panel(ui));
@@ -913,6 +991,12 @@ impl eframe::App for ViewerApp {
             let response = ui.allocate_rect(rect, Sense::click_and_drag());
             let aspect = f64::from(rect.width().max(1.0)) / f64::from(rect.height().max(1.0));
             moving = self.handle_camera_input(&ctx, &response, aspect);
+            let now = Instant::now();
+            if moving {
+                self.last_motion = Some(now);
+            }
+            let coarse = self.wants_coarse(now);
+            self.sync_detail(coarse);
             let view_px = [
                 (rect.width() * ctx.pixels_per_point()) as u32,
                 (rect.height() * ctx.pixels_per_point()) as u32,
@@ -949,11 +1033,13 @@ impl eframe::App for ViewerApp {
             ui.painter().galley(hint_rect.min + Vec2::new(8.0, 4.0), galley, Color32::from_gray(220));
         });
         self.still_window(&ctx);
-        self.scripted_capture(&ctx);
         let busy = matches!(self.status.state, WorkerState::Meshing) || self.loading.is_some();
         if moving || adapting || self.continuous || busy || self.capture.is_some() || self.scripted.is_some()
         {
             ctx.request_repaint();
+        } else if self.coarse {
+            // Back to every element once the view has rested.
+            ctx.request_repaint_after(REST);
         } else if self.status.state == WorkerState::Running {
             // The worker's publications wake the window; this is a floor for the panel's
             // clocks in case a shot takes long.

@@ -11,6 +11,7 @@
 
 mod app;
 pub mod camera;
+pub mod coarse;
 pub mod render;
 mod still;
 pub mod worker;
@@ -24,8 +25,8 @@ use radiosity_solver::SolverParams;
 pub use app::{KEY_HINT, ViewState};
 pub use camera::{FlyCamera, MoveInput, SceneExtent};
 pub use render::{
-    COLOR_FORMAT, DisplayMode, FrameParams, RenderTarget, SCENE_WGSL, SceneRenderer, TONEMAP_WGSL, Wireframe,
-    headless_gpu,
+    COLOR_FORMAT, Detail, DisplayMode, FrameParams, RenderTarget, SCENE_WGSL, SceneRenderer, TONEMAP_WGSL,
+    Wireframe, headless_gpu,
 };
 pub use worker::{Progress, Snapshot, SolveJob, SolveWorker, Status, WorkerOptions, WorkerState};
 
@@ -61,6 +62,8 @@ pub struct ViewerOptions {
     pub display: DisplayMode,
     /// Subdivision lines at start.
     pub wireframe: Wireframe,
+    /// How much of a big mesh is drawn, at start.
+    pub detail: Detail,
     /// Exposure in stops at start; `None`: automatic (log-average luminance to middle grey).
     pub exposure_ev: Option<f64>,
     /// Tone-map operator at start.
@@ -88,6 +91,7 @@ impl ViewerOptions {
             samples: default_samples(),
             display: DisplayMode::Smooth,
             wireframe: Wireframe::Off,
+            detail: Detail::Auto,
             exposure_ev: None,
             operator: radiosity_image::ToneOperator::Aces,
             command: format!("radiosity view {scene_label}"),

@@ -10,6 +10,10 @@
 //! own colour: the vertex radiosity for smooth shading (the same values and the same
 //! barycentric interpolation as the CPU renderer) or its element's value for flat shading.
 //! Colours stay linear to the fragment shader, which tone maps them (`tonemap.wgsl`).
+//!
+//! A big mesh also gets a coarse copy ([`crate::coarse`]) with its own buffers; the viewer
+//! draws it while the camera moves or the solve runs on a CPU rasteriser, and only its
+//! colours are uploaded at each snapshot meanwhile.
 
 use std::sync::Arc;
 
@@ -18,6 +22,8 @@ use glam::{DMat4, DVec3};
 use radiosity_core::{Mesh, Rgb};
 use radiosity_image::ToneOperator;
 use radiosity_solver::Solution;
+
+use crate::coarse::{COARSE_TRIANGLES, CoarseTriangle};
 
 /// WGSL source of the tone-map functions (shared with the CPU/GPU agreement test).
 pub const TONEMAP_WGSL: &str = include_str!("shaders/tonemap.wgsl");
@@ -114,6 +120,33 @@ impl Wireframe {
             Wireframe::Off => 0,
             Wireframe::Patches => 2,
             Wireframe::Elements => 3,
+        }
+    }
+}
+
+/// How much of a big mesh is drawn (see [`crate::coarse`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Detail {
+    /// On a CPU rasteriser, the coarse copy while the camera moves or the solve runs and the
+    /// whole mesh once the view rests; on a GPU, always the whole mesh.
+    #[default]
+    Auto,
+    /// Always every element.
+    Full,
+    /// Always the coarse copy (when the mesh has one).
+    Coarse,
+}
+
+impl Detail {
+    /// Every choice, in panel order.
+    pub const ALL: [Detail; 3] = [Detail::Auto, Detail::Full, Detail::Coarse];
+
+    /// Label in the panel.
+    pub fn label(self) -> &'static str {
+        match self {
+            Detail::Auto => "auto",
+            Detail::Full => "full",
+            Detail::Coarse => "coarse",
         }
     }
 }
@@ -326,6 +359,17 @@ struct Geometry {
     colours: wgpu::Buffer,
     /// Scratch for the colour upload, kept to avoid reallocating at every snapshot.
     scratch: Vec<[f32; 3]>,
+    /// A coarser copy for big meshes ([`crate::coarse`]).
+    coarse: Option<CoarseGeometry>,
+    /// Whether `colours` lags the last solution (only the coarse copy's were uploaded).
+    full_stale: bool,
+}
+
+/// The coarse copy of a big mesh on the GPU.
+struct CoarseGeometry {
+    triangles: Vec<CoarseTriangle>,
+    vertices: wgpu::Buffer,
+    colours: wgpu::Buffer,
 }
 
 /// Draws a [`Mesh`] lit by a [`Solution`].
@@ -337,6 +381,10 @@ pub struct SceneRenderer {
     format: wgpu::TextureFormat,
     samples: u32,
     geometry: Option<Geometry>,
+    /// Whether [`Self::paint`] draws the coarse copy (when there is one).
+    coarse: bool,
+    /// Most triangles of the coarse copy; meshes over twice as many get one.
+    coarse_budget: usize,
 }
 
 impl SceneRenderer {
@@ -442,7 +490,17 @@ impl SceneRenderer {
             None,
             wgpu::CompareFunction::Always,
         );
-        Self { mesh_pipeline, background_pipeline, uniforms, bind_group, format, samples, geometry: None }
+        Self {
+            mesh_pipeline,
+            background_pipeline,
+            uniforms,
+            bind_group,
+            format,
+            samples,
+            geometry: None,
+            coarse: false,
+            coarse_budget: COARSE_TRIANGLES,
+        }
     }
 
     /// The colour format the pipelines were made for.
@@ -469,33 +527,72 @@ impl SceneRenderer {
         let origin = if lo.is_finite() && hi.is_finite() { (lo + hi) * 0.5 } else { DVec3::ZERO };
         let triangles = oriented_triangles(mesh);
         let edges = edge_flags(mesh, &triangles);
+        let vertex = |v: u32, edges: u32| StaticVertex {
+            position: (mesh.positions[v as usize] - origin).as_vec3().to_array(),
+            edges,
+        };
         let mut vertices = Vec::with_capacity(triangles.len() * 3);
         for ((_, tri), flags) in triangles.iter().zip(&edges) {
-            for &v in tri {
-                let p = (mesh.positions[v as usize] - origin).as_vec3();
-                vertices.push(StaticVertex { position: p.to_array(), edges: *flags });
-            }
+            vertices.extend(tri.iter().map(|&v| vertex(v, *flags)));
         }
-        use wgpu::util::DeviceExt;
-        let vertex_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("radiosity mesh vertices"),
-            contents: bytemuck::cast_slice(&vertices),
-            usage: wgpu::BufferUsages::VERTEX,
-        });
-        let colours = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("radiosity mesh colours"),
-            size: (vertices.len().max(1) * 12) as u64,
-            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let coarse = (triangles.len() > 2 * self.coarse_budget)
+            .then(|| crate::coarse::coarse_mesh(mesh, &triangles, self.coarse_budget))
+            .flatten()
+            .map(|coarse| {
+                // No subdivision lines on the coarse copy: its edges are no element's.
+                let at = |i: u32| StaticVertex {
+                    position: (coarse.positions[i as usize] - origin).as_vec3().to_array(),
+                    edges: 0,
+                };
+                let vertices: Vec<StaticVertex> =
+                    coarse.triangles.iter().flat_map(|t| t.corners.map(at)).collect();
+                CoarseGeometry {
+                    vertices: vertex_buffer(device, "radiosity coarse vertices", &vertices),
+                    colours: colour_buffer(device, "radiosity coarse colours", vertices.len()),
+                    triangles: coarse.triangles,
+                }
+            });
         self.geometry = Some(Geometry {
             mesh: mesh.clone(),
             triangles,
             origin,
-            vertices: vertex_buffer,
-            colours,
+            colours: colour_buffer(device, "radiosity mesh colours", vertices.len()),
+            vertices: vertex_buffer(device, "radiosity mesh vertices", &vertices),
             scratch: Vec::new(),
+            coarse,
+            full_stale: false,
         });
+    }
+
+    /// Sets the most triangles of the coarse copy made for the next mesh uploaded (default
+    /// [`COARSE_TRIANGLES`]); meshes with more than twice as many get one.
+    pub fn set_coarse_budget(&mut self, triangles: usize) {
+        self.coarse_budget = triangles.max(1);
+    }
+
+    /// Whether the uploaded mesh has a coarse copy to draw.
+    pub fn has_coarse(&self) -> bool {
+        self.geometry.as_ref().is_some_and(|g| g.coarse.is_some())
+    }
+
+    /// Triangles drawn per frame at full detail and, when there is one, by the coarse copy.
+    pub fn triangle_counts(&self) -> (usize, Option<usize>) {
+        self.geometry
+            .as_ref()
+            .map_or((0, None), |g| (g.triangles.len(), g.coarse.as_ref().map(|c| c.triangles.len())))
+    }
+
+    /// Chooses what [`Self::paint`] draws: the coarse copy (when the mesh has one) or every
+    /// element. Drawing every element after the coarse copy was shown needs the colours of
+    /// the shown solution uploaded again: see [`Self::full_colours_stale`].
+    pub fn set_coarse(&mut self, coarse: bool) {
+        self.coarse = coarse;
+    }
+
+    /// Whether the full mesh's colours lag the last solution given (only the coarse copy's
+    /// were uploaded while it was drawn).
+    pub fn full_colours_stale(&self) -> bool {
+        self.geometry.as_ref().is_some_and(|g| g.full_stale)
     }
 
     /// Uploads the colours `mode` shows from `solution` (which must belong to the uploaded
@@ -510,17 +607,30 @@ impl SceneRenderer {
             return;
         }
         let f = |c: Rgb| [c.r as f32, c.g as f32, c.b as f32];
+        let corner = |e: u32, v: u32| match mode {
+            DisplayMode::Smooth | DisplayMode::FalseColour => f(solution.vertex_radiosity[v as usize]),
+            DisplayMode::FlatElements => f(solution.element_radiosity[e as usize]),
+            DisplayMode::Unshot => f(solution.element_unshot[e as usize].abs()),
+        };
         g.scratch.clear();
-        for &(e, tri) in &g.triangles {
-            match mode {
-                DisplayMode::Smooth | DisplayMode::FalseColour => {
-                    g.scratch.extend(tri.iter().map(|&v| f(solution.vertex_radiosity[v as usize])));
-                }
-                DisplayMode::FlatElements => g.scratch.extend([f(solution.element_radiosity[e as usize]); 3]),
-                DisplayMode::Unshot => g.scratch.extend([f(solution.element_unshot[e as usize].abs()); 3]),
+        if let Some(c) = &g.coarse {
+            for t in &c.triangles {
+                g.scratch.extend(t.colours.map(|v| corner(t.element, v)));
             }
+            queue.write_buffer(&c.colours, 0, bytemuck::cast_slice(&g.scratch));
+            // While the coarse copy is drawn, the full mesh's colours (six times as many
+            // corners or more) wait until it is drawn again.
+            if self.coarse {
+                g.full_stale = true;
+                return;
+            }
+            g.scratch.clear();
+        }
+        for &(e, tri) in &g.triangles {
+            g.scratch.extend(tri.map(|v| corner(e, v)));
         }
         queue.write_buffer(&g.colours, 0, bytemuck::cast_slice(&g.scratch));
+        g.full_stale = false;
     }
 
     /// Writes the frame's settings for the next [`Self::paint`]; `width_px` is the width of
@@ -551,13 +661,16 @@ impl SceneRenderer {
         pass.set_bind_group(0, &self.bind_group, &[]);
         pass.set_pipeline(&self.background_pipeline);
         pass.draw(0..3, 0..1);
-        if let Some(g) = &self.geometry
-            && !g.triangles.is_empty()
-        {
+        let Some(g) = &self.geometry else { return };
+        let (vertices, colours, triangles) = match &g.coarse {
+            Some(c) if self.coarse => (&c.vertices, &c.colours, c.triangles.len()),
+            _ => (&g.vertices, &g.colours, g.triangles.len()),
+        };
+        if triangles > 0 {
             pass.set_pipeline(&self.mesh_pipeline);
-            pass.set_vertex_buffer(0, g.vertices.slice(..));
-            pass.set_vertex_buffer(1, g.colours.slice(..));
-            pass.draw(0..(g.triangles.len() * 3) as u32, 0..1);
+            pass.set_vertex_buffer(0, vertices.slice(..));
+            pass.set_vertex_buffer(1, colours.slice(..));
+            pass.draw(0..(triangles * 3) as u32, 0..1);
         }
     }
 
@@ -611,6 +724,26 @@ impl SceneRenderer {
         }
         queue.submit([encoder.finish()]);
     }
+}
+
+/// A vertex buffer holding `vertices`.
+fn vertex_buffer(device: &wgpu::Device, label: &str, vertices: &[StaticVertex]) -> wgpu::Buffer {
+    use wgpu::util::DeviceExt;
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: bytemuck::cast_slice(vertices),
+        usage: wgpu::BufferUsages::VERTEX,
+    })
+}
+
+/// A colour buffer for `corners` triangle corners (RGB f32), written at each snapshot.
+fn colour_buffer(device: &wgpu::Device, label: &str, corners: usize) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: (corners.max(1) * 12) as u64,
+        usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
 }
 
 /// The mesh's element triangles, each wound counter-clockwise seen from the side its element

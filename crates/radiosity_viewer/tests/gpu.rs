@@ -293,3 +293,70 @@ fn any_target_format_gives_the_same_picture() {
         assert!((0..3).all(|c| a[c].abs_diff(b[c]) <= 1), "background {a:?} vs {b:?}");
     }
 }
+
+/// A mesh over twice the coarse budget gets a coarse copy: drawn, it shows the same walls as
+/// the full mesh (region means within a few sRGB levels: it loses only detail smaller than its
+/// cells); drawn meanwhile, it leaves the full mesh's colours stale until they are uploaded
+/// again, and the full picture then equals a fresh renderer's to the bit.
+#[test]
+fn the_coarse_copy_shows_the_same_walls_and_full_detail_catches_up() {
+    let (device, queue) = gpu();
+    let scene = cornell_box();
+    let problem = Problem::new(&scene, &MeshParams::try_new(120.0, 15.0).unwrap()).unwrap();
+    let mesh = problem.mesh();
+    let mut solver = problem.solver(SolverParams::preview()).unwrap();
+    solver.step(StepBudget::Shots(100));
+    let early = solver.solution();
+    solver.step(StepBudget::Shots(200));
+    let late = solver.solution();
+
+    let (w, h) = (320u32, 240u32);
+    let aspect = f64::from(w) / f64::from(h);
+    let (lo, hi) = mesh.bounds();
+    let camera = FlyCamera::from_scene_camera(&scene.camera.unwrap(), &SceneExtent::new(lo, hi));
+    let frame = FrameParams {
+        clip_from_world: camera.clip_from_view(aspect) * camera.view_from_world(),
+        exposure_ev: 0.0,
+        operator: ToneOperator::Aces,
+        mode: DisplayMode::Smooth,
+        wireframe: Wireframe::Off,
+        log_range: (-1.0, 0.0),
+        background: [0.1, 0.1, 0.1, 1.0],
+    };
+    let target = RenderTarget::new(&device, [w, h], COLOR_FORMAT, 1);
+    let draw = |renderer: &SceneRenderer| {
+        renderer.draw(&device, &queue, &target, &frame);
+        target.read_rgba8(&device, &queue).unwrap()
+    };
+
+    let mut fresh = SceneRenderer::new(&device, COLOR_FORMAT, 1);
+    fresh.set_mesh(&device, mesh);
+    let (full_triangles, none) = fresh.triangle_counts();
+    assert_eq!(none, None, "{full_triangles} triangles: under the default budget, no coarse copy");
+    fresh.set_solution(&queue, &late, DisplayMode::Smooth);
+    let full = draw(&fresh);
+    full.save(out_dir().join("coarse_cornell_full.png")).unwrap();
+
+    let mut renderer = SceneRenderer::new(&device, COLOR_FORMAT, 1);
+    renderer.set_coarse_budget(full_triangles / 8);
+    renderer.set_mesh(&device, mesh);
+    let coarse_triangles = renderer.triangle_counts().1.expect("a coarse copy");
+    assert!(coarse_triangles <= full_triangles / 8, "{coarse_triangles} of {full_triangles}");
+    renderer.set_solution(&queue, &early, DisplayMode::Smooth);
+    renderer.set_coarse(true);
+    renderer.set_solution(&queue, &late, DisplayMode::Smooth);
+    assert!(renderer.full_colours_stale(), "only the coarse copy's colours were uploaded");
+    let coarse = draw(&renderer);
+    coarse.save(out_dir().join("coarse_cornell.png")).unwrap();
+    for (x0, x1, wall) in [(0.05, 0.2, "red wall"), (0.8, 0.95, "green wall"), (0.0, 1.0, "whole view")] {
+        let (a, b) = (mean_rgb(&full, x0, x1), mean_rgb(&coarse, x0, x1));
+        let worst = (0..3).map(|c| (a[c] - b[c]).abs()).fold(0.0, f64::max);
+        assert!(worst < 4.0, "{wall}: full {a:?}, coarse {b:?}");
+    }
+
+    renderer.set_coarse(false);
+    assert!(renderer.full_colours_stale());
+    renderer.set_solution(&queue, &late, DisplayMode::Smooth);
+    assert!(!renderer.full_colours_stale());
+    assert!(draw(&renderer) == full, "full detail after the coarse copy equals a fresh renderer's picture");
+}
