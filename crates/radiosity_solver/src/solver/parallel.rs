@@ -104,15 +104,35 @@ pub(super) fn for_each_block_mut<T: Send>(
         }
         return;
     }
-    let mut parts: Vec<(Range<usize>, &mut [T])> = Vec::with_capacity(blocks.len());
-    let (mut rest, mut at) = (items, 0);
-    for b in blocks {
-        let range = elements_of(b);
-        let (own, after) = std::mem::take(&mut rest)[range.start - at..].split_at_mut(range.len());
-        parts.push((b.clone(), own));
-        (rest, at) = (after, range.end);
-    }
+    let mut items = Carve::new(items);
+    let parts: Vec<(Range<usize>, &mut [T])> =
+        blocks.iter().map(|b| (b.clone(), items.take(elements_of(b)))).collect();
     parts.into_par_iter().for_each(|(b, items)| f(b, items));
+}
+
+/// Cuts a slice into disjoint mutable pieces, given in increasing order by their ranges in the
+/// whole slice, so that each can go to its own task.
+pub(super) struct Carve<'a, T> {
+    rest: &'a mut [T],
+    /// Index in the whole slice of `rest[0]`.
+    at: usize,
+}
+
+impl<'a, T> Carve<'a, T> {
+    /// Ready to cut `whole`.
+    pub(super) fn new(whole: &'a mut [T]) -> Self {
+        Self { rest: whole, at: 0 }
+    }
+
+    /// The piece `range` of the whole slice; what lies before it is dropped.
+    ///
+    /// # Panics
+    /// When `range` starts before the end of the last piece taken or runs past the slice.
+    pub(super) fn take(&mut self, range: Range<usize>) -> &'a mut [T] {
+        let (own, after) = std::mem::take(&mut self.rest)[range.start - self.at..].split_at_mut(range.len());
+        (self.rest, self.at) = (after, range.end);
+        own
+    }
 }
 
 #[cfg(test)]

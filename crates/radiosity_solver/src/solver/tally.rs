@@ -6,6 +6,7 @@ use rayon::prelude::*;
 
 use super::SolverError;
 use super::mesh_tables::MeshTables;
+use super::parallel::Carve;
 use super::row::{CLUSTER_TERM, NearField, Row};
 
 /// Power bookkeeping per channel: emitted = absorbed + unshot + escaped, to round-off.
@@ -271,23 +272,18 @@ impl Tally {
         // sums are then added in span order: the same numbers for any thread count.
         let per_chunk = (row.spans.len() / CHUNKS).max(MIN_SPANS_PER_CHUNK);
         let mut chunks: Vec<Chunk> = Vec::with_capacity(row.spans.len().div_ceil(per_chunk));
-        let (mut radiosity, mut unshot) = (&mut self.radiosity[..], &mut self.unshot[..]);
-        let (mut power, mut abs) = (&mut self.patch_unshot_power[..], &mut self.patch_abs[..]);
-        let (mut at, mut offset, mut at_patch) = (0, 0, 0);
+        let (mut radiosity, mut unshot) = (Carve::new(&mut self.radiosity), Carve::new(&mut self.unshot));
+        let (mut power, mut abs) =
+            (Carve::new(&mut self.patch_unshot_power), Carve::new(&mut self.patch_abs));
+        let mut offset = 0;
         for spans in row.spans.chunks(per_chunk) {
             let first = spans[0].0 as usize;
             let (last, count) = spans[spans.len() - 1];
             let end = last as usize + count as usize;
-            let (r, rest_r) = std::mem::take(&mut radiosity)[first - at..].split_at_mut(end - first);
-            let (u, rest_u) = std::mem::take(&mut unshot)[first - at..].split_at_mut(end - first);
-            (radiosity, unshot, at) = (rest_r, rest_u, end);
             let (first_patch, end_patch) =
                 (tables.element_patch[first] as usize, tables.element_patch[end - 1] as usize + 1);
-            let (p, rest_p) =
-                std::mem::take(&mut power)[first_patch - at_patch..].split_at_mut(end_patch - first_patch);
-            let (a, rest_a) =
-                std::mem::take(&mut abs)[first_patch - at_patch..].split_at_mut(end_patch - first_patch);
-            (power, abs, at_patch) = (rest_p, rest_a, end_patch);
+            let (r, u) = (radiosity.take(first..end), unshot.take(first..end));
+            let (p, a) = (power.take(first_patch..end_patch), abs.take(first_patch..end_patch));
             let factors: usize = spans.iter().map(|&(_, c)| c as usize).sum();
             chunks.push(Chunk {
                 spans,
