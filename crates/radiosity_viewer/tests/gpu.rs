@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use eframe::wgpu;
 use radiosity_core::{MeshParams, Rgb, cornell_box, srgb_encode};
 use radiosity_image::{ToneOperator, ToneParams, tone_map};
-use radiosity_solver::{Problem, SolverParams, StepBudget};
+use radiosity_solver::{Problem, Solution, SolverParams, StepBudget};
 use radiosity_viewer::render::{false_colour, shader_operator};
 use radiosity_viewer::{
     COLOR_FORMAT, DisplayMode, FlyCamera, FrameParams, RenderTarget, SceneExtent, SceneRenderer,
@@ -183,22 +183,36 @@ fn mean_rgb(img: &image::RgbaImage, x0: f64, x1: f64) -> [f64; 3] {
     sum.map(|s| s / n)
 }
 
+/// The Cornell box meshed with `element`-sized elements, its solutions after each of `shots`
+/// shots in all (increasing), and its camera.
+fn solved_cornell(element: f64, shots: &[u64]) -> (Problem, Vec<Solution>, FlyCamera) {
+    let scene = cornell_box();
+    let problem = Problem::new(&scene, &MeshParams::try_new(120.0, element).unwrap()).unwrap();
+    let mut solver = problem.solver(SolverParams::preview()).unwrap();
+    let mut done = 0;
+    let solutions = shots
+        .iter()
+        .map(|&n| {
+            solver.step(StepBudget::Shots(n - done));
+            done = n;
+            solver.solution()
+        })
+        .collect();
+    let (lo, hi) = problem.mesh().bounds();
+    let camera = FlyCamera::from_scene_camera(&scene.camera.unwrap(), &SceneExtent::new(lo, hi));
+    (problem, solutions, camera)
+}
+
 /// The renderer draws the lit box into a headless target: red wall on the left, green on the
 /// right, lit but not blown out. The picture is kept in the test's temporary folder.
 #[test]
 fn offscreen_cornell_shows_red_left_and_green_right() {
     let (device, queue) = gpu();
-    let scene = cornell_box();
-    let problem = Problem::new(&scene, &MeshParams::try_new(120.0, 40.0).unwrap()).unwrap();
-    let mesh = problem.mesh();
-    let mut solver = problem.solver(SolverParams::preview()).unwrap();
-    solver.step(StepBudget::Shots(300));
-    let solution = solver.solution();
+    let (problem, solutions, camera) = solved_cornell(40.0, &[300]);
+    let (mesh, solution) = (problem.mesh(), &solutions[0]);
 
     let (w, h) = (320u32, 240u32);
     let aspect = f64::from(w) / f64::from(h);
-    let (lo, hi) = mesh.bounds();
-    let camera = FlyCamera::from_scene_camera(&scene.camera.unwrap(), &SceneExtent::new(lo, hi));
     let ev = 0.0;
     for (mode, wireframe, name) in [
         (DisplayMode::Smooth, Wireframe::Off, "smooth"),
@@ -209,14 +223,14 @@ fn offscreen_cornell_shows_red_left_and_green_right() {
         let mut renderer = SceneRenderer::new(&device, COLOR_FORMAT, 1);
         let target = RenderTarget::new(&device, [w, h], COLOR_FORMAT, 1);
         renderer.set_mesh(&device, mesh);
-        renderer.set_solution(&queue, &solution, mode);
+        renderer.set_solution(&queue, solution, mode);
         let frame = FrameParams {
             clip_from_world: camera.clip_from_view(aspect) * camera.view_from_world(),
             exposure_ev: ev,
             operator: ToneOperator::Aces,
             mode,
             wireframe,
-            log_range: radiosity_viewer::render::false_colour_range(&solution, mode),
+            log_range: radiosity_viewer::render::false_colour_range(solution, mode),
             background: [0.1, 0.1, 0.1, 1.0],
         };
         renderer.draw(&device, &queue, &target, &frame);
@@ -244,15 +258,9 @@ fn offscreen_cornell_shows_red_left_and_green_right() {
 #[test]
 fn any_target_format_gives_the_same_picture() {
     let (device, queue) = gpu();
-    let scene = cornell_box();
-    let problem = Problem::new(&scene, &MeshParams::try_new(120.0, 40.0).unwrap()).unwrap();
-    let mesh = problem.mesh();
-    let mut solver = problem.solver(SolverParams::preview()).unwrap();
-    solver.step(StepBudget::Shots(100));
-    let solution = solver.solution();
+    let (problem, solutions, camera) = solved_cornell(40.0, &[100]);
+    let (mesh, solution) = (problem.mesh(), &solutions[0]);
     let (w, h) = (160u32, 120u32);
-    let (lo, hi) = mesh.bounds();
-    let camera = FlyCamera::from_scene_camera(&scene.camera.unwrap(), &SceneExtent::new(lo, hi));
     let frame = FrameParams {
         clip_from_world: camera.clip_from_view(f64::from(w) / f64::from(h)) * camera.view_from_world(),
         exposure_ev: 1.0,
@@ -265,7 +273,7 @@ fn any_target_format_gives_the_same_picture() {
     let picture = |format, samples| {
         let mut renderer = SceneRenderer::new(&device, format, samples);
         renderer.set_mesh(&device, mesh);
-        renderer.set_solution(&queue, &solution, DisplayMode::Smooth);
+        renderer.set_solution(&queue, solution, DisplayMode::Smooth);
         let target = RenderTarget::new(&device, [w, h], format, samples);
         renderer.draw(&device, &queue, &target, &frame);
         target.read_rgba8(&device, &queue).unwrap()
@@ -301,19 +309,11 @@ fn any_target_format_gives_the_same_picture() {
 #[test]
 fn the_coarse_copy_shows_the_same_walls_and_full_detail_catches_up() {
     let (device, queue) = gpu();
-    let scene = cornell_box();
-    let problem = Problem::new(&scene, &MeshParams::try_new(120.0, 15.0).unwrap()).unwrap();
-    let mesh = problem.mesh();
-    let mut solver = problem.solver(SolverParams::preview()).unwrap();
-    solver.step(StepBudget::Shots(100));
-    let early = solver.solution();
-    solver.step(StepBudget::Shots(200));
-    let late = solver.solution();
+    let (problem, solutions, camera) = solved_cornell(15.0, &[100, 300]);
+    let (mesh, early, late) = (problem.mesh(), &solutions[0], &solutions[1]);
 
     let (w, h) = (320u32, 240u32);
     let aspect = f64::from(w) / f64::from(h);
-    let (lo, hi) = mesh.bounds();
-    let camera = FlyCamera::from_scene_camera(&scene.camera.unwrap(), &SceneExtent::new(lo, hi));
     let frame = FrameParams {
         clip_from_world: camera.clip_from_view(aspect) * camera.view_from_world(),
         exposure_ev: 0.0,
@@ -333,7 +333,7 @@ fn the_coarse_copy_shows_the_same_walls_and_full_detail_catches_up() {
     fresh.set_mesh(&device, mesh);
     let (full_triangles, none) = fresh.triangle_counts();
     assert_eq!(none, None, "{full_triangles} triangles: under the default budget, no coarse copy");
-    fresh.set_solution(&queue, &late, DisplayMode::Smooth);
+    fresh.set_solution(&queue, late, DisplayMode::Smooth);
     let full = draw(&fresh);
     full.save(out_dir().join("coarse_cornell_full.png")).unwrap();
 
@@ -342,9 +342,9 @@ fn the_coarse_copy_shows_the_same_walls_and_full_detail_catches_up() {
     renderer.set_mesh(&device, mesh);
     let coarse_triangles = renderer.triangle_counts().1.expect("a coarse copy");
     assert!(coarse_triangles <= full_triangles / 8, "{coarse_triangles} of {full_triangles}");
-    renderer.set_solution(&queue, &early, DisplayMode::Smooth);
+    renderer.set_solution(&queue, early, DisplayMode::Smooth);
     renderer.set_coarse(true);
-    renderer.set_solution(&queue, &late, DisplayMode::Smooth);
+    renderer.set_solution(&queue, late, DisplayMode::Smooth);
     assert!(renderer.full_colours_stale(), "only the coarse copy's colours were uploaded");
     let coarse = draw(&renderer);
     coarse.save(out_dir().join("coarse_cornell.png")).unwrap();
@@ -356,7 +356,7 @@ fn the_coarse_copy_shows_the_same_walls_and_full_detail_catches_up() {
 
     renderer.set_coarse(false);
     assert!(renderer.full_colours_stale());
-    renderer.set_solution(&queue, &late, DisplayMode::Smooth);
+    renderer.set_solution(&queue, late, DisplayMode::Smooth);
     assert!(!renderer.full_colours_stale());
     assert!(draw(&renderer) == full, "full detail after the coarse copy equals a fresh renderer's picture");
 }
