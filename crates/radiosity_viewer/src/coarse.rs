@@ -9,7 +9,8 @@
 //! A cell's point minimises the squared distances to the planes of its triangles (the
 //! quadric error of Garland & Heckbert 1997, used for clustering by Lindstrom 2000), so it
 //! stays on the crease where a wall meets the floor and on the corner of a box: no sawtooth
-//! along edges, no cracks between the faces.
+//! along edges, no cracks between the faces. Border edges add the plane through them square
+//! to their triangle, so open borders do not shrink by half a cell either.
 //!
 //! The colours stay the solution's vertex radiosity, at every new snapshot, with nothing to
 //! recompute: each corner shows a vertex of its cell whose triangle faces the same way (one
@@ -138,6 +139,36 @@ impl Quadric {
     }
 }
 
+/// Per triangle, bit i set when its edge from corner i to corner i + 1 belongs to no other
+/// triangle: a surface's open border, or where it meets another surface that has vertices of
+/// its own. By sorting rather than hashing: a few million edges sort in a fraction of a second.
+fn border_edges(triangles: &[(u32, [u32; 3])]) -> Vec<u8> {
+    use rayon::prelude::*;
+    let mut edges: Vec<(u64, u32)> = triangles
+        .iter()
+        .enumerate()
+        .flat_map(|(k, (_, t))| {
+            (0..3).map(move |i| {
+                let (a, b) = (t[i], t[(i + 1) % 3]);
+                ((u64::from(a.min(b)) << 32) | u64::from(a.max(b)), (k * 3 + i) as u32)
+            })
+        })
+        .collect();
+    edges.par_sort_unstable();
+    let mut borders = vec![0u8; triangles.len()];
+    for run in edges.chunk_by(|a, b| a.0 == b.0) {
+        if let [(_, at)] = run {
+            borders[*at as usize / 3] |= 1 << (at % 3);
+        }
+    }
+    borders
+}
+
+/// n nᵀ.
+fn outer(n: DVec3) -> DMat3 {
+    DMat3::from_cols(n * n.x, n * n.y, n * n.z)
+}
+
 /// Builds the coarse triangles for the cells in `keys` of edge `cell`.
 fn cluster(mesh: &Mesh, triangles: &[(u32, [u32; 3])], keys: &[u64], lo: DVec3, cell: f64) -> CoarseMesh {
     let off_centre = |v: u32| {
@@ -146,13 +177,25 @@ fn cluster(mesh: &Mesh, triangles: &[(u32, [u32; 3])], keys: &[u64], lo: DVec3, 
     };
     let mut quadrics: HashMap<u64, Quadric> = HashMap::default();
     let mut colour: HashMap<(u64, u8), (u32, f64)> = HashMap::default();
-    for &(e, t) in triangles {
+    let borders = border_edges(triangles);
+    for (&(e, t), border) in triangles.iter().zip(borders) {
         let side = facing(mesh.elements[e as usize].normal);
         let p = t.map(|v| mesh.positions[v as usize]);
         let cross = (p[1] - p[0]).cross(p[2] - p[0]);
         let (w, n) = (0.5 * cross.length(), cross.normalize_or_zero());
-        let nn = DMat3::from_cols(n * n.x, n * n.y, n * n.z) * w;
-        let nd = n * (n.dot(p[0]) * w);
+        let (mut nn, mut nd) = (outer(n) * w, n * (n.dot(p[0]) * w));
+        // A border edge also pins its cells to the plane through it square to the triangle
+        // (Lindstrom 2000), or the clustered surface would shrink from its border by up to
+        // half a cell; where another surface meets it square, that plane is the other's.
+        for i in 0..3 {
+            if border & (1 << i) != 0 {
+                let edge = p[(i + 1) % 3] - p[i];
+                let m = edge.cross(n).normalize_or_zero();
+                let w = edge.length_squared();
+                nn += outer(m) * w;
+                nd += m * (m.dot(p[i]) * w);
+            }
+        }
         for v in t {
             let (key, d) = (keys[v as usize], off_centre(v));
             let q = quadrics.entry(key).or_insert(Quadric::EMPTY);
