@@ -17,8 +17,6 @@
 //! of six directions), the one nearest the cell's centre. The two sides of a wall thinner than
 //! a cell share a cell, and the lit side must not take the colour of the dark one.
 
-use std::collections::hash_map::Entry;
-
 use glam::{DMat3, DVec3};
 use radiosity_core::Mesh;
 use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
@@ -203,14 +201,11 @@ fn cluster(mesh: &Mesh, triangles: &[(u32, [u32; 3])], keys: &[u64], lo: DVec3, 
             q.nd += nd;
             q.sum += mesh.positions[v as usize];
             q.count += 1.0;
-            match colour.entry((key, side)) {
-                Entry::Occupied(mut o) => keep_nearest(o.get_mut(), v, d),
-                Entry::Vacant(slot) => {
-                    slot.insert((v, d));
-                }
-            }
+            colour.entry((key, side)).and_modify(|slot| keep_nearest(slot, v, d)).or_insert((v, d));
         }
     }
+    // Each cell's point, solved once.
+    let points: HashMap<u64, DVec3> = quadrics.iter().map(|(&k, q)| (k, q.point(cell, lo))).collect();
     let mut seen: HashSet<([u64; 3], u8)> = HashSet::default();
     let mut index: HashMap<u64, u32> = HashMap::default();
     let mut positions = Vec::new();
@@ -227,7 +222,7 @@ fn cluster(mesh: &Mesh, triangles: &[(u32, [u32; 3])], keys: &[u64], lo: DVec3, 
         if !seen.insert((sorted, side)) {
             continue;
         }
-        let p = cells.map(|k| quadrics[&k].point(cell, lo));
+        let p = cells.map(|k| points[&k]);
         // A triangle folded over by the merge would show its back: leave it out.
         if (p[1] - p[0]).cross(p[2] - p[0]).dot(normal) <= 0.0 {
             continue;

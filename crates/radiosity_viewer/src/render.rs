@@ -570,11 +570,6 @@ impl SceneRenderer {
         self.coarse_budget = triangles.max(1);
     }
 
-    /// Whether the uploaded mesh has a coarse copy to draw.
-    pub fn has_coarse(&self) -> bool {
-        self.geometry.as_ref().is_some_and(|g| g.coarse.is_some())
-    }
-
     /// Triangles drawn per frame at full detail and, when there is one, by the coarse copy.
     pub fn triangle_counts(&self) -> (usize, Option<usize>) {
         self.geometry
