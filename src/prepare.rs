@@ -92,6 +92,11 @@ pub struct MeshOpts {
     /// corner_refinement, else 2].
     #[arg(long, value_name = "LEVELS")]
     pub corner_refinement: Option<u32>,
+    /// Quarter the elements that other geometry comes nearer to than their size (a wall
+    /// behind a model, a board under the next shelf) this many times, 0 to 4; 0: none
+    /// [default: the scene's `[mesh]` proximity_refinement, else 2].
+    #[arg(long, value_name = "LEVELS")]
+    pub proximity_refinement: Option<u32>,
     /// Quarter the elements where the light changes steeply (shadow edges), found by a quick
     /// probe solve, this many times, 0 to 4; 0: none [default: the scene's `[mesh]`
     /// adaptive_levels, else 2].
@@ -295,6 +300,9 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
         .map(|m| m.with_contacts(o.mesh.contacts.unwrap_or(base.contacts)))
         .map(|m| m.with_shadow_outlines(o.mesh.shadow_outlines.unwrap_or(base.shadow_outlines)))
         .and_then(|m| m.with_corner_refinement(o.mesh.corner_refinement.unwrap_or(base.corner_refinement)))
+        .and_then(|m| {
+            m.with_proximity_refinement(o.mesh.proximity_refinement.unwrap_or(base.proximity_refinement))
+        })
         .and_then(|m| m.with_adaptive_levels(o.mesh.adaptive_levels.unwrap_or(base.adaptive_levels)))
         .map_err(|e| input(format!("mesh options: {e}")))?;
     // The scene file's limit is checked (with its line) by the loader; this is the option's.
@@ -508,6 +516,7 @@ mod tests {
             contacts: None,
             shadow_outlines: None,
             corner_refinement: None,
+            proximity_refinement: None,
             adaptive_levels: None,
         };
         let o = SolveOpts::with_mesh(mesh, 2.0);

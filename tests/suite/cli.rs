@@ -166,6 +166,13 @@ fn info_takes_mesh_options_only() {
     };
     let elements = |args: &[&str]| value(args, "elements").parse::<usize>().unwrap();
     assert!(elements(&["info", "cornell", "--element-size", "70"]) < elements(&["info", "cornell"]));
+    let plain = ["info", "cornell", "--adaptive-levels", "0"];
+    assert!(
+        elements(&[&plain[..], &["--proximity-refinement", "0"]].concat()) < elements(&plain),
+        "the tall block near the red wall refines the wall"
+    );
+    let o = radiosity(&["info", "cornell", "--proximity-refinement", "5"]);
+    assert!(!o.status.success() && stderr(&o).contains("proximity_refinement"), "{}", stderr(&o));
     assert_ne!(
         value(&["info", "cornell", "--light-scale", "2"], "emitted"),
         value(&["info", "cornell"], "emitted")

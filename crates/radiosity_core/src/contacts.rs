@@ -145,6 +145,26 @@ impl Grid {
     }
 }
 
+impl Grid {
+    /// Whether `f` holds for some candidate listed in the cells overlapping `[lo, hi]` or
+    /// among the large ones, stopping at the first (a candidate may be offered twice).
+    fn any_near(&self, lo: DVec3, hi: DVec3, mut f: impl FnMut(u32) -> bool) -> bool {
+        if self.large.iter().any(|&k| f(k)) {
+            return true;
+        }
+        let (from, to) = (self.cell_of(lo), self.cell_of(hi));
+        for z in from[2]..=to[2] {
+            for y in from[1]..=to[1] {
+                let row = (z * self.dims[1] + y) * self.dims[0];
+                if self.cells[row + from[0]..=row + to[0]].iter().flatten().any(|&k| f(k)) {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+}
+
 /// A surface cut along footprints.
 pub(crate) struct Cut {
     /// Convex pieces covering the surface minus the footprints, in a fixed order.
@@ -251,6 +271,43 @@ impl<'a> Contacts<'a> {
             }
         }
         edges.into_iter().zip(met).filter(|&(_, m)| m).map(|(e, _)| e).collect()
+    }
+
+    /// Whether some polygon comes within `reach` of point `c` of a surface facing `n`, on its
+    /// front side (a vertex more than `eps` in front of the surface's plane through `c`):
+    /// something near enough to shape the light there (see `grading::refine_near`). The
+    /// surface's own polygon and its coplanar neighbours lie in that plane and do not count,
+    /// nor does anything wholly behind it (a board's edges seen from its top), nor a polygon
+    /// whose plane holds one of `corners` (the surface's inside corners, graded apart: a wall
+    /// seen from the floor beside it).
+    pub(crate) fn geometry_within(
+        &self,
+        c: DVec3,
+        n: DVec3,
+        reach: f64,
+        eps: f64,
+        corners: &[(DVec3, DVec3)],
+    ) -> bool {
+        let r = DVec3::splat(reach);
+        self.grid.any_near(c - r, c + r, |k| {
+            let (_, p, lo, hi) = &self.candidates[k as usize];
+            if c.clamp(*lo, *hi).distance_squared(c) >= reach * reach {
+                return false;
+            }
+            let v = p.vertices();
+            if !v.iter().any(|&q| n.dot(q - c) > eps) {
+                return false;
+            }
+            // The other face of an inside corner, or a piece of it (a wall given as two
+            // triangles): its plane holds the corner's edge.
+            let (m, d) = plane(p);
+            let slack = tolerance(p).max(eps);
+            if corners.iter().any(|&(a, b)| (m.dot(a) - d).abs() <= slack && (m.dot(b) - d).abs() <= slack) {
+                return false;
+            }
+            (1..v.len() - 1)
+                .any(|i| closest_on_triangle(c, [v[0], v[i], v[i + 1]]).distance_squared(c) < reach * reach)
+        })
     }
 
     /// `target` (polygon `id`, or a polygon made of model faces when `None`) cut along the
@@ -383,6 +440,44 @@ impl<'a> Contacts<'a> {
 /// a polygon in that plane, unit normal `n`) that lie within `reach` of the box along the
 /// plane. Along axis k a step t in the plane moves by at most |t| √(1 − n_k²), so an axis the
 /// plane is square to is widened by `eps` alone.
+/// The point of triangle `t` nearest `p`: by the region of the triangle's plane `p`
+/// projects into (a corner, an edge, the inside), as in Ericson, *Real-Time Collision
+/// Detection* §5.1.5.
+fn closest_on_triangle(p: DVec3, [a, b, c]: [DVec3; 3]) -> DVec3 {
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return a;
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return b;
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return a + ab * (d1 / (d1 - d3));
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return c;
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return a + ac * (d2 / (d2 - d6));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0 {
+        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+    }
+    let denom = va + vb + vc;
+    if denom.abs() <= f64::MIN_POSITIVE {
+        return a; // a degenerate triangle: its corners stand for it
+    }
+    a + ab * (vb / denom) + ac * (vc / denom)
+}
+
 fn slab_box(lo: DVec3, hi: DVec3, n: DVec3, reach: f64, eps: f64) -> (DVec3, DVec3) {
     // Steps in the plane within the widened box are at most its diagonal long.
     let span = lo.distance(hi) + 2.0 * 3f64.sqrt() * reach;

@@ -152,6 +152,40 @@ pub(crate) fn grade(b: &mut SurfaceBuilder, edges: &[(DVec3, DVec3)], levels: u3
     splits.conform(b);
 }
 
+/// Quarters the elements of `b` that something comes nearer to than their size, `levels`
+/// times, down to `min_size`, and conforms the result. `near(centre, reach)` says whether
+/// other geometry comes within `reach` of an element's centre on the surface's front side.
+///
+/// Light on a surface changes over about the distance to what stands near it: behind a
+/// model 10 cm from a wall, under a shelf, around a model's feet. An element as large as
+/// that distance averages the bright and the dim, and a small object among such elements
+/// gets back their mean: a cow on a shelf, between boards 26 cm elements wide, came out 3 %
+/// dark against the path tracer (the same scene with 10 cm elements: within 0.6 %). The
+/// criterion is geometric (element size against distance, as the local feature size of
+/// mesh generation), so it costs no probe solve and holds for meshes of any size.
+pub(crate) fn refine_near(
+    b: &mut SurfaceBuilder,
+    levels: u32,
+    min_size: f64,
+    near: &dyn Fn(DVec3, f64) -> bool,
+) {
+    let mut splits = Splits::default();
+    for _ in 0..levels {
+        let before = b.elements.len();
+        splits.quarter_marked(b, &|b, vs| {
+            let k = vs.len();
+            let p = |i: usize| b.positions[vs[i % k] as usize];
+            let size = (0..k).map(|i| p(i).distance(p(i + 1))).fold(0.0, f64::max);
+            let centre = (0..k).map(p).sum::<DVec3>() / k as f64;
+            size >= 2.0 * min_size && near(centre, size)
+        });
+        if b.elements.len() == before {
+            break;
+        }
+    }
+    splits.conform(b);
+}
+
 /// Cuts every element with a split vertex inside one of its sides into triangles that use
 /// it: a fan from a corner whose own two sides are whole, or else from the element's centre.
 fn conform(b: &mut SurfaceBuilder, midpoints: &HashMap<(u32, u32), u32>) {

@@ -29,9 +29,10 @@ pub use canonical::{
 pub use color::Rgb;
 pub use film::CameraRays;
 pub use mesh::{
-    DEFAULT_ADAPTIVE_LEVELS, DEFAULT_CORNER_REFINEMENT, DEFAULT_CREASE_ANGLE_DEG, Element,
-    MAX_ADAPTIVE_LEVELS, MAX_CORNER_REFINEMENT, MAX_ELEMENTS, Mesh, MeshError, MeshParams, Patch, Refinement,
-    Smoothing, Surface, estimate_elements, first_object_over_limit,
+    DEFAULT_ADAPTIVE_LEVELS, DEFAULT_CORNER_REFINEMENT, DEFAULT_CREASE_ANGLE_DEG,
+    DEFAULT_PROXIMITY_REFINEMENT, Element, MAX_ADAPTIVE_LEVELS, MAX_CORNER_REFINEMENT, MAX_ELEMENTS,
+    MAX_PROXIMITY_REFINEMENT, Mesh, MeshError, MeshParams, Patch, Refinement, Smoothing, Surface,
+    estimate_elements, first_object_over_limit,
 };
 pub use one_line::{MAX_PART_CHARS, escape_controls, one_line};
 pub use scene::{

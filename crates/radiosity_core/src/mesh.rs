@@ -55,6 +55,11 @@ pub struct MeshParams {
     /// standing on it) are halved towards the corner, in [0, [`MAX_CORNER_REFINEMENT`]]; 0
     /// grades nothing (see the `grading` module). Default [`DEFAULT_CORNER_REFINEMENT`].
     pub corner_refinement: u32,
+    /// How many times elements that other geometry comes nearer to than their size (a wall
+    /// behind a model, a board under the next shelf) are quartered, in
+    /// [0, [`MAX_PROXIMITY_REFINEMENT`]]; 0 refines nothing (see `grading::refine_near`).
+    /// Default [`DEFAULT_PROXIMITY_REFINEMENT`].
+    pub proximity_refinement: u32,
     /// Levels of adaptive subdivision, in [0, [`MAX_ADAPTIVE_LEVELS`]]: elements where the
     /// light changes steeply between neighbours (shadow edges) are quartered, each level after
     /// a quick probe solve of the mesh so far. `Mesh::build` alone does not do it:
@@ -73,6 +78,13 @@ pub const MAX_ADAPTIVE_LEVELS: u32 = 4;
 /// The default [`MeshParams::corner_refinement`]: elements next to an inside corner a
 /// quarter as wide as the rest.
 pub const DEFAULT_CORNER_REFINEMENT: u32 = 2;
+
+/// The default [`MeshParams::proximity_refinement`]: elements near other geometry down to a
+/// quarter of the element size.
+pub const DEFAULT_PROXIMITY_REFINEMENT: u32 = 2;
+
+/// The largest [`MeshParams::proximity_refinement`]: elements 1/16 as wide as the rest.
+pub const MAX_PROXIMITY_REFINEMENT: u32 = 4;
 
 /// The largest [`MeshParams::corner_refinement`]: elements 1/64 as wide as the rest.
 pub const MAX_CORNER_REFINEMENT: u32 = 6;
@@ -100,6 +112,7 @@ impl MeshParams {
             contacts: true,
             shadow_outlines: true,
             corner_refinement: DEFAULT_CORNER_REFINEMENT,
+            proximity_refinement: DEFAULT_PROXIMITY_REFINEMENT,
             adaptive_levels: DEFAULT_ADAPTIVE_LEVELS,
         })
     }
@@ -123,6 +136,18 @@ impl MeshParams {
             return Err(SceneError::BadCornerRefinement { value: levels });
         }
         Ok(Self { corner_refinement: levels, ..self })
+    }
+
+    /// The same parameters with elements near other geometry quartered `levels` times.
+    ///
+    /// # Errors
+    /// [`SceneError::BadProximityRefinement`] when `levels` exceeds
+    /// [`MAX_PROXIMITY_REFINEMENT`].
+    pub fn with_proximity_refinement(self, levels: u32) -> Result<Self, SceneError> {
+        if levels > MAX_PROXIMITY_REFINEMENT {
+            return Err(SceneError::BadProximityRefinement { value: levels });
+        }
+        Ok(Self { proximity_refinement: levels, ..self })
     }
 
     /// The same parameters with `levels` of adaptive subdivision.
@@ -158,6 +183,7 @@ impl MeshParams {
             contacts: true,
             shadow_outlines: true,
             corner_refinement: DEFAULT_CORNER_REFINEMENT,
+            proximity_refinement: DEFAULT_PROXIMITY_REFINEMENT,
             adaptive_levels: DEFAULT_ADAPTIVE_LEVELS,
         }
     }
@@ -166,6 +192,33 @@ impl MeshParams {
     pub fn scaled(self, factor: f64) -> Self {
         Self { patch_size: self.patch_size * factor, element_size: self.element_size * factor, ..self }
     }
+}
+
+/// Whether a surface's inside corners are needed: to grade towards them, or to leave them to
+/// the grading when refining near other geometry (with the grading off too, they are left
+/// ungraded).
+fn grades_or_refines(params: &MeshParams) -> bool {
+    params.corner_refinement > 0 || params.proximity_refinement > 0
+}
+
+/// Quarters the elements of surface `b` (facing `normal`) that other geometry comes nearer
+/// to than their size, [`MeshParams::proximity_refinement`] times (see
+/// `grading::refine_near`), no smaller than the element size over 2^levels.
+fn refine_near(
+    b: &mut SurfaceBuilder,
+    normal: DVec3,
+    corners: &[(DVec3, DVec3)],
+    contacts: &Contacts,
+    params: &MeshParams,
+) {
+    let levels = params.proximity_refinement;
+    if levels == 0 {
+        return;
+    }
+    let min_size = params.element_size / f64::from(1u32 << levels);
+    let near =
+        |centre: DVec3, size: f64| contacts.geometry_within(centre, normal, size, 1e-4 * size, corners);
+    grading::refine_near(b, levels, min_size, &near);
 }
 
 /// What cuts a polygon before it is meshed.
@@ -1025,7 +1078,8 @@ impl Mesh {
             shadow_pieces: vec![0; scene.objects.len()],
             ..Mesh::default()
         };
-        let contacts = (params.contacts || params.corner_refinement > 0).then(|| Contacts::new(scene));
+        let contacts = (params.contacts || params.corner_refinement > 0 || params.proximity_refinement > 0)
+            .then(|| Contacts::new(scene));
         let shadows = params.shadow_outlines.then(|| ShadowOutlines::new(scene)).filter(|s| !s.is_empty());
         // The back face of an emitting material that emits from its front only: the same
         // reflectance, no emission (one per material, made when first needed).
@@ -1074,16 +1128,22 @@ impl Mesh {
                         } else {
                             let mut b = SurfaceBuilder::default();
                             mesh_triangle_group(&mut b, m, &group, params);
-                            if let Some(c) = contacts.as_ref().filter(|_| params.corner_refinement > 0) {
-                                let edges: Vec<(DVec3, DVec3)> = group
-                                    .iter()
-                                    .map(|&f| (f as usize, &m.polygons()[f as usize]))
-                                    .filter(|(_, p)| is_large(p, params))
-                                    .flat_map(|(index, p)| {
-                                        c.inside_corners(p, Some(PolygonId { object: oi, index }))
-                                    })
-                                    .collect();
+                            if let Some(c) = contacts.as_ref() {
+                                let edges: Vec<(DVec3, DVec3)> = if grades_or_refines(params) {
+                                    group
+                                        .iter()
+                                        .map(|&f| (f as usize, &m.polygons()[f as usize]))
+                                        .filter(|(_, p)| is_large(p, params))
+                                        .flat_map(|(index, p)| {
+                                            c.inside_corners(p, Some(PolygonId { object: oi, index }))
+                                        })
+                                        .collect()
+                                } else {
+                                    Vec::new()
+                                };
                                 grading::grade(&mut b, &edges, params.corner_refinement);
+                                let normal = m.polygons()[first].normal();
+                                refine_near(&mut b, normal, &edges, c, params);
                             }
                             mesh.push_surface(b, oi, o.material, refinement);
                         }
@@ -1151,9 +1211,10 @@ impl Mesh {
         for piece in pieces {
             let mut b = SurfaceBuilder::default();
             mesh_polygon(&mut b, piece, params);
-            if let Some(c) = contacts.filter(|_| large && params.corner_refinement > 0) {
-                let edges = c.inside_corners(piece, id);
+            if let Some(c) = contacts.filter(|_| large) {
+                let edges = if grades_or_refines(params) { c.inside_corners(piece, id) } else { Vec::new() };
                 grading::grade(&mut b, &edges, params.corner_refinement);
+                refine_near(&mut b, p.normal(), &edges, c, params);
             }
             self.push_surface(b, object, material, refinement);
         }
@@ -1643,6 +1704,94 @@ mod tests {
     /// around them), each surface of the Cornell box is still a disc without T-vertices:
     /// V − E + F = 1 (a vertex inside a neighbour's side would add two sides and one vertex),
     /// keeps its area, and has elements a quarter as wide as the rest along its corners.
+    /// Every surface of `mesh` is a disc (Euler characteristic 1 over its elements): no
+    /// element overlaps another and no side is left with a T-vertex.
+    fn assert_discs(mesh: &Mesh) {
+        for (s, surface) in mesh.surfaces.iter().enumerate() {
+            let patches = surface.patches.start as usize..surface.patches.end as usize;
+            let elements = mesh.patches[patches.start].elements.start as usize
+                ..mesh.patches[patches.end - 1].elements.end as usize;
+            let mut vertices = std::collections::HashSet::new();
+            let mut sides = std::collections::HashSet::new();
+            for e in elements.clone() {
+                let v = mesh.elements[e].vertex_indices();
+                for k in 0..v.len() {
+                    vertices.insert(v[k]);
+                    sides.insert((v[k].min(v[(k + 1) % v.len()]), v[k].max(v[(k + 1) % v.len()])));
+                }
+            }
+            let euler = vertices.len() as i64 - sides.len() as i64 + elements.len() as i64;
+            assert_eq!(euler, 1, "surface {s} of '{}'", mesh.object_names[surface.object as usize]);
+        }
+    }
+
+    /// A board 10 cm over a 4 × 4 floor of 25 cm elements: the floor under it is quartered
+    /// twice (down to a quarter of the element size, no finer), the floor far from it is left
+    /// as it was, the area is kept and every surface stays conforming; with
+    /// `proximity_refinement` 0 the floor is the plain lattice.
+    #[test]
+    fn elements_under_a_board_are_quartered_down_to_the_distance() {
+        let at = |y: f64, lo: f64, hi: f64| {
+            vec![DVec3::new(lo, y, lo), DVec3::new(lo, y, hi), DVec3::new(hi, y, hi), DVec3::new(hi, y, lo)]
+        };
+        let floor = Polygon::try_new(at(0.0, 0.0, 4.0)).unwrap();
+        let board = crate::scene::box_faces(
+            DVec3::new(1.5, 0.1, 1.5),
+            DVec3::new(2.5, 0.15, 2.5),
+            crate::scene::Facing::Outward,
+            0.0,
+        )
+        .unwrap();
+        let m = Material::try_new("m", Rgb::splat(0.5), Rgb::ONE).unwrap();
+        let object = |name: &str, ps| Object {
+            name: name.into(),
+            material: 0,
+            shape: Shape::Polygons(ps),
+            sides: crate::Sides::One,
+        };
+        let scene = Scene::try_new(
+            "board",
+            None,
+            vec![m],
+            vec![object("floor", vec![floor]), object("board", board)],
+        )
+        .unwrap();
+        let params = MeshParams::try_new(1.0, 0.25).unwrap();
+        let longest = |mesh: &Mesh, e: usize| {
+            let pts: Vec<DVec3> = mesh.element_corners(e).collect();
+            (0..pts.len()).map(|k| pts[k].distance(pts[(k + 1) % pts.len()])).fold(0.0, f64::max)
+        };
+        let floor_elements = |mesh: &Mesh| {
+            (0..mesh.elements.len()).filter(|&e| mesh.element_object(e) == 0).collect::<Vec<_>>()
+        };
+        let plain = Mesh::build(&scene, &params.with_proximity_refinement(0).unwrap()).unwrap();
+        assert_eq!(floor_elements(&plain).len(), 256);
+        let refined = Mesh::build(&scene, &params).unwrap();
+        assert_discs(&refined);
+        assert!((refined.total_area() - plain.total_area()).abs() < 1e-9 * plain.total_area());
+        // Horizontal distance of an element's centre from the board's footprint.
+        let outside = |c: DVec3| {
+            let d = |x: f64| (1.5 - x).max(x - 2.5).max(0.0);
+            d(c.x).hypot(d(c.z))
+        };
+        let (mut under, mut far) = (0, 0);
+        for e in floor_elements(&refined) {
+            let c = refined.elements[e].centre;
+            let size = longest(&refined, e);
+            assert!(size >= 0.0625 - 1e-9, "element {e} at {c}: {size}");
+            if (1.75..2.25).contains(&c.x) && (1.75..2.25).contains(&c.z) {
+                assert!(size <= 0.0625 + 1e-9, "under the board at {c}: {size}");
+                under += 1;
+            }
+            if outside(c) > 0.6 {
+                assert!((size - 0.25).abs() < 1e-9, "far from the board at {c}: {size}");
+                far += 1;
+            }
+        }
+        assert_eq!(under, 64, "the middle 0.5 × 0.5 in 6.25 cm squares");
+        assert!(far > 150, "{far}");
+    }
+
     #[test]
     fn graded_cornell_surfaces_stay_conforming() {
         let scene = crate::cornell_box();
@@ -1651,22 +1800,7 @@ mod tests {
         let plain = Mesh::build(&scene, &params.with_corner_refinement(0).unwrap()).unwrap();
         assert!(graded.elements.len() > plain.elements.len() * 5 / 4, "{}", graded.elements.len());
         assert_eq!(graded.patches.len(), plain.patches.len());
-        for (s, surface) in graded.surfaces.iter().enumerate() {
-            let patches = surface.patches.start as usize..surface.patches.end as usize;
-            let elements = graded.patches[patches.start].elements.start as usize
-                ..graded.patches[patches.end - 1].elements.end as usize;
-            let mut vertices = std::collections::HashSet::new();
-            let mut sides = std::collections::HashSet::new();
-            for e in elements.clone() {
-                let v = graded.elements[e].vertex_indices();
-                for k in 0..v.len() {
-                    vertices.insert(v[k]);
-                    sides.insert((v[k].min(v[(k + 1) % v.len()]), v[k].max(v[(k + 1) % v.len()])));
-                }
-            }
-            let euler = vertices.len() as i64 - sides.len() as i64 + elements.len() as i64;
-            assert_eq!(euler, 1, "surface {s} of '{}'", graded.object_names[surface.object as usize]);
-        }
+        assert_discs(&graded);
         assert!((graded.total_area() - plain.total_area()).abs() < 1e-9 * plain.total_area());
         let thinnest = |m: &Mesh| m.elements.iter().map(|e| e.area).fold(f64::INFINITY, f64::min);
         assert!(thinnest(&graded) < 0.3 * thinnest(&plain));

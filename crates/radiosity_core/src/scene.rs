@@ -128,6 +128,12 @@ pub enum SceneError {
         /// Value given.
         value: u32,
     },
+    /// A proximity refinement beyond the largest allowed.
+    #[error("proximity_refinement must be a whole number in [0, 4], got {value}")]
+    BadProximityRefinement {
+        /// Value given.
+        value: u32,
+    },
     /// Adaptive subdivision levels beyond the largest allowed.
     #[error("adaptive_levels must be a whole number in [0, 4], got {value}")]
     BadAdaptiveLevels {

@@ -737,6 +737,12 @@ fn mesh_params(loc: &Locator, d: &MeshDesc) -> Result<MeshParams, LoadError> {
             .map_err(|e| loc.at(levels.span(), "mesh.corner_refinement", e.to_string()))?,
         None => params,
     };
+    let params = match &d.proximity_refinement {
+        Some(levels) => params
+            .with_proximity_refinement(*levels.get_ref())
+            .map_err(|e| loc.at(levels.span(), "mesh.proximity_refinement", e.to_string()))?,
+        None => params,
+    };
     let params = match &d.adaptive_levels {
         Some(levels) => params
             .with_adaptive_levels(*levels.get_ref())

@@ -351,8 +351,9 @@ fn the_crease_angle_comes_from_the_mesh_table() {
     assert!(err.starts_with("e.toml:14:") && err.contains("mesh.crease_angle"), "{err}");
 }
 
-/// `[mesh] corner_refinement` sets the grading towards inside corners, `adaptive_levels` the
-/// adaptive subdivision; past 6 and 4 they are errors at their lines. `shadow_outlines` turns
+/// `[mesh] corner_refinement` sets the grading towards inside corners,
+/// `proximity_refinement` the refinement near other geometry, `adaptive_levels` the adaptive
+/// subdivision; past 6, 4 and 4 they are errors at their lines. `shadow_outlines` turns
 /// the shadow outlines off (on by default) and takes only a boolean.
 #[test]
 fn the_corner_refinement_comes_from_the_mesh_table() {
@@ -368,6 +369,11 @@ fn the_corner_refinement_comes_from_the_mesh_table() {
     let scene = parse_scene(&format!("{base}adaptive_levels = 1\n"), "a.toml").unwrap().scene;
     assert_eq!(scene.mesh.unwrap().adaptive_levels, 1);
     assert_eq!(default.mesh.unwrap().adaptive_levels, radiosity_core::DEFAULT_ADAPTIVE_LEVELS);
+    let scene = parse_scene(&format!("{base}proximity_refinement = 0\n"), "p.toml").unwrap().scene;
+    assert_eq!(scene.mesh.unwrap().proximity_refinement, 0);
+    assert_eq!(default.mesh.unwrap().proximity_refinement, radiosity_core::DEFAULT_PROXIMITY_REFINEMENT);
+    let err = parse_scene(&format!("{base}proximity_refinement = 5\n"), "q.toml").unwrap_err().to_string();
+    assert!(err.starts_with("q.toml:14:") && err.contains("mesh.proximity_refinement"), "{err}");
     let err = parse_scene(&format!("{base}adaptive_levels = 5\n"), "b.toml").unwrap_err().to_string();
     assert!(err.starts_with("b.toml:14:") && err.contains("mesh.adaptive_levels"), "{err}");
     assert!(default.mesh.unwrap().shadow_outlines);
