@@ -14,9 +14,14 @@
 //! edges, where rays graze the blockers' edges (the seed room: 0.21 % of its 17.9 k elements
 //! differed). A shooter's row is also computed again when its unshot power has drifted past a
 //! threshold (`first_shots`), a decision that 1e-7 apart can take one way on one path and the
-//! other on the other; with it the seed room has 0.33 % of its elements off. So: every element
-//! within 1e-5 relative, except at most 0.5 % of elements, none of them off by more than 5 %;
-//! per-object means within 1e-4.
+//! other on the other; with it, and with elements laid fine near other geometry, the seed room
+//! has 63 of its 22.9 k elements (0.28 %) off. An element in a slit lit only through it (the
+//! ceiling above the seed room's lamp, which hangs 5 cm below it) gets all its light from rays
+//! grazing the slit's edges and is some fifty times dimmer than the ceiling around the lamp, so one flipped ray
+//! moves it by several per cent of its own value but by a thousandth of its object's mean.
+//! So: every element within 1e-5 relative, except at most 0.5 % of elements, none of them off
+//! by more than 5 % of its own value or 0.5 % of its object's mean; per-object means within
+//! 1e-4.
 
 use radiosity_core::{Scene, furnace_box, two_plates, unit_cube_floor_light};
 use radiosity_solver::{Problem, Solution, SolverParams};
@@ -40,12 +45,19 @@ fn compare(name: &str, scene: &Scene, max_shots: u64) {
     let fast = solve(&problem, false, max_shots);
     let reference = solve(&problem, true, max_shots);
     assert_eq!(fast.shots, reference.shots, "{name}");
+    let (fo, ro) = (fast.object_radiosity(mesh), reference.object_radiosity(mesh));
     let mut off = 0;
     for (e, (a, b)) in fast.element_radiosity.iter().zip(&reference.element_radiosity).enumerate() {
+        let object = &ro[mesh.element_object(e)];
+        let mean = object.radiosity_back.unwrap_or(object.radiosity).max_channel();
+        let mean = mean.max(object.radiosity.max_channel());
         for (x, y) in [(a.r, b.r), (a.g, b.g), (a.b, b.b)] {
             let d = (x - y).abs() / y.abs().max(1e-300);
             if d > 1e-5 {
-                assert!(d < 0.05, "{name}: element {e}: {x} vs reference {y}");
+                assert!(
+                    d < 0.05 || (x - y).abs() < 0.005 * mean,
+                    "{name}: element {e}: {x} vs reference {y} (object mean {mean})"
+                );
                 off += 1;
                 break;
             }
@@ -53,7 +65,6 @@ fn compare(name: &str, scene: &Scene, max_shots: u64) {
     }
     let n = mesh.elements.len();
     assert!(off * 1000 <= 5 * n, "{name}: {off} of {n} elements differ");
-    let (fo, ro) = (fast.object_radiosity(mesh), reference.object_radiosity(mesh));
     for (f, r) in fo.iter().zip(&ro) {
         for (x, y) in [(f.radiosity.r, r.radiosity.r), (f.radiosity.g, r.radiosity.g)] {
             assert!((x - y).abs() <= 1e-4 * y.abs().max(1e-12), "{name}: {}: {x} vs {y}", f.name);

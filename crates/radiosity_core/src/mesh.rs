@@ -55,7 +55,7 @@ pub struct MeshParams {
     /// standing on it) are halved towards the corner, in [0, [`MAX_CORNER_REFINEMENT`]]; 0
     /// grades nothing (see the `grading` module). Default [`DEFAULT_CORNER_REFINEMENT`].
     pub corner_refinement: u32,
-    /// How many times elements that other geometry comes nearer to than their size (a wall
+    /// How many times elements that other geometry comes nearer to than half their size (a wall
     /// behind a model, a board under the next shelf) are quartered, in
     /// [0, [`MAX_PROXIMITY_REFINEMENT`]]; 0 refines nothing (see `grading::refine_near`).
     /// Default [`DEFAULT_PROXIMITY_REFINEMENT`].
@@ -202,7 +202,7 @@ fn grades_or_refines(params: &MeshParams) -> bool {
 }
 
 /// Quarters the elements of surface `b` (facing `normal`) that other geometry comes nearer
-/// to than their size, [`MeshParams::proximity_refinement`] times (see
+/// to than half their size, [`MeshParams::proximity_refinement`] times (see
 /// `grading::refine_near`), no smaller than the element size over 2^levels.
 fn refine_near(
     b: &mut SurfaceBuilder,
@@ -217,7 +217,7 @@ fn refine_near(
     }
     let min_size = params.element_size / f64::from(1u32 << levels);
     let near =
-        |centre: DVec3, size: f64| contacts.geometry_within(centre, normal, size, 1e-4 * size, corners);
+        |centre: DVec3, reach: f64| contacts.geometry_within(centre, normal, reach, 1e-4 * reach, corners);
     grading::refine_near(b, levels, min_size, &near);
 }
 
@@ -1725,7 +1725,7 @@ mod tests {
         }
     }
 
-    /// A board 10 cm over a 4 × 4 floor of 25 cm elements: the floor under it is quartered
+    /// A board 5 cm over a 4 × 4 floor of 25 cm elements: the floor under it is quartered
     /// twice (down to a quarter of the element size, no finer), the floor far from it is left
     /// as it was, the area is kept and every surface stays conforming; with
     /// `proximity_refinement` 0 the floor is the plain lattice.
@@ -1736,8 +1736,8 @@ mod tests {
         };
         let floor = Polygon::try_new(at(0.0, 0.0, 4.0)).unwrap();
         let board = crate::scene::box_faces(
-            DVec3::new(1.5, 0.1, 1.5),
-            DVec3::new(2.5, 0.15, 2.5),
+            DVec3::new(1.5, 0.05, 1.5),
+            DVec3::new(2.5, 0.1, 2.5),
             crate::scene::Facing::Outward,
             0.0,
         )
