@@ -17,8 +17,9 @@
 //! other on the other; with it, and with elements laid fine near other geometry, the seed room
 //! has 63 of its 22.9 k elements (0.28 %) off. An element in a slit lit only through it (the
 //! ceiling above the seed room's lamp, which hangs 5 cm below it) gets all its light from rays
-//! grazing the slit's edges and is some fifty times dimmer than the ceiling around the lamp, so one flipped ray
-//! moves it by several per cent of its own value but by a thousandth of its object's mean.
+//! grazing the slit's edges and is some fifty times dimmer than the ceiling around the lamp,
+//! so one flipped ray moves it by several per cent of its own value but by a thousandth of its
+//! object's mean.
 //! So: every element within 1e-5 relative, except at most 0.5 % of elements, none of them off
 //! by more than 5 % of its own value or 0.5 % of its object's mean; per-object means within
 //! 1e-4.
