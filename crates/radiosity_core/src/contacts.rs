@@ -436,10 +436,6 @@ impl<'a> Contacts<'a> {
     }
 }
 
-/// The bounding box of the points within `eps` of the plane through the box `[lo, hi]` (of
-/// a polygon in that plane, unit normal `n`) that lie within `reach` of the box along the
-/// plane. Along axis k a step t in the plane moves by at most |t| √(1 − n_k²), so an axis the
-/// plane is square to is widened by `eps` alone.
 /// The point of triangle `t` nearest `p`: by the region of the triangle's plane `p`
 /// projects into (a corner, an edge, the inside), as in Ericson, *Real-Time Collision
 /// Detection* §5.1.5.
@@ -478,6 +474,10 @@ fn closest_on_triangle(p: DVec3, [a, b, c]: [DVec3; 3]) -> DVec3 {
     a + ab * (vb / denom) + ac * (vc / denom)
 }
 
+/// The bounding box of the points within `eps` of the plane through the box `[lo, hi]` (of
+/// a polygon in that plane, unit normal `n`) that lie within `reach` of the box along the
+/// plane. Along axis k a step t in the plane moves by at most |t| √(1 − n_k²), so an axis the
+/// plane is square to is widened by `eps` alone.
 fn slab_box(lo: DVec3, hi: DVec3, n: DVec3, reach: f64, eps: f64) -> (DVec3, DVec3) {
     // Steps in the plane within the widened box are at most its diagonal long.
     let span = lo.distance(hi) + 2.0 * 3f64.sqrt() * reach;
