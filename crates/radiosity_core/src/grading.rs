@@ -153,8 +153,8 @@ pub(crate) fn grade(b: &mut SurfaceBuilder, edges: &[(DVec3, DVec3)], levels: u3
 }
 
 /// Quarters the elements of `b` that something comes nearer to than half their size (their
-/// own half-width, from their centre), `levels` times, down to `min_size`, and conforms the
-/// result. `near(centre, reach)` says whether other geometry comes within `reach` of an
+/// own half-width, from their centre), `levels` times while they are larger than `min_size`,
+/// and conforms the result. `near(centre, reach)` says whether other geometry comes within `reach` of an
 /// element's centre on the surface's front side.
 ///
 /// Light on a surface changes over about the distance to what stands near it: behind a
@@ -181,7 +181,10 @@ pub(crate) fn refine_near(
             let p = |i: usize| b.positions[vs[i % k] as usize];
             let size = (0..k).map(|i| p(i).distance(p(i + 1))).fold(0.0, f64::max);
             let centre = (0..k).map(p).sum::<DVec3>() / k as f64;
-            size >= 2.0 * min_size && near(centre, 0.5 * size)
+            // Strictly larger: a grid lays elements a little under the element size, and
+            // each of `levels` quarterings must still find them above `min_size` (the
+            // element size over 2^levels).
+            size > min_size * (1.0 + 1e-9) && near(centre, 0.5 * size)
         });
         if b.elements.len() == before {
             break;

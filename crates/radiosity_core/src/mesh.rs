@@ -79,9 +79,9 @@ pub const MAX_ADAPTIVE_LEVELS: u32 = 4;
 /// quarter as wide as the rest.
 pub const DEFAULT_CORNER_REFINEMENT: u32 = 2;
 
-/// The default [`MeshParams::proximity_refinement`]: elements near other geometry down to a
-/// quarter of the element size.
-pub const DEFAULT_PROXIMITY_REFINEMENT: u32 = 2;
+/// The default [`MeshParams::proximity_refinement`]: elements near other geometry half as
+/// wide as the rest, the level measured against the path tracer in docs/PERFORMANCE.md.
+pub const DEFAULT_PROXIMITY_REFINEMENT: u32 = 1;
 
 /// The largest [`MeshParams::proximity_refinement`]: elements 1/16 as wide as the rest.
 pub const MAX_PROXIMITY_REFINEMENT: u32 = 4;
@@ -1766,7 +1766,12 @@ mod tests {
         };
         let plain = Mesh::build(&scene, &params.with_proximity_refinement(0).unwrap()).unwrap();
         assert_eq!(floor_elements(&plain).len(), 256);
-        let refined = Mesh::build(&scene, &params).unwrap();
+        // One level (the default) halves the floor's elements near the board once.
+        let once = Mesh::build(&scene, &params).unwrap();
+        let sizes = floor_elements(&once).into_iter().map(|e| longest(&once, e));
+        assert!(sizes.fold(f64::MAX, f64::min) > 0.125 - 1e-9);
+        assert!(floor_elements(&once).len() > 256);
+        let refined = Mesh::build(&scene, &params.with_proximity_refinement(2).unwrap()).unwrap();
         assert_discs(&refined);
         assert!((refined.total_area() - plain.total_area()).abs() < 1e-9 * plain.total_area());
         // Horizontal distance of an element's centre from the board's footprint.
