@@ -369,8 +369,8 @@ fn the_corner_refinement_comes_from_the_mesh_table() {
     let scene = parse_scene(&format!("{base}adaptive_levels = 1\n"), "a.toml").unwrap().scene;
     assert_eq!(scene.mesh.unwrap().adaptive_levels, 1);
     assert_eq!(default.mesh.unwrap().adaptive_levels, radiosity_core::DEFAULT_ADAPTIVE_LEVELS);
-    let scene = parse_scene(&format!("{base}proximity_refinement = 0\n"), "p.toml").unwrap().scene;
-    assert_eq!(scene.mesh.unwrap().proximity_refinement, 0);
+    let scene = parse_scene(&format!("{base}proximity_refinement = 2\n"), "p.toml").unwrap().scene;
+    assert_eq!(scene.mesh.unwrap().proximity_refinement, 2);
     assert_eq!(default.mesh.unwrap().proximity_refinement, radiosity_core::DEFAULT_PROXIMITY_REFINEMENT);
     let err = parse_scene(&format!("{base}proximity_refinement = 5\n"), "q.toml").unwrap_err().to_string();
     assert!(err.starts_with("q.toml:14:") && err.contains("mesh.proximity_refinement"), "{err}");
