@@ -21,7 +21,8 @@ use std::collections::HashMap;
 use glam::DVec3;
 
 use crate::planar::{
-    area, area_signed, bounds, clean, contains_within, key, lexicographic, plane, split, tolerance,
+    area, area_signed, bounds, clean, contains_within, distance_to_polygon, key, lexicographic, plane, split,
+    tolerance,
 };
 use crate::scene::{Polygon, Scene, Shape};
 
@@ -305,8 +306,7 @@ impl<'a> Contacts<'a> {
             if corners.iter().any(|&(a, b)| (m.dot(a) - d).abs() <= slack && (m.dot(b) - d).abs() <= slack) {
                 return false;
             }
-            (1..v.len() - 1)
-                .any(|i| closest_on_triangle(c, [v[0], v[i], v[i + 1]]).distance_squared(c) < reach * reach)
+            distance_to_polygon(c, m, v) < reach
         })
     }
 
@@ -434,44 +434,6 @@ impl<'a> Contacts<'a> {
         }
         first.is_some_and(|(_, from_behind)| from_behind)
     }
-}
-
-/// The point of triangle `t` nearest `p`: by the region of the triangle's plane `p`
-/// projects into (a corner, an edge, the inside), as in Ericson, *Real-Time Collision
-/// Detection* §5.1.5.
-fn closest_on_triangle(p: DVec3, [a, b, c]: [DVec3; 3]) -> DVec3 {
-    let (ab, ac, ap) = (b - a, c - a, p - a);
-    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return a;
-    }
-    let bp = p - b;
-    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return b;
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return a + ab * (d1 / (d1 - d3));
-    }
-    let cp = p - c;
-    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return c;
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return a + ac * (d2 / (d2 - d6));
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0 {
-        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-    }
-    let denom = va + vb + vc;
-    if denom.abs() <= f64::MIN_POSITIVE {
-        return a; // a degenerate triangle: its corners stand for it
-    }
-    a + ab * (vb / denom) + ac * (vc / denom)
 }
 
 /// The bounding box of the points within `eps` of the plane through the box `[lo, hi]` (of

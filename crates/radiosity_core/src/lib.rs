@@ -35,6 +35,7 @@ pub use mesh::{
     estimate_elements, first_object_over_limit,
 };
 pub use one_line::{MAX_PART_CHARS, escape_controls, one_line};
+pub use planar::distance_to_polygon;
 pub use scene::{
     Camera, Facing, MAX_POLYGON_VERTICES, MAX_TIME_LIMIT_SECONDS, Material, Object, Polygon, PolygonMesh,
     Scene, SceneError, Shape, Sides, SolverSettings, Sphere, box_faces, unique_names,

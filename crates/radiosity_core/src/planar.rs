@@ -33,6 +33,25 @@ pub(crate) fn plane(p: &Polygon) -> (DVec3, f64) {
     (p.normal(), p.normal().dot(centre))
 }
 
+/// Distance from `p` to a convex planar polygon, counter-clockwise about its unit normal `n`:
+/// to its plane when `p` projects inside it, else to its nearest edge.
+pub fn distance_to_polygon(p: DVec3, n: DVec3, poly: &[DVec3]) -> f64 {
+    let k = poly.len();
+    let height = n.dot(p - poly[0]);
+    let q = p - n * height;
+    let inside = (0..k).all(|i| (poly[(i + 1) % k] - poly[i]).cross(q - poly[i]).dot(n) >= 0.0);
+    if inside {
+        return height.abs();
+    }
+    (0..k)
+        .map(|i| {
+            let (a, b) = (poly[i], poly[(i + 1) % k]);
+            let t = ((p - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
+            p.distance(a + (b - a) * t)
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// Orders points by x, then y, then z: a fixed order for corners whatever the input's.
 pub(crate) fn lexicographic(a: DVec3, b: DVec3) -> std::cmp::Ordering {
     a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)).then(a.z.total_cmp(&b.z))

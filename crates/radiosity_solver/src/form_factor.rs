@@ -13,6 +13,7 @@
 //!   away; kept for comparison.
 
 use glam::DVec3;
+pub use radiosity_core::distance_to_polygon;
 use std::f64::consts::PI;
 
 /// Clips a convex polygon to the half-space `n · (x − p) ≥ 0`; at most 5 vertices come out of
@@ -325,24 +326,6 @@ pub fn for_each_point(poly: &[DVec3], n: u32, rule: Rule, mut f: impl FnMut(DVec
             }
         }
     }
-}
-
-/// Distance from `p` to a convex planar polygon with unit normal `n`.
-pub fn distance_to_polygon(p: DVec3, n: DVec3, poly: &[DVec3]) -> f64 {
-    let k = poly.len();
-    let height = n.dot(p - poly[0]);
-    let q = p - n * height;
-    let inside = (0..k).all(|i| (poly[(i + 1) % k] - poly[i]).cross(q - poly[i]).dot(n) >= 0.0);
-    if inside {
-        return height.abs();
-    }
-    (0..k)
-        .map(|i| {
-            let (a, b) = (poly[i], poly[(i + 1) % k]);
-            let t = ((p - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
-            p.distance(a + (b - a) * t)
-        })
-        .fold(f64::INFINITY, f64::min)
 }
 
 /// Unoccluded area-to-area form factor `F(receiver → shooter)` by `n × n` midpoint quadrature
