@@ -154,8 +154,8 @@ pub(crate) fn grade(b: &mut SurfaceBuilder, edges: &[(DVec3, DVec3)], levels: u3
 
 /// Quarters the elements of `b` that something comes nearer to than half their size (their
 /// own half-width, from their centre), `levels` times while they are larger than `min_size`,
-/// and conforms the result. `near(centre, reach)` says whether other geometry comes within `reach` of an
-/// element's centre on the surface's front side.
+/// and conforms the result. `near(centre, reach)` says whether other geometry comes within
+/// `reach` of an element's centre on the surface's front side.
 ///
 /// Light on a surface changes over about the distance to what stands near it: behind a
 /// model 10 cm from a wall, under a shelf, around a model's feet. An element larger than

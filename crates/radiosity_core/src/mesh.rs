@@ -1727,10 +1727,10 @@ mod tests {
         }
     }
 
-    /// A board 5 cm over a 4 × 4 floor of 25 cm elements: the floor under it is quartered
-    /// twice (down to a quarter of the element size, no finer), the floor far from it is left
-    /// as it was, the area is kept and every surface stays conforming; with
-    /// `proximity_refinement` 0 the floor is the plain lattice.
+    /// A board 5 cm over a 4 × 4 floor of 25 cm elements: with `proximity_refinement` 0 (the
+    /// default) the floor is the plain lattice; one level halves the elements near the board
+    /// once; two quarter those under it twice (a quarter of the element size, no finer), leave
+    /// the floor far from it as it was, keep the area, and every surface stays conforming.
     #[test]
     fn elements_under_a_board_are_quartered_down_to_the_distance() {
         let at = |y: f64, lo: f64, hi: f64| {
