@@ -94,7 +94,7 @@ pub struct MeshOpts {
     pub corner_refinement: Option<u32>,
     /// Quarter the elements that other geometry comes nearer to than half their size (a wall
     /// behind a model, a board under the next shelf) this many times, 0 to 4; 0: none
-    /// [default: the scene's `[mesh]` proximity_refinement, else 0].
+    /// [default: the scene's `[mesh]` proximity_refinement, else 1].
     #[arg(long, value_name = "LEVELS")]
     pub proximity_refinement: Option<u32>,
     /// Quarter the elements where the light changes steeply (shadow edges), found by a quick
