@@ -1728,8 +1728,8 @@ mod tests {
         }
     }
 
-    /// A board 5 cm over a 4 × 4 floor of 25 cm elements: with `proximity_refinement` 0 the
-    /// floor is the plain lattice; one level halves the elements near the board
+    /// A board 5 cm over a 4 × 4 floor of 25 cm elements: with `proximity_refinement` 0, or
+    /// with a board that emits, the floor is the plain lattice; one level halves the elements near the board
     /// once; two quarter those under it twice (a quarter of the element size, no finer), leave
     /// the floor far from it as it was, keep the area, and every surface stays conforming.
     #[test]
@@ -1745,20 +1745,20 @@ mod tests {
             0.0,
         )
         .unwrap();
-        let m = Material::try_new("m", Rgb::splat(0.5), Rgb::ONE).unwrap();
-        let object = |name: &str, ps| Object {
+        let lit = Material::try_new("lit", Rgb::splat(0.5), Rgb::ONE).unwrap();
+        let wood = Material::try_new("wood", Rgb::splat(0.5), Rgb::ZERO).unwrap();
+        let object = |name: &str, material, ps| Object {
             name: name.into(),
-            material: 0,
+            material,
             shape: Shape::Polygons(ps),
             sides: crate::Sides::One,
         };
-        let scene = Scene::try_new(
-            "board",
-            None,
-            vec![m],
-            vec![object("floor", vec![floor]), object("board", board)],
-        )
-        .unwrap();
+        let scene_with_board = |board_material| {
+            let objects =
+                vec![object("floor", 0, vec![floor.clone()]), object("board", board_material, board.clone())];
+            Scene::try_new("board", None, vec![lit.clone(), wood.clone()], objects).unwrap()
+        };
+        let scene = scene_with_board(1);
         let params = MeshParams::try_new(1.0, 0.25).unwrap();
         let longest = |mesh: &Mesh, e: usize| {
             let pts: Vec<DVec3> = mesh.element_corners(e).collect();
@@ -1769,6 +1769,9 @@ mod tests {
         };
         let plain = Mesh::build(&scene, &params.with_proximity_refinement(0).unwrap()).unwrap();
         assert_eq!(floor_elements(&plain).len(), 256);
+        // A board that emits (a lamp hung low) refines nothing.
+        let lamp = Mesh::build(&scene_with_board(0), &params.with_proximity_refinement(2).unwrap()).unwrap();
+        assert_eq!(floor_elements(&lamp).len(), 256);
         // One level halves the floor's elements near the board once.
         let once = Mesh::build(&scene, &params.with_proximity_refinement(1).unwrap()).unwrap();
         let sizes = floor_elements(&once).into_iter().map(|e| longest(&once, e));
