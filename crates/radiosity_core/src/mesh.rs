@@ -1729,9 +1729,10 @@ mod tests {
     }
 
     /// A board 5 cm over a 4 × 4 floor of 25 cm elements: with `proximity_refinement` 0, or
-    /// with a board that emits, the floor is the plain lattice; one level halves the elements near the board
-    /// once; two quarter those under it twice (a quarter of the element size, no finer), leave
-    /// the floor far from it as it was, keep the area, and every surface stays conforming.
+    /// with a board that emits, the floor is the plain lattice; one level halves the elements
+    /// near the board once; two quarter those under it twice (a quarter of the element size,
+    /// no finer), leave the floor far from it as it was, keep the area, and every surface
+    /// stays conforming.
     #[test]
     fn elements_under_a_board_are_quartered_down_to_the_distance() {
         let at = |y: f64, lo: f64, hi: f64| {

@@ -203,7 +203,7 @@ pub(crate) struct MeshDesc {
     /// Halve elements along inside corners this many times, 0 to 6 (default 2).
     pub(crate) corner_refinement: Option<Spanned<u32>>,
     /// Quarter elements that other geometry comes nearer to than half their size this many
-    /// times, 0 to 4 (default 0).
+    /// times, 0 to 4 (default 1).
     pub(crate) proximity_refinement: Option<Spanned<u32>>,
     /// Levels of adaptive subdivision, 0 to 4 (default 2).
     pub(crate) adaptive_levels: Option<Spanned<u32>>,

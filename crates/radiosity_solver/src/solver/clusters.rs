@@ -386,8 +386,8 @@ impl Clusters {
             acc += share(e) / total;
             cdf.push(acc);
         }
-        // A jittered √POINTS × √POINTS grid mapped by the shares: u picks the element, v and the rest of
-        // u place the point in it (as a patch's ray ends, `ray_ends.rs`).
+        // A jittered √POINTS × √POINTS grid mapped by the shares: u picks the element, v and
+        // the rest of u place the point in it (as a patch's ray ends, `ray_ends.rs`).
         let side = (POINTS as f64).sqrt() as usize;
         let mut rng = Rng::for_task(params.seed, GROUP_STREAM ^ g as u64, u64::MAX);
         let mut points = Vec::with_capacity(POINTS);
