@@ -64,6 +64,9 @@ pub fn run(a: ExportArgs) -> Result<()> {
     let prepared = prepare(&a.scene, &a.solve)?;
     let (solver, report) = run_solver(&prepared)?;
     let solution = solver.solution();
+    // The solver's tables and kept rows are not needed past here: on a big model they are
+    // as large as the picture's inputs.
+    drop(solver);
     let mesh = prepared.problem.mesh();
 
     // The exposure for display colours: fixed, or the log-average radiance over the elements

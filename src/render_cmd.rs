@@ -304,6 +304,9 @@ pub fn run(a: RenderArgs) -> Result<()> {
 
     let (solver, report) = run_solver(&prepared)?;
     let solution = solver.solution();
+    // The solver's tables and kept rows are not needed past here: on a big model they are
+    // as large as the picture's inputs.
+    drop(solver);
     let start = Instant::now();
     let renderer = Renderer::new(prepared.problem.mesh().clone());
     // The irradiance cache is gathered before the first row: say so, and keep the spinner

@@ -35,8 +35,8 @@ pub fn run(a: SolveArgs) -> Result<()> {
     let (solver, report) = run_solver(&prepared)?;
     let Prepared { scene, problem, .. } = &prepared;
     let mesh = problem.mesh();
-    let solution = solver.solution();
-    let objects = solution.object_radiosity(mesh);
+    let objects = solver.object_radiosity();
+    drop(solver);
     let secs = report.elapsed.as_secs_f64();
     let stop = report.stop_reason.map_or("running", |s| s.as_str());
     // The source document's figures (S13): facets, iterations, time.

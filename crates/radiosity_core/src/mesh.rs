@@ -478,6 +478,7 @@ impl Smoothing {
                 pairs.extend(group.iter().filter(|&&(_, b)| compatible(a, b)).map(|&(_, b)| (a, b, 1.0)));
             }
         }
+        drop(places);
         t_junctions(mesh, &vertex_surface, 1e-6 * diagonal, &compatible, &mut pairs);
         if pairs.is_empty() {
             return Self::default();
@@ -605,10 +606,16 @@ fn t_junctions(
         cells[first..].iter().take_while(move |&&(k, _)| k == c).map(|&(_, i)| i)
     };
     // The outline's vertices, copies of one place next to each other.
+    // (Each vertex ends two outline edges: its index is deduplicated before the 32-byte
+    // entries are made.)
+    let mut outline_vertices: Vec<u32> = outline.iter().flat_map(|&(a, b)| [a, b]).collect();
+    drop(outline);
+    outline_vertices.sort_unstable();
+    outline_vertices.dedup();
     let mut on_outline: Vec<([u64; 3], u32)> =
-        outline.iter().flat_map(|&(a, b)| [a, b]).map(|v| (bits(mesh.positions[v as usize]), v)).collect();
+        outline_vertices.iter().map(|&v| (bits(mesh.positions[v as usize]), v)).collect();
+    drop(outline_vertices);
     on_outline.sort_unstable();
-    on_outline.dedup();
     for place in on_outline.chunk_by(|x, y| x.0 == y.0) {
         let p = mesh.positions[place[0].1 as usize];
         for i in in_cell(cell(p)) {
@@ -1168,12 +1175,25 @@ impl Mesh {
                         (mesh.materials.len() - 1) as u32
                     })
                 };
+                // The back faces repeat the front's patches, elements and vertices one for one:
+                // room for them at once, rather than doubling tables of millions.
+                let front = &mesh.surfaces[first_surface as usize..];
+                if let (Some(first), Some(last)) = (front.first(), front.last()) {
+                    let patches = (last.patches.end - first.patches.start) as usize;
+                    let elements = (mesh.patches[last.patches.end as usize - 1].elements.end
+                        - mesh.patches[first.patches.start as usize].elements.start)
+                        as usize;
+                    mesh.surfaces.reserve_exact(front.len());
+                    mesh.patches.reserve_exact(patches);
+                    mesh.elements.reserve_exact(elements);
+                }
                 for s in first_surface..mesh.surfaces.len() as u32 {
                     mesh.push_back_face(s, back_material);
                 }
             }
         }
         mesh.contacts_incomplete = contacts.is_some_and(|c| c.budget_spent());
+        mesh.shrink_to_fit();
         mesh.smoothing = Smoothing::new(&mesh, params.crease_angle_deg);
         Ok(mesh)
     }
@@ -1287,6 +1307,17 @@ impl Mesh {
             back: false,
             twin: None,
         });
+    }
+
+    /// Gives back the tables' spare capacity: grown push by push, they hold up to twice
+    /// what a million-facet model needs, for as long as the mesh lives.
+    fn shrink_to_fit(&mut self) {
+        self.positions.shrink_to_fit();
+        self.shading_normals.shrink_to_fit();
+        self.elements.shrink_to_fit();
+        self.patches.shrink_to_fit();
+        self.surfaces.shrink_to_fit();
+        self.occluders.shrink_to_fit();
     }
 
     /// Adds the back face of surface `s`: its vertices (normals negated), patches and elements

@@ -44,42 +44,48 @@ pub struct ObjectRadiosity {
 impl Solution {
     /// Per-object area-weighted mean radiosity, in scene object order.
     pub fn object_radiosity(&self, mesh: &Mesh) -> Vec<ObjectRadiosity> {
-        let mut out: Vec<ObjectRadiosity> = mesh
-            .object_names
-            .iter()
-            .map(|n| ObjectRadiosity {
-                name: n.clone(),
-                area: 0.0,
-                emitted_power: Rgb::ZERO,
-                radiosity: Rgb::ZERO,
-                radiosity_back: None,
-            })
-            .collect();
-        let mut back_area = vec![0.0; out.len()];
-        for (e, el) in mesh.elements.iter().enumerate() {
-            let object = mesh.element_object(e);
-            let o = &mut out[object];
-            o.emitted_power += mesh.element_material(e).emission * el.area;
-            if mesh.element_is_back(e) {
-                back_area[object] += el.area;
-                *o.radiosity_back.get_or_insert(Rgb::ZERO) += self.element_radiosity[e] * el.area;
-            } else {
-                o.area += el.area;
-                o.radiosity += self.element_radiosity[e] * el.area;
-            }
-        }
-        for (o, back_area) in out.iter_mut().zip(back_area) {
-            if o.area > 0.0 {
-                o.radiosity = o.radiosity / o.area;
-            }
-            if let Some(b) = &mut o.radiosity_back
-                && back_area > 0.0
-            {
-                *b = *b / back_area;
-            }
-        }
-        out
+        object_radiosity(mesh, &self.element_radiosity)
     }
+}
+
+/// Per-object area-weighted mean of `element_radiosity` over `mesh`, in scene object order
+/// (front and back faces apart).
+pub(crate) fn object_radiosity(mesh: &Mesh, element_radiosity: &[Rgb]) -> Vec<ObjectRadiosity> {
+    let mut out: Vec<ObjectRadiosity> = mesh
+        .object_names
+        .iter()
+        .map(|n| ObjectRadiosity {
+            name: n.clone(),
+            area: 0.0,
+            emitted_power: Rgb::ZERO,
+            radiosity: Rgb::ZERO,
+            radiosity_back: None,
+        })
+        .collect();
+    let mut back_area = vec![0.0; out.len()];
+    for (e, el) in mesh.elements.iter().enumerate() {
+        let object = mesh.element_object(e);
+        let o = &mut out[object];
+        o.emitted_power += mesh.element_material(e).emission * el.area;
+        if mesh.element_is_back(e) {
+            back_area[object] += el.area;
+            *o.radiosity_back.get_or_insert(Rgb::ZERO) += element_radiosity[e] * el.area;
+        } else {
+            o.area += el.area;
+            o.radiosity += element_radiosity[e] * el.area;
+        }
+    }
+    for (o, back_area) in out.iter_mut().zip(back_area) {
+        if o.area > 0.0 {
+            o.radiosity = o.radiosity / o.area;
+        }
+        if let Some(b) = &mut o.radiosity_back
+            && back_area > 0.0
+        {
+            *b = *b / back_area;
+        }
+    }
+    out
 }
 
 /// Area-weighted average of element values at each vertex, over the elements around it and

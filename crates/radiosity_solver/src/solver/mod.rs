@@ -172,10 +172,17 @@ impl Solver {
         self.tally.energy(&self.mesh)
     }
 
-    /// A snapshot of the current solution.
-    pub fn solution(&self) -> Solution {
+    /// Per-object area-weighted mean radiosity now, in scene object order: what
+    /// [`Solution::object_radiosity`] gives, without the per-vertex averages a snapshot
+    /// holds (on a million-facet model, two tables of hundreds of MB a report never reads).
+    pub fn object_radiosity(&self) -> Vec<crate::ObjectRadiosity> {
+        crate::solution::object_radiosity(&self.mesh, &self.element_radiosity())
+    }
+
+    /// Each element's radiosity now, with the ambient term when it is on.
+    fn element_radiosity(&self) -> Vec<Rgb> {
         let tally = &self.tally;
-        let element_radiosity = match self.params.ambient {
+        match self.params.ambient {
             Ambient::Off => tally.radiosity.clone(),
             Ambient::On => {
                 let unshot_power: Rgb = tally.patch_unshot_power.iter().copied().sum();
@@ -188,7 +195,13 @@ impl Solver {
                     })
                     .collect()
             }
-        };
+        }
+    }
+
+    /// A snapshot of the current solution.
+    pub fn solution(&self) -> Solution {
+        let tally = &self.tally;
+        let element_radiosity = self.element_radiosity();
         Solution {
             vertex_radiosity: vertex_average(
                 &self.mesh,

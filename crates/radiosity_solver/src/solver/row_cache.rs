@@ -24,7 +24,9 @@ const PLAN_CACHE_ENTRIES: usize = 1 << 20;
 /// Each shooter's kept row, or its kept plans.
 pub(super) struct RowCache {
     /// Each shooter's form factors to its receivers, kept up to `params.row_cache_bytes`.
-    rows: Vec<Option<Row>>,
+    /// Boxed: a row inline is some 150 bytes, and a table of millions of patches that keeps
+    /// a few hundred rows was 350 MB of empty slots.
+    rows: Vec<Option<Box<Row>>>,
     row_bytes: usize,
     /// Plans depend on geometry only, so each shooter's plans are kept for its next shots
     /// when its form factors are not, up to [`PLAN_CACHE_ENTRIES`] in all.
@@ -54,7 +56,7 @@ impl RowCache {
 
     /// Takes `shooter`'s kept row out, if it has one; hand it back with [`RowCache::keep`].
     pub(super) fn take(&mut self, shooter: usize) -> Option<Row> {
-        self.rows[shooter].take()
+        self.rows[shooter].take().map(|row| *row)
     }
 
     /// Drops `shooter`'s kept row, if any: it no longer holds.
@@ -84,13 +86,13 @@ impl RowCache {
     ) {
         self.shots[shooter] += 1;
         if was_kept {
-            self.rows[shooter] = Some(row);
+            self.rows[shooter] = Some(Box::new(row));
             return;
         }
         let bytes = row.bytes();
         if !params.reference_path && self.make_room(shooter, bytes) {
             self.row_bytes += bytes;
-            self.rows[shooter] = Some(row);
+            self.rows[shooter] = Some(Box::new(row));
             self.kept.push(shooter);
         } else if self.plans[shooter].is_none() {
             // The row will be computed again: keep its plans.
@@ -112,7 +114,7 @@ impl RowCache {
         }
         let shots = self.shots[shooter];
         let mut victims: Vec<usize> = self.kept.iter().copied().filter(|&k| self.shots[k] < shots).collect();
-        let freeable: usize = victims.iter().filter_map(|&k| self.rows[k].as_ref()).map(Row::bytes).sum();
+        let freeable: usize = victims.iter().filter_map(|&k| self.rows[k].as_deref()).map(Row::bytes).sum();
         if self.row_bytes - freeable + bytes > budget {
             return false;
         }
