@@ -277,10 +277,20 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
     }
     if o.mesh.sides.is_none() {
         let sealed = radiosity_core::seal_closed_objects(&mut scene);
-        if !sealed.is_empty() {
+        let (holed, closed): (Vec<&radiosity_core::Sealed>, Vec<_>) =
+            sealed.iter().partition(|s| s.hole_share > 0.0);
+        if !closed.is_empty() {
             crate::output::note(format_args!(
                 "note: {} closed and lit from outside: meshed one-sided, no light reaches inside (--sides 2 meshes both faces)",
-                name_list(&scene, &sealed)
+                name_list(&scene, &closed.iter().map(|s| s.object).collect::<Vec<_>>())
+            ))?;
+        }
+        if !holed.is_empty() {
+            let widest = holed.iter().map(|s| s.hole_share).fold(0.0, f64::max);
+            crate::output::note(format_args!(
+                "note: {} closed but for small holes (at most {:.1} % of the area) and lit from outside: meshed one-sided, the light through the holes absorbed (--sides 2 meshes both faces)",
+                name_list(&scene, &holed.iter().map(|s| s.object).collect::<Vec<_>>()),
+                widest * 100.0
             ))?;
         }
     }

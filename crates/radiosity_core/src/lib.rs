@@ -40,7 +40,7 @@ pub use scene::{
     Camera, Facing, MAX_POLYGON_VERTICES, MAX_TIME_LIMIT_SECONDS, Material, Object, Polygon, PolygonMesh,
     Scene, SceneError, Shape, Sides, SolverSettings, Sphere, box_faces, unique_names,
 };
-pub use sealed::seal_closed_objects;
+pub use sealed::{MAX_HOLE_SHARE, Sealed, seal_closed_objects};
 pub use srgb::{encode_srgb, srgb_decode, srgb_encode};
 
 /// Re-export of the vector maths used in the public API.
