@@ -56,6 +56,25 @@ unsafe impl GlobalAlloc for Counting {
     }
 }
 
+/// Has glibc's allocator keep the memory a program frees for its next allocations rather
+/// than hand it back to the system at once: every allocation over its mmap threshold (at
+/// most 32 MB) was mapped on its own and unmapped when freed, so the next table of that size
+/// took fresh pages, each zeroed by the kernel on first touch. Meshing and setting up a
+/// 1.1 M-triangle scene made 1.18 M page faults for a 1.79 GB peak, 4.7–8.8 s of system
+/// time; with this, 0.47 M faults, 3.8–4.2 s, and a 1.90 GB peak. Call before any thread
+/// starts.
+pub fn keep_freed_memory() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: `mallopt` only sets the allocator's parameters; no allocation is in flight on
+    // another thread yet.
+    unsafe {
+        // No allocation mapped on its own: all come from the heap, which reuses what is freed...
+        libc::mallopt(libc::M_MMAP_MAX, 0);
+        // ...and gives its free top back to the system only past 2 GB.
+        libc::mallopt(libc::M_TRIM_THRESHOLD, i32::MAX);
+    }
+}
+
 /// Heap bytes live now.
 pub fn live() -> usize {
     LIVE.load(Ordering::Relaxed)

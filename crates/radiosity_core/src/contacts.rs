@@ -16,7 +16,7 @@
 //! surface; smoothing pools their vertices as it does for any coplanar surfaces of one object.
 //! Footprints of more than [`MAX_FOOTPRINT_CORNERS`] corners do not cut (see there).
 
-use std::collections::HashMap;
+use rustc_hash::FxHashMap as HashMap;
 
 use glam::DVec3;
 
@@ -475,8 +475,8 @@ fn chain(edges: &[Edge], n: DVec3) -> Vec<Vec<DVec3>> {
         let (ka, kb) = (key(a), key(b));
         if ka < kb { (ka, kb) } else { (kb, ka) }
     };
-    let mut face_normal = HashMap::new();
-    let mut first_face = HashMap::new();
+    let mut face_normal = HashMap::default();
+    let mut first_face = HashMap::default();
     let mut inside = std::collections::HashSet::new();
     for &(a, b, normal, centre) in edges {
         if key(a) == key(b) {
@@ -495,7 +495,7 @@ fn chain(edges: &[Edge], n: DVec3) -> Vec<Vec<DVec3>> {
             Some(_) => {}
         }
     }
-    let mut next: HashMap<[u64; 3], Vec<DVec3>> = HashMap::new();
+    let mut next: HashMap<[u64; 3], Vec<DVec3>> = HashMap::default();
     let mut added = std::collections::HashSet::new();
     for &(a, b, _, _) in edges {
         let pair = pair_of(a, b);

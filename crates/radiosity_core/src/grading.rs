@@ -19,7 +19,7 @@
 //! its sides is cut into triangles that use it, so smooth shading has no T-vertex to tear at.
 //! Each element keeps its patch.
 
-use std::collections::HashMap;
+use rustc_hash::FxHashMap as HashMap;
 
 use glam::DVec3;
 
@@ -261,7 +261,7 @@ mod tests {
     /// Every element side is either used twice with opposite directions or lies on the
     /// outline of the unit square: no T-vertex, no overlap, no hole.
     fn assert_conforming(b: &SurfaceBuilder) {
-        let mut sides: HashMap<(u32, u32), i32> = HashMap::new();
+        let mut sides: HashMap<(u32, u32), i32> = HashMap::default();
         for (vs, _) in &b.elements {
             for i in 0..vs.len() {
                 let (p, q) = (vs[i], vs[(i + 1) % vs.len()]);

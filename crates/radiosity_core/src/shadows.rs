@@ -23,7 +23,7 @@
 //! blocks are): all their corners lie on or behind each face. Concave objects and tessellated
 //! models cast no outlines; they are left to adaptive subdivision.
 
-use std::collections::HashMap;
+use rustc_hash::FxHashMap as HashMap;
 
 use glam::{DVec2, DVec3};
 
@@ -253,7 +253,7 @@ fn solids(scene: &Scene) -> Vec<Vec<DVec3>> {
         .collect();
     // Union–find over faces: a face joins the first face met at each of its corners.
     let mut sets = UnionFind::new(faces.len());
-    let mut first_at: HashMap<[u64; 3], u32> = HashMap::new();
+    let mut first_at: HashMap<[u64; 3], u32> = HashMap::default();
     for (f, p) in (0u32..).zip(&faces) {
         for &q in p.vertices() {
             let other = *first_at.entry(key(q)).or_insert(f);

@@ -25,7 +25,7 @@
 //! `radiosity_core::Mesh::build`). Degenerate faces are dropped with a warning count; an
 //! object left with no face is an error.
 
-use std::collections::HashMap;
+use rustc_hash::FxHashMap as HashMap;
 use std::path::Path;
 
 use radiosity_core::glam::{DMat4, DQuat, DVec3};
@@ -343,7 +343,7 @@ impl PartBuilder {
             world_from_model,
             mirrored: world_from_model.determinant() < 0.0,
             positions: Vec::new(),
-            index_of: HashMap::new(),
+            index_of: HashMap::default(),
             faces: Vec::new(),
             dropped: 0,
         }

@@ -6,8 +6,8 @@
 //! Each MTL library is checked line by line before `tobj` sees it ([`check_mtl`]): `tobj`
 //! panics on a colour of fewer than three numbers, and its other MTL errors name no line.
 
+use rustc_hash::FxHashMap as HashMap;
 use std::cell::RefCell;
-use std::collections::HashMap;
 use std::io::Cursor;
 use std::path::Path;
 
@@ -297,7 +297,7 @@ pub(crate) fn parse_obj(
 
     // Our materials: those the parts use, in order of first use, plus the grey default.
     let mut out_materials: Vec<radiosity_core::Material> = Vec::new();
-    let mut material_of: HashMap<Option<usize>, usize> = HashMap::new();
+    let mut material_of: HashMap<Option<usize>, usize> = HashMap::default();
     let mut resolve = |id: Option<usize>, warnings: &mut Vec<String>| -> Result<usize, LoadError> {
         if let Some(&m) = material_of.get(&id) {
             return Ok(m);
@@ -449,7 +449,7 @@ pub(crate) fn parse_obj(
         return Err(model_error(origin, None, "no face with an area: every face is degenerate"));
     }
     // tobj starts a new model at each `usemtl`: parts named alike are told apart by material.
-    let mut counts: HashMap<&str, usize> = HashMap::new();
+    let mut counts: HashMap<&str, usize> = HashMap::default();
     for p in &parts {
         *counts.entry(p.name.as_str()).or_insert(0) += 1;
     }
