@@ -98,7 +98,7 @@ def torus_knot(segments=96, sides=12, p=2, q=3):
         for j in range(sides):
             a0, a1 = i * sides + j, i * sides + (j + 1) % sides
             b0, b1 = ((i + 1) % segments) * sides + j, ((i + 1) % segments) * sides + (j + 1) % sides
-            faces += [(a0, b0, b1), (a0, b1, a1)]
+            faces += [(a0, b1, b0), (a0, a1, b1)]  # wound outwards (positive volume)
     return verts, np.array(faces)
 
 

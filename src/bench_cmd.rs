@@ -231,7 +231,9 @@ fn big_case(scene_arg: &str, clustering: bool) -> Result<serde_json::Value> {
     alloc::reset_peak();
     let before = alloc::live();
     let start = Instant::now();
-    let scene = radiosity_io::resolve_scene(scene_arg)?.scene;
+    let mut scene = radiosity_io::resolve_scene(scene_arg)?.scene;
+    // As `solve` does without `--sides`: closed models lit from outside are one-sided.
+    radiosity_core::seal_closed_objects(&mut scene);
     let loaded = start.elapsed().as_secs_f64();
     let problem = Problem::new(&scene, &scene.mesh_params())?;
     let meshed = start.elapsed().as_secs_f64() - loaded;

@@ -285,6 +285,13 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
                 name_list(&scene, &closed.iter().map(|s| s.object).collect::<Vec<_>>())
             ))?;
         }
+        let turned: Vec<usize> = sealed.iter().filter(|s| s.turned).map(|s| s.object).collect();
+        if !turned.is_empty() {
+            crate::output::note(format_args!(
+                "note: {} wound with the light on the back of every face: turned over",
+                name_list(&scene, &turned)
+            ))?;
+        }
         if !holed.is_empty() {
             let widest = holed.iter().map(|s| s.hole_share).fold(0.0, f64::max);
             crate::output::note(format_args!(

@@ -290,6 +290,14 @@ impl Polygon {
         self.area
     }
 
+    /// The same polygon lit from its other side: the first vertex kept, the rest in reverse
+    /// order, the normal negated.
+    pub fn flipped(&self) -> Self {
+        let mut vertices = self.vertices.clone();
+        vertices[1..].reverse();
+        Self { vertices, normal: -self.normal, area: self.area }
+    }
+
     /// The same polygon with its vertices transformed by `f` (must keep it planar and convex,
     /// e.g. a rigid motion or a uniform scale).
     ///
@@ -339,6 +347,22 @@ impl PolygonMesh {
             polygons.push(polygon);
         }
         Ok(Self { positions, faces, polygons })
+    }
+
+    /// The same mesh with every face lit from its other side ([`Polygon::flipped`]).
+    pub fn flipped(&self) -> Self {
+        let faces = (self.faces.iter())
+            .map(|f| {
+                let mut f = f.clone();
+                f[1..].reverse();
+                f
+            })
+            .collect();
+        Self {
+            positions: self.positions.clone(),
+            faces,
+            polygons: self.polygons.iter().map(Polygon::flipped).collect(),
+        }
     }
 
     /// Vertex positions, scene units.

@@ -54,11 +54,16 @@ pub struct Sealed {
     /// The area its holes span over its surface's area: 0 for a watertight surface, at most
     /// [`MAX_HOLE_SHARE`].
     pub hole_share: f64,
+    /// Its faces were turned: every emitter lay on their back side, so their fronts enclosed
+    /// a space no light reaches (a model whose normals point inwards, a room whose normals
+    /// point out).
+    pub turned: bool,
 }
 
 /// Makes one-sided every two-sided, non-emitting object of `scene` whose faces close up into
 /// one consistently wound surface, but for holes spanning at most [`MAX_HOLE_SHARE`] of its
-/// area, with no emitter on its back side; returns them in scene order.
+/// area, with no emitter on its back side, or with every emitter on it (then its faces are
+/// turned, so that the side the light is on is their front); returns them in scene order.
 pub fn seal_closed_objects(scene: &mut Scene) -> Vec<Sealed> {
     let points = emitter_points(scene);
     let mut sealed = Vec::new();
@@ -74,10 +79,21 @@ pub fn seal_closed_objects(scene: &mut Scene) -> Vec<Sealed> {
         }
         let Some(holes) = Holes::of(polygons) else { continue };
         let surface = Closed::new(polygons, &holes.caps);
-        if points.iter().all(|&p| !surface.behind(p)) {
-            o.sides = Sides::One;
-            sealed.push(Sealed { object: i, hole_share: holes.share });
+        let behind = points.iter().filter(|&&p| surface.behind(p)).count();
+        let turned = match behind {
+            0 => false,
+            n if n == points.len() => true,
+            _ => continue,
+        };
+        if turned {
+            o.shape = match &o.shape {
+                Shape::Polygons(ps) => Shape::Polygons(ps.iter().map(Polygon::flipped).collect()),
+                Shape::Mesh(m) => Shape::Mesh(m.flipped()),
+                Shape::Sphere(_) => continue,
+            };
         }
+        o.sides = Sides::One;
+        sealed.push(Sealed { object: i, hole_share: holes.share, turned });
     }
     sealed
 }
@@ -359,8 +375,8 @@ mod tests {
     }
 
     /// A scan with small holes (two cells of one face, 2/96 of the area) is sealed, its
-    /// holes' share reported; with its lamp inside, or with holes past `MAX_HOLE_SHARE`
-    /// (a whole face: a fifth), it keeps both sides.
+    /// holes' share reported, and turned when its lamp is inside; with holes that touch or
+    /// reach past `MAX_HOLE_SHARE` (a whole face: a fifth), it keeps both sides.
     #[test]
     fn a_box_with_small_holes_is_sealed_a_wide_open_one_is_not() {
         let mut s = scene(vec![lamp(DVec3::new(0.5, 3.0, 0.5), true), gridded_box(&[(0, 5), (0, 7)])]);
@@ -371,8 +387,10 @@ mod tests {
         assert!((got[0].hole_share - expected).abs() < 1e-12, "{} vs {expected}", got[0].hole_share);
         assert_eq!(s.objects[1].sides, Sides::One);
 
+        // Its lamp inside: its outside gets only what leaks through the holes.
         let mut inside = scene(vec![lamp(DVec3::new(0.5, 0.5, 0.5), true), gridded_box(&[(0, 5), (0, 7)])]);
-        assert!(sealed(&mut inside).is_empty(), "lamp inside a box with small holes");
+        let got = seal_closed_objects(&mut inside);
+        assert!(got.len() == 1 && got[0].turned, "lamp inside a box with small holes: {got:?}");
 
         // Two holes that meet at a corner: the rims cannot be told apart there.
         let mut touching =
@@ -394,22 +412,60 @@ mod tests {
         }
     }
 
-    /// A lamp inside a box wound outwards lights its back faces: they stay.
+    /// A lamp inside a box wound outwards lights its back faces only: it is turned inside
+    /// out (a room modelled as a box with its normals out) and sealed so.
     #[test]
-    fn a_box_with_its_lamp_inside_keeps_both_sides() {
-        let mut s = scene(vec![lamp(DVec3::new(0.5, 0.9, 0.5), true), boxed(Facing::Outward, true)]);
-        assert!(seal_closed_objects(&mut s).is_empty());
-        assert_eq!(s.objects[1].sides, Sides::Two { emits_back: false });
+    fn a_box_with_its_lamp_inside_is_turned_inside_out() {
+        for as_mesh in [false, true] {
+            let mut s = scene(vec![lamp(DVec3::new(0.5, 0.9, 0.5), true), boxed(Facing::Outward, as_mesh)]);
+            assert_eq!(
+                seal_closed_objects(&mut s),
+                vec![Sealed { object: 1, hole_share: 0.0, turned: true }]
+            );
+            assert_eq!(s.objects[1].sides, Sides::One);
+            let polygons = match &s.objects[1].shape {
+                Shape::Polygons(ps) => ps.clone(),
+                Shape::Mesh(m) => m.polygons().to_vec(),
+                Shape::Sphere(_) => unreachable!(),
+            };
+            for p in &polygons {
+                let centre = p.vertices().iter().sum::<DVec3>() / p.vertices().len() as f64;
+                assert!(p.normal().dot(centre - DVec3::splat(0.5)) < 0.0, "mesh {as_mesh}: faces the inside");
+            }
+        }
     }
 
     /// A room wound inwards with its lamp inside: its outside is its back, which no light
-    /// reaches. With a lamp outside it instead, the back stays.
+    /// reaches. With its lamp outside instead (a model whose normals point inwards), its
+    /// faces are turned outwards and it is sealed so; with lamps on both sides it keeps both.
     #[test]
-    fn a_room_wound_inwards_is_sealed_with_its_lamp_inside_only() {
+    fn a_closed_surface_is_sealed_on_the_side_its_lamps_are() {
         let mut s = scene(vec![lamp(DVec3::new(0.5, 0.9, 0.5), true), boxed(Facing::Inward, true)]);
-        assert_eq!(sealed(&mut s), vec![1]);
+        let got = seal_closed_objects(&mut s);
+        assert_eq!(got, vec![Sealed { object: 1, hole_share: 0.0, turned: false }]);
+
+        let facing_out = |o: &Object| match &o.shape {
+            Shape::Mesh(m) => m.polygons().iter().all(|p| {
+                let centre = p.vertices().iter().sum::<DVec3>() / p.vertices().len() as f64;
+                p.normal().dot(centre - DVec3::splat(0.5)) > 0.0
+            }),
+            _ => panic!("a mesh was given"),
+        };
         let mut s = scene(vec![lamp(DVec3::new(0.5, 3.0, 0.5), true), boxed(Facing::Inward, true)]);
+        assert!(!facing_out(&s.objects[1]));
+        let got = seal_closed_objects(&mut s);
+        assert_eq!(got, vec![Sealed { object: 1, hole_share: 0.0, turned: true }]);
+        assert_eq!(s.objects[1].sides, Sides::One);
+        assert!(facing_out(&s.objects[1]), "turned outwards");
+
+        let both = vec![
+            lamp(DVec3::new(0.5, 0.9, 0.5), true),
+            lamp(DVec3::new(0.5, 3.0, 0.5), true),
+            boxed(Facing::Inward, true),
+        ];
+        let mut s = scene(both);
         assert!(seal_closed_objects(&mut s).is_empty());
+        assert_eq!(s.objects[2].sides, Sides::Two { emits_back: false });
     }
 
     /// A box without its top, or with one face turned over, is not closed.
