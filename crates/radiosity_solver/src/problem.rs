@@ -204,6 +204,7 @@ impl std::fmt::Debug for Problem {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Ambient;
     use radiosity_core::furnace_box;
 
     /// The problem's solver gives what the hand-built mesh and BVH give, bit for bit: the
@@ -221,6 +222,22 @@ mod tests {
         by_hand.solve();
         assert_eq!(via_problem.solution().element_radiosity, by_hand.solution().element_radiosity);
         assert!(via_problem.solution().shots > 0);
+    }
+
+    /// The solver's object means (what `solve` prints) are the snapshot's, ambient term
+    /// included, and mid-solve (unshot power left for the ambient term to stand for).
+    #[test]
+    fn object_means_without_a_snapshot_are_the_snapshots() {
+        let scene = radiosity_core::cornell_box();
+        for ambient in [Ambient::Off, Ambient::On] {
+            let params = SolverParams { max_shots: Some(30), ambient, ..SolverParams::preview() };
+            let problem = Problem::new(&scene, &scene.mesh_params()).unwrap();
+            let mut solver = problem.solver(params).unwrap();
+            solver.solve();
+            let direct = solver.object_radiosity();
+            assert_eq!(direct, solver.solution().object_radiosity(problem.mesh()), "{ambient:?}");
+            assert!(direct.iter().any(|o| o.radiosity.sum() > 0.0));
+        }
     }
 
     #[test]
