@@ -277,26 +277,24 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
     }
     if o.mesh.sides.is_none() {
         let sealed = radiosity_core::seal_closed_objects(&mut scene);
-        let (holed, closed): (Vec<&radiosity_core::Sealed>, Vec<_>) =
-            sealed.iter().partition(|s| s.hole_share > 0.0);
-        if !closed.is_empty() {
+        let names = |keep: fn(&radiosity_core::Sealed) -> bool| {
+            let objects: Vec<usize> = sealed.iter().filter(|s| keep(s)).map(|s| s.object).collect();
+            (!objects.is_empty()).then(|| name_list(&scene, &objects))
+        };
+        if let Some(closed) = names(|s| s.hole_share == 0.0) {
             crate::output::note(format_args!(
-                "note: {} closed and lit from outside: meshed one-sided, no light reaches inside (--sides 2 meshes both faces)",
-                name_list(&scene, &closed.iter().map(|s| s.object).collect::<Vec<_>>())
+                "note: {closed} closed and lit from outside: meshed one-sided, no light reaches inside (--sides 2 meshes both faces)"
             ))?;
         }
-        let turned: Vec<usize> = sealed.iter().filter(|s| s.turned).map(|s| s.object).collect();
-        if !turned.is_empty() {
+        if let Some(turned) = names(|s| s.turned) {
             crate::output::note(format_args!(
-                "note: {} wound with the light on the back of every face: turned over",
-                name_list(&scene, &turned)
+                "note: {turned} wound with the light on the back of every face: turned over"
             ))?;
         }
-        if !holed.is_empty() {
-            let widest = holed.iter().map(|s| s.hole_share).fold(0.0, f64::max);
+        if let Some(holed) = names(|s| s.hole_share > 0.0) {
+            let widest = sealed.iter().map(|s| s.hole_share).fold(0.0, f64::max);
             crate::output::note(format_args!(
-                "note: {} closed but for small holes (at most {:.1} % of the area) and lit from outside: meshed one-sided, the light through the holes absorbed (--sides 2 meshes both faces)",
-                name_list(&scene, &holed.iter().map(|s| s.object).collect::<Vec<_>>()),
+                "note: {holed} closed but for small holes (at most {:.1} % of the area) and lit from outside: meshed one-sided, the light through the holes absorbed (--sides 2 meshes both faces)",
                 widest * 100.0
             ))?;
         }

@@ -317,21 +317,26 @@ mod tests {
         }
     }
 
+    /// `faces` (corner lists) as one mesh whose corners in the same place share a vertex,
+    /// as a model file gives them.
+    fn shared_mesh(faces: impl IntoIterator<Item = Vec<DVec3>>) -> PolygonMesh {
+        let mut positions: Vec<DVec3> = Vec::new();
+        let mut index = |q: DVec3| match positions.iter().position(|&p| p == q) {
+            Some(i) => i as u32,
+            None => {
+                positions.push(q);
+                (positions.len() - 1) as u32
+            }
+        };
+        let faces: Vec<Vec<u32>> =
+            faces.into_iter().map(|f| f.into_iter().map(&mut index).collect()).collect();
+        PolygonMesh::try_new(positions, faces).unwrap()
+    }
+
     fn boxed(normals: Facing, faces_as_mesh: bool) -> Object {
         let faces = box_faces(DVec3::ZERO, DVec3::ONE, normals, 0.0).unwrap();
         let shape = if faces_as_mesh {
-            // Shared vertices, as a model file gives them.
-            let mut positions: Vec<DVec3> = Vec::new();
-            let mut index = |q: DVec3| match positions.iter().position(|&p| p == q) {
-                Some(i) => i as u32,
-                None => {
-                    positions.push(q);
-                    (positions.len() - 1) as u32
-                }
-            };
-            let faces: Vec<Vec<u32>> =
-                faces.iter().map(|f| f.vertices().iter().map(|&q| index(q)).collect()).collect();
-            Shape::Mesh(PolygonMesh::try_new(positions, faces).unwrap())
+            Shape::Mesh(shared_mesh(faces.iter().map(|f| f.vertices().to_vec())))
         } else {
             Shape::Polygons(faces)
         };
@@ -356,8 +361,7 @@ mod tests {
     /// the quads `missing` (face, cell) left out.
     fn gridded_box(missing: &[(usize, usize)]) -> Object {
         let faces = box_faces(DVec3::ZERO, DVec3::ONE, Facing::Outward, 0.0).unwrap();
-        let mut positions: Vec<DVec3> = Vec::new();
-        let mut quads: Vec<Vec<u32>> = Vec::new();
+        let mut quads: Vec<Vec<DVec3>> = Vec::new();
         for (f, face) in faces.iter().enumerate() {
             let v = face.vertices();
             let at = |a: usize, b: usize| {
@@ -365,22 +369,10 @@ mod tests {
             };
             for cell in (0..16).filter(|c| !missing.contains(&(f, *c))) {
                 let (a, b) = (cell % 4, cell / 4);
-                let corners = [at(a, b), at(a + 1, b), at(a + 1, b + 1), at(a, b + 1)];
-                quads.push(
-                    corners
-                        .iter()
-                        .map(|&q| match positions.iter().position(|&p| p == q) {
-                            Some(i) => i as u32,
-                            None => {
-                                positions.push(q);
-                                (positions.len() - 1) as u32
-                            }
-                        })
-                        .collect(),
-                );
+                quads.push(vec![at(a, b), at(a + 1, b), at(a + 1, b + 1), at(a, b + 1)]);
             }
         }
-        let shape = Shape::Mesh(PolygonMesh::try_new(positions, quads).unwrap());
+        let shape = Shape::Mesh(shared_mesh(quads));
         Object { name: "scan".into(), material: 1, shape, sides: Sides::Two { emits_back: false } }
     }
 
@@ -417,21 +409,11 @@ mod tests {
     /// the surface still encloses what no light reaches.
     #[test]
     fn solids_meeting_along_an_edge_are_sealed() {
-        let mut positions: Vec<DVec3> = Vec::new();
-        let mut faces: Vec<Vec<u32>> = Vec::new();
-        for lo in [DVec3::ZERO, DVec3::new(1.0, 1.0, 0.0)] {
-            for f in box_faces(lo, lo + DVec3::ONE, Facing::Outward, 0.0).unwrap() {
-                let face = f.vertices().iter().map(|&q| match positions.iter().position(|&p| p == q) {
-                    Some(i) => i as u32,
-                    None => {
-                        positions.push(q);
-                        (positions.len() - 1) as u32
-                    }
-                });
-                faces.push(face.collect());
-            }
-        }
-        let shape = Shape::Mesh(PolygonMesh::try_new(positions, faces).unwrap());
+        let faces = [DVec3::ZERO, DVec3::new(1.0, 1.0, 0.0)]
+            .into_iter()
+            .flat_map(|lo| box_faces(lo, lo + DVec3::ONE, Facing::Outward, 0.0).unwrap())
+            .map(|f| f.vertices().to_vec());
+        let shape = Shape::Mesh(shared_mesh(faces));
         let cubes =
             Object { name: "cubes".into(), material: 1, shape, sides: Sides::Two { emits_back: false } };
         let mut s = scene(vec![lamp(DVec3::new(0.5, 3.0, 0.5), true), cubes]);
