@@ -365,7 +365,15 @@ fn receive_shared(shot: &Shot, plans: &[PatchPlan], element_area: &[f64], factor
             if ahead <= 0.0 {
                 continue;
             }
-            let facing = corners.iter().map(|c| normal.dot(*c - p)).fold(f64::INFINITY, f64::min);
+            // The shooter's corners' heights over the member's plane: all at or below it,
+            // the member sees none of the shooter (half of a curved model's facets; the
+            // clipping below found so too, and took a fifth of the sharing groups' time).
+            let heights = corners.iter().map(|c| normal.dot(*c - p));
+            let (facing, highest) =
+                heights.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), h| (lo.min(h), hi.max(h)));
+            if highest <= 0.0 {
+                continue;
+            }
             if facing > tolerance && ahead > tolerance {
                 batch[n] = k;
                 n += 1;
