@@ -232,7 +232,7 @@ fn big_case(scene_arg: &str, clustering: bool) -> Result<serde_json::Value> {
     let before = alloc::live();
     let start = Instant::now();
     let mut scene = radiosity_io::resolve_scene(scene_arg)?.scene;
-    // As `solve` does without `--sides`: closed models lit from outside are one-sided.
+    // As `solve` does without `--sides`: closed models lit from one side are one-sided.
     radiosity_core::seal_closed_objects(&mut scene);
     let loaded = start.elapsed().as_secs_f64();
     let problem = Problem::new(&scene, &scene.mesh_params())?;

@@ -283,7 +283,7 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
         };
         if let Some(closed) = names(|s| s.hole_share == 0.0) {
             crate::output::note(format_args!(
-                "note: {closed} closed and lit from outside: meshed one-sided, no light reaches inside (--sides 2 meshes both faces)"
+                "note: {closed} closed with the light on one side only: meshed one-sided, no light reaches the other (--sides 2 meshes both faces)"
             ))?;
         }
         if let Some(turned) = names(|s| s.turned) {
@@ -294,7 +294,7 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
         if let Some(holed) = names(|s| s.hole_share > 0.0) {
             let widest = sealed.iter().map(|s| s.hole_share).fold(0.0, f64::max);
             crate::output::note(format_args!(
-                "note: {holed} closed but for small holes (at most {:.1} % of the area) and lit from outside: meshed one-sided, the light through the holes absorbed (--sides 2 meshes both faces)",
+                "note: {holed} closed but for small holes (at most {:.1} % of the area) with the light on one side only: meshed one-sided, the light through the holes absorbed (--sides 2 meshes both faces)",
                 widest * 100.0
             ))?;
         }

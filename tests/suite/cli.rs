@@ -539,8 +539,8 @@ fn a_closed_model_lit_from_outside_is_meshed_one_sided() {
         (leading_count(&String::from_utf8_lossy(&o.stdout), "elements"), stderr(&o))
     };
     let ((sealed, said), (both, quiet)) = (info(&[]), info(&["--sides", "2"]));
-    assert!(said.contains("'ball' is closed and lit from outside: meshed one-sided"), "{said}");
-    assert!(!quiet.contains("closed and lit from outside"), "{quiet}");
+    assert!(said.contains("'ball' is closed with the light on one side only: meshed one-sided"), "{said}");
+    assert!(!quiet.contains("closed with the light on one side only"), "{quiet}");
     assert!(both >= sealed + 16 * 32, "elements: {sealed} sealed, {both} with both sides");
     let ball = |extra: &[&str]| {
         let json = dir.path().join(format!("ball{}.json", extra.len()));

@@ -1,4 +1,4 @@
-//! Closed models lit from outside.
+//! Closed models lit from one side.
 //!
 //! A model's faces that close up into one consistently wound surface (every edge run along
 //! as often in each direction: shared by two faces, or by two pairs where solids meet along

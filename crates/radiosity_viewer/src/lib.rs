@@ -196,7 +196,7 @@ pub fn default_samples() -> u32 {
 }
 
 /// Loads a scene file or built-in name, the error on one line as the command prints it
-/// ([`radiosity_core::one_line`]), with closed models lit from outside made one-sided as the
+/// ([`radiosity_core::one_line`]), with closed models lit from one side made one-sided as the
 /// command does ([`radiosity_core::seal_closed_objects`]). The loader's warnings are
 /// dropped: the window has no place for them yet.
 fn load_scene(arg: &str) -> Result<Scene, String> {
@@ -227,7 +227,7 @@ mod tests {
         assert!(load_scene("cornell").is_ok());
     }
 
-    /// A scene opened in the window has its closed models lit from outside made one-sided, as
+    /// A scene opened in the window has its closed models lit from one side made one-sided, as
     /// the command's: a cube (an OBJ, so two-sided) under a lamp.
     #[test]
     fn the_window_seals_closed_models_as_the_command_does() {
