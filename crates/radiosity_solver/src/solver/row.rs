@@ -184,6 +184,7 @@ impl Solver {
         let scratch = &mut self.scratch;
         scratch.load_shooter(&mesh, patch, &self.tables.element_radii);
         let cdf = self.first_shots.cdf(&mesh, shooter);
+        scratch.near_runs.load(&scratch.shooter_elements, cdf, patch.centre);
         let lift = patch.normal * self.tables.ray_offset;
         let (targets, lifted) = (&mut scratch.targets, &mut scratch.lifted_targets);
         draw_ray_ends(
@@ -211,6 +212,7 @@ impl Solver {
             lifted_targets: &scratch.lifted_targets,
             shooter_elements: &scratch.shooter_elements,
             cdf,
+            near_runs: &scratch.near_runs,
             vertex_means: &tables.vertex_means,
             element_radii: &tables.element_radii,
             lifted_corners: &tables.lifted_corners,

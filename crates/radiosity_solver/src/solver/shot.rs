@@ -8,6 +8,7 @@ use radiosity_core::{Mesh, Patch};
 use super::SolverParams;
 use super::clusters::Clusters;
 use super::plans::PatchPlan;
+use super::rays::NearRuns;
 use super::receive::Received;
 use super::shared::Sharing;
 use super::uneven::{Cluster, Uneven};
@@ -69,6 +70,8 @@ pub(super) struct Shot<'a> {
     /// Their cumulative shares of its unshot power when its spread was last fixed (see
     /// `first_shots`).
     pub(super) cdf: &'a [f64],
+    /// The same, by runs, as near receivers weigh them (see `rays::NearEnds`).
+    pub(super) near_runs: &'a NearRuns,
     /// Every element's vertex mean (see `MeshTables::vertex_means`).
     pub(super) vertex_means: &'a [DVec3],
     /// Every element's circumradius.
@@ -145,6 +148,8 @@ pub(super) struct ShotScratch {
     pub(super) group_factors: Vec<f32>,
     /// Which receiving groups share their visibility in this shot.
     pub(super) sharing: Sharing,
+    /// The shooter's runs of elements for its near receivers' ray ends.
+    pub(super) near_runs: NearRuns,
 }
 
 impl ShotScratch {
@@ -162,6 +167,7 @@ impl ShotScratch {
             cluster_order: Vec::new(),
             group_factors: Vec::new(),
             sharing: Sharing::default(),
+            near_runs: NearRuns::default(),
         }
     }
 
