@@ -216,11 +216,7 @@ impl Solver {
             vertex_means: &tables.vertex_means,
             element_radii: &tables.element_radii,
             lifted_corners: &tables.lifted_corners,
-            uneven: density.map(|density| Uneven {
-                density,
-                clusters: &scratch.clusters,
-                order: &scratch.cluster_order,
-            }),
+            uneven: density.map(|_| Uneven { clusters: &scratch.clusters }),
             accel: &*self.accel,
             boxes: &tables.occluder_boxes,
             blockers: &tables.blockers,
