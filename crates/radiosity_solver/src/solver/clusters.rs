@@ -31,7 +31,7 @@
 use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use glam::{DVec3, Vec3};
+use glam::{DVec3, Vec3, Vec4};
 use radiosity_accel::RayQuery;
 use radiosity_core::{Mesh, Rgb};
 
@@ -144,8 +144,11 @@ pub(super) struct Tile {
 /// A group's unshot power as its first shot spread it.
 struct Frozen {
     /// Σ_k w_k n_k over its elements, w_k their shares of its unshot power, summed per bin of
-    /// normals (see [`normal_bin`]); empty bins left out.
-    axes: Vec<DVec3>,
+    /// normals (see [`normal_bin`]); empty bins left out. Four to a lane group by
+    /// coordinate, in single precision, the last group padded with zero axes: every far
+    /// receiver of the group's row weighs them all (one by one in double precision, that
+    /// was 8 % of a knot room's solve).
+    axes: Vec<[Vec4; 3]>,
     /// Points drawn over it by unshot power, with their element's normal and patch.
     points: Vec<(DVec3, DVec3, u32)>,
     /// The same points lifted off their facets, in single precision: the rays' ends.
@@ -155,6 +158,19 @@ struct Frozen {
     near: NearPoints,
     /// Its first shot carried at least `bright_share` of the solve's first shot.
     bright: bool,
+}
+
+impl Frozen {
+    /// Σ_a max(a · d, 0) over its axes: the group's far field towards unit direction `d`
+    /// (see [`unoccluded`]).
+    fn lobe(&self, d: DVec3) -> f64 {
+        let d = d.as_vec3();
+        let sum = self
+            .axes
+            .iter()
+            .fold(Vec4::ZERO, |sum, [x, y, z]| sum + (*x * d.x + *y * d.y + *z * d.z).max(Vec4::ZERO));
+        f64::from(sum.element_sum())
+    }
 }
 
 /// Who shoots next.
@@ -375,10 +391,21 @@ impl Clusters {
         // vector a sends out π|a| over the sphere, and |Σ w_k n_k| < Σ w_k when the normals
         // differ, so unscaled the far field lost what a curved group's bins spread (the
         // members' own lobes send out exactly their shares).
-        let axes = bins
+        let axes: Vec<DVec3> = bins
             .into_iter()
             .filter(|(a, _)| *a != DVec3::ZERO)
             .map(|(a, w)| a.normalize_or_zero() * w)
+            .collect();
+        let axes = axes
+            .chunks(4)
+            .map(|four| {
+                let mut lanes = [Vec4::ZERO; 3];
+                for (lane, a) in four.iter().enumerate() {
+                    let a = a.as_vec3();
+                    (lanes[0][lane], lanes[1][lane], lanes[2][lane]) = (a.x, a.y, a.z);
+                }
+                lanes
+            })
             .collect();
         let mut cdf = Vec::with_capacity(elements.len());
         let mut acc = 0.0;
@@ -685,7 +712,7 @@ fn unoccluded(
         if cos_r <= 0.0 {
             return (0.0, false);
         }
-        let out: f64 = frozen.axes.iter().map(|a| a.dot(d).max(0.0)).sum();
+        let out = frozen.lobe(d);
         return (group.area * out * cos_r / (std::f64::consts::PI * r2), false);
     }
     let disc = group.area / POINTS as f64;
@@ -951,7 +978,7 @@ mod tests {
                 for j in 0..columns {
                     let phi = std::f64::consts::TAU * (f64::from(j) + 0.5) / f64::from(columns);
                     let d = DVec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
-                    let lobe: f64 = frozen.axes.iter().map(|a| a.dot(d).max(0.0)).sum();
+                    let lobe = frozen.lobe(d);
                     sent += lobe * theta.sin();
                 }
             }
@@ -969,7 +996,8 @@ mod tests {
         let (mesh, clusters, groups) = frozen_globe(|n| vec![0, n / 2]);
         for g in groups {
             let (group, frozen) = (clusters.group(g), clusters.groups[g].frozen.as_ref().unwrap());
-            let axis = frozen.axes.iter().sum::<DVec3>().normalize();
+            let sum = |k: usize| frozen.axes.iter().map(|a| f64::from(a[k].element_sum())).sum::<f64>();
+            let axis = DVec3::new(sum(0), sum(1), sum(2)).normalize();
             for tilt in [DVec3::ZERO, DVec3::X * 0.5, DVec3::Z * 0.5] {
                 let dir = (axis + tilt).normalize();
                 let p = group.centre + dir * 10.0 * group.radius;
