@@ -145,7 +145,7 @@ pub struct SolveOpts {
     /// (largest) shot's power; 0: every shooter is.
     #[arg(long, allow_negative_numbers = true, default_value_t = SolverParams::default().bright_share, value_name = "SHARE")]
     pub bright_share: f64,
-    /// Let the small facets of a tessellated model shoot in groups of one cell (1/24 of the
+    /// Let the small facets of a tessellated model shoot in groups of one cell (1/16 of the
     /// scene's diagonal) each, so that a model's shots follow its size and not its triangle
     /// count; false: every facet shoots on its own.
     #[arg(long, value_name = "true|false", default_value_t = SolverParams::default().clustering, action = clap::ArgAction::Set)]
