@@ -24,7 +24,7 @@ pub(super) const NONUNIFORM: f64 = 0.5;
 /// the elements of only the clusters it is close to (see [`density_weight`]).
 #[derive(Clone, Debug)]
 pub(super) struct Cluster {
-    /// Its elements, as a range of [`Uneven::order`].
+    /// Its elements, as a range of the order [`cluster_elements`] fills.
     pub(super) members: std::ops::Range<usize>,
     /// Area-weighted centre of its elements.
     pub(super) centre: DVec3,
