@@ -399,3 +399,58 @@ fn draw_rays_from(
         ray(from, to);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A shooter of more elements than [`RUNS`] is cut into runs of consecutive ones: each
+    /// run carries its elements' share of the unshot power and its middle element's centre,
+    /// the shares sum to the whole, and the lanes past the last run carry nothing.
+    #[test]
+    fn near_runs_carry_their_elements_shares_and_centres() {
+        let n = 601;
+        let elements: Vec<ShooterElement> = (0..n)
+            .map(|k| {
+                let (x, y) = ((k % 25) as f64, (k / 25) as f64);
+                let corners = [
+                    DVec3::new(x, y, 0.0),
+                    DVec3::new(x + 1.0, y, 0.0),
+                    DVec3::new(x + 1.0, y + 1.0, 0.0),
+                    DVec3::new(x, y + 1.0, 0.0),
+                ];
+                let centre = DVec3::new(x + 0.5, y + 0.5, 0.0);
+                ShooterElement { corners, count: 4, centre, radius: 0.5f64.sqrt(), area: 1.0 }
+            })
+            .collect();
+        // Uneven power: element k holds 1 + k % 3.
+        let mut cdf = Vec::with_capacity(n);
+        let mut acc = 0.0;
+        for k in 0..n {
+            acc += (1 + k % 3) as f64;
+            cdf.push(acc);
+        }
+        let cdf: Vec<f64> = cdf.iter().map(|c| c / acc).collect();
+        let origin = DVec3::new(12.0, 12.0, 0.0);
+        let mut table = NearRuns::default();
+        table.load(&elements, &cdf, origin);
+        assert_eq!(table.per_run, 3);
+        assert_eq!(table.runs, 201);
+        assert_eq!(table.share.len(), 51, "four runs to a lane group");
+        let mut total = 0.0;
+        for r in 0..table.runs {
+            let (g, lane) = (r / 4, r % 4);
+            let (first, end) = (3 * r, (3 * r + 3).min(n));
+            let power: f64 = (first..end).map(|k| (1 + k % 3) as f64).sum::<f64>() / acc;
+            assert!((f64::from(table.share[g][lane]) - power).abs() < 1e-6, "run {r}");
+            let centre = elements[(first + end) / 2].centre - origin;
+            let laid = DVec3::new(table.x[g][lane].into(), table.y[g][lane].into(), table.z[g][lane].into());
+            assert!(laid.distance(centre) < 1e-5, "run {r}: {laid} for {centre}");
+            total += f64::from(table.share[g][lane]);
+        }
+        assert!((total - 1.0).abs() < 1e-5, "{total}");
+        for lane in table.runs % 4..4 {
+            assert_eq!(table.share[table.runs / 4][lane], 0.0);
+        }
+    }
+}
