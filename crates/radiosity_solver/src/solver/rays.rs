@@ -403,26 +403,15 @@ fn draw_rays_from(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::solver::shot::unit_squares;
 
     /// A shooter of more elements than [`RUNS`] is cut into runs of consecutive ones: each
     /// run carries its elements' share of the unshot power and its middle element's centre,
     /// the shares sum to the whole, and the lanes past the last run carry nothing.
     #[test]
     fn near_runs_carry_their_elements_shares_and_centres() {
-        let n = 601;
-        let elements: Vec<ShooterElement> = (0..n)
-            .map(|k| {
-                let (x, y) = ((k % 25) as f64, (k / 25) as f64);
-                let corners = [
-                    DVec3::new(x, y, 0.0),
-                    DVec3::new(x + 1.0, y, 0.0),
-                    DVec3::new(x + 1.0, y + 1.0, 0.0),
-                    DVec3::new(x, y + 1.0, 0.0),
-                ];
-                let centre = DVec3::new(x + 0.5, y + 0.5, 0.0);
-                ShooterElement { corners, count: 4, centre, radius: 0.5f64.sqrt(), area: 1.0 }
-            })
-            .collect();
+        let elements = unit_squares(25);
+        let n = elements.len();
         // Uneven power: element k holds 1 + k % 3.
         let mut cdf = Vec::with_capacity(n);
         let mut acc = 0.0;
@@ -435,8 +424,8 @@ mod tests {
         let mut table = NearRuns::default();
         table.load(&elements, &cdf, origin);
         assert_eq!(table.per_run, 3);
-        assert_eq!(table.runs, 201);
-        assert_eq!(table.share.len(), 51, "four runs to a lane group");
+        assert_eq!(table.runs, 209);
+        assert_eq!(table.share.len(), 53, "four runs to a lane group");
         let mut total = 0.0;
         for r in 0..table.runs {
             let (g, lane) = (r / 4, r % 4);

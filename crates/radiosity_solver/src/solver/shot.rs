@@ -56,6 +56,27 @@ impl ShooterElement {
     }
 }
 
+/// A `k × k` grid of unit squares in the plane z = 0, facing +z, row after row: a shooter's
+/// elements for the tests.
+#[cfg(test)]
+pub(super) fn unit_squares(k: usize) -> Vec<ShooterElement> {
+    let mut out = Vec::with_capacity(k * k);
+    for j in 0..k {
+        for i in 0..k {
+            let (x, y) = (i as f64, j as f64);
+            let corners = [
+                DVec3::new(x, y, 0.0),
+                DVec3::new(x + 1.0, y, 0.0),
+                DVec3::new(x + 1.0, y + 1.0, 0.0),
+                DVec3::new(x, y + 1.0, 0.0),
+            ];
+            let centre = DVec3::new(x + 0.5, y + 0.5, 0.0);
+            out.push(ShooterElement { corners, count: 4, centre, radius: 0.5f64.sqrt(), area: 1.0 });
+        }
+    }
+    out
+}
+
 /// What every receiver of one shot reads.
 pub(super) struct Shot<'a> {
     pub(super) mesh: &'a Mesh,

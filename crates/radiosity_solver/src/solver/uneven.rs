@@ -181,32 +181,14 @@ pub(super) fn density_weight(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// A `k × k` grid of unit squares in the plane z = 0, facing +z.
-    fn grid(k: usize) -> Vec<ShooterElement> {
-        let mut out = Vec::new();
-        for j in 0..k {
-            for i in 0..k {
-                let (x, y) = (i as f64, j as f64);
-                let corners = [
-                    DVec3::new(x, y, 0.0),
-                    DVec3::new(x + 1.0, y, 0.0),
-                    DVec3::new(x + 1.0, y + 1.0, 0.0),
-                    DVec3::new(x, y + 1.0, 0.0),
-                ];
-                let centre = DVec3::new(x + 0.5, y + 0.5, 0.0);
-                out.push(ShooterElement { corners, count: 4, centre, radius: 0.5f64.sqrt(), area: 1.0 });
-            }
-        }
-        out
-    }
+    use crate::solver::shot::unit_squares;
 
     /// Every element lands in exactly one cluster of at most [`CLUSTER`], each cluster's
     /// sphere holds its elements, and its area and density are its elements' sum and
     /// area-weighted mean.
     #[test]
     fn clusters_partition_the_elements_and_bound_them() {
-        let elements = grid(9);
+        let elements = unit_squares(9);
         let density: Vec<f64> = (0..elements.len()).map(|k| (k % 7) as f64 * 0.3).collect();
         let (mut order, mut clusters) = (Vec::new(), Vec::new());
         cluster_elements(&elements, &density, &mut order, &mut clusters);
@@ -236,7 +218,7 @@ mod tests {
     /// from above that half than from above the other, near and far (one cluster's mean).
     #[test]
     fn density_weight_follows_the_part_a_receiver_sees() {
-        let elements = grid(8);
+        let elements = unit_squares(8);
         let (mut order, mut clusters) = (Vec::new(), Vec::new());
         let even = vec![1.0; elements.len()];
         cluster_elements(&elements, &even, &mut order, &mut clusters);
