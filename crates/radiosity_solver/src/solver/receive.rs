@@ -70,17 +70,18 @@ pub(super) fn element_facing(shooter: &Patch, plan: &PatchPlan, receiver: &[DVec
             && receiver.iter().all(|p| shooter.normal.dot(*p - corner) > 1e-9 * shooter.area.sqrt()))
 }
 
-/// Element `e`'s form factor to the shooter without visibility: weighted for an uneven
-/// shooter, and before that weighting.
-fn unoccluded(shot: &Shot, plan: &PatchPlan, e: usize) -> (f64, f64) {
-    let Shot { mesh, shooter, shooter_elements, uneven, params, .. } = *shot;
+/// Element `e`'s form factor to the shooter without visibility, before any weighting: what
+/// geometry alone gives, rounded to single precision so that a row computed from the kept
+/// factors (see [`super::row::Geometry`]) is the row computed afresh.
+fn unweighted(shot: &Shot, plan: &PatchPlan, e: usize) -> f64 {
+    let Shot { mesh, shooter, params, .. } = *shot;
     let el = &mesh.elements[e];
-    let pts = corners_of(mesh, e);
-    let receiver = &pts[..el.vertex_count as usize];
-    let corners = shooter.corners();
-    let facing = element_facing(shooter, plan, receiver);
-    match params.form_factor {
+    let f = match params.form_factor {
         FormFactorMethod::Exact => {
+            let pts = corners_of(mesh, e);
+            let receiver = &pts[..el.vertex_count as usize];
+            let corners = shooter.corners();
+            let facing = element_facing(shooter, plan, receiver);
             let (n, rule) = if plan.far {
                 (1, Rule::Midpoint)
             } else {
@@ -107,40 +108,46 @@ fn unoccluded(shot: &Shot, plan: &PatchPlan, e: usize) -> (f64, f64) {
                     }
                 });
             }
-            if let Some(uneven) =
-                uneven.filter(|_| if plan.touching { !in_near_field(shot, e) } else { near(shot, e) })
-            {
-                // A receiver near the shooter sees its near part under a larger form factor
-                // than the rest (a sofa's back 20 cm from a wall patch lit above the sofa and
-                // dark behind it), so the shooter's mean unshot radiosity is wrong for it when
-                // that radiosity is uneven: the transfer is Σ_k ΔB_k F_{j→k} = ΔB̄ Σ_k d_k
-                // F_{j→k}, d_k = ΔB_k/ΔB̄, weighted here by the spread fixed with the row. The
-                // form factor keeps its quadrature; the weighting is taken at the centre.
-                // Receivers that touch the shooter are weighted so too when they are a model's
-                // grouped facets or far from it, else at each shot, by the spread it has then
-                // (`row::NearField`).
-                let weight = density_weight(el.centre, el.normal, shooter.normal, &uneven, shooter_elements);
-                return (f * weight, f);
-            }
-            (f, f)
+            f
         }
         FormFactorMethod::PointToPoint => {
-            let f = point_to_point(el.centre, el.normal, shooter.centre, shooter.normal, shooter.area);
-            (f, f)
+            point_to_point(el.centre, el.normal, shooter.centre, shooter.normal, shooter.area)
         }
-    }
+    };
+    round(f)
+}
+
+/// `f` in single precision, at least 0.
+fn round(f: f64) -> f64 {
+    f64::from(f.max(0.0) as f32)
 }
 
 /// The first pass for the elements of receiving patch `q` (`first` is its first element,
-/// `out` its slice): their unoccluded form factors, then their pilot rays (nothing when its
-/// group shares its visibility: the group is received whole, see `row::receive_shared`).
+/// `out` its slice): their unoccluded form factors (taken from `kept`, one per mesh element,
+/// when the shooter's geometry was kept), then their pilot rays (nothing when its group
+/// shares its visibility: the group is received whole, see `row::receive_shared`).
 #[inline]
-pub(super) fn receive_patch(shot: &Shot, plan: &PatchPlan, q: usize, first: usize, out: &mut [Received]) {
+pub(super) fn receive_patch(
+    shot: &Shot,
+    plan: &PatchPlan,
+    q: usize,
+    first: usize,
+    kept: Option<&[f32]>,
+    out: &mut [Received],
+) {
     out.fill(Received::default());
     if !plan.live || shot.shares(q) {
         return;
     }
-    unoccluded_factors(shot, plan, first, out);
+    match kept {
+        Some(kept) => {
+            for (r, &f) in out.iter_mut().zip(&kept[first..]) {
+                (r.unoccluded, r.unweighted) = (f64::from(f), f64::from(f));
+            }
+        }
+        None => unoccluded_factors(shot, plan, first, out),
+    }
+    weigh(shot, plan, q, first, out);
     if plan.visibility == Visibility::Clear {
         return;
     }
@@ -155,18 +162,12 @@ pub(super) fn receive_patch(shot: &Shot, plan: &PatchPlan, q: usize, first: usiz
     }
 }
 
-/// The unoccluded form factors of one receiving patch's elements. A patch that faces the
-/// shooter from far away takes them four at a time (one midpoint each, nothing to clip: the
-/// same formula and points as [`unoccluded`]).
+/// The unoccluded form factors of one receiving patch's elements, before any weighting. A
+/// patch that faces the shooter from far away takes them four at a time (one midpoint each,
+/// nothing to clip: the same formula and points as [`unweighted`]).
 fn unoccluded_factors(shot: &Shot, plan: &PatchPlan, first: usize, out: &mut [Received]) {
     let params = shot.params;
-    let weighted = shot.uneven.is_some() && patch_near(shot, shot.mesh.elements[first].patch as usize);
-    if plan.facing
-        && plan.far
-        && !weighted
-        && !params.reference_path
-        && params.form_factor == FormFactorMethod::Exact
-    {
+    if plan.facing && plan.far && !params.reference_path && params.form_factor == FormFactorMethod::Exact {
         let corners = shot.shooter.corners();
         for (c, chunk) in out.chunks_mut(4).enumerate() {
             let base = first + 4 * c;
@@ -177,14 +178,41 @@ fn unoccluded_factors(shot: &Shot, plan: &PatchPlan, first: usize, out: &mut [Re
             }
             let f = points_to_polygon_in_front_x4(&points, &normals, chunk.len(), corners);
             for (r, f) in chunk.iter_mut().zip(f) {
-                r.unoccluded = f.max(0.0);
+                r.unoccluded = round(f);
                 r.unweighted = r.unoccluded;
             }
         }
     } else {
         for (k, r) in out.iter_mut().enumerate() {
-            let (weighted, unweighted) = unoccluded(shot, plan, first + k);
-            (r.unoccluded, r.unweighted) = (weighted.max(0.0), unweighted.max(0.0));
+            r.unweighted = unweighted(shot, plan, first + k);
+            r.unoccluded = r.unweighted;
+        }
+    }
+}
+
+/// An uneven shooter's weighting of the receivers near it. A receiver near the shooter sees
+/// its near part under a larger form factor than the rest (a sofa's back 20 cm from a wall
+/// patch lit above the sofa and dark behind it), so the shooter's mean unshot radiosity is
+/// wrong for it when that radiosity is uneven: the transfer is Σ_k ΔB_k F_{j→k} = ΔB̄ Σ_k d_k
+/// F_{j→k}, d_k = ΔB_k/ΔB̄, weighted here by the spread fixed with the row. The form factor
+/// keeps its quadrature; the weighting is taken at the centre. Receivers that touch the
+/// shooter are weighted so too when they are a model's grouped facets or far from it, else
+/// at each shot, by the spread it has then (`row::NearField`).
+fn weigh(shot: &Shot, plan: &PatchPlan, q: usize, first: usize, out: &mut [Received]) {
+    let Some(uneven) = shot.uneven else { return };
+    // Only a touching patch's elements may be weighted beyond `near` (those outside the
+    // near field).
+    if !plan.touching && !patch_near(shot, q) {
+        return;
+    }
+    let Shot { mesh, shooter, shooter_elements, .. } = *shot;
+    for (k, r) in out.iter_mut().enumerate() {
+        let e = first + k;
+        let weighted = if plan.touching { !in_near_field(shot, e) } else { near(shot, e) };
+        if weighted && r.unweighted > 0.0 {
+            let el = &mesh.elements[e];
+            let weight = density_weight(el.centre, el.normal, shooter.normal, &uneven, shooter_elements);
+            r.unoccluded = (r.unweighted * weight).max(0.0);
         }
     }
 }

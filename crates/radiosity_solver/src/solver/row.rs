@@ -34,9 +34,49 @@ pub(super) struct Row {
     /// The receivers that touch the shooter, weighted at each shot by the part of it they
     /// see (see [`NearField`]).
     pub(super) near: NearField,
+    /// What geometry alone decided for a patch shooter's row, kept with it when the budget
+    /// allows, so that the row computed again after its spread moves traces rays only.
+    pub(super) geometry: Option<Box<Geometry>>,
     /// While the row is built: pushes merge only into a span that starts at this element or
     /// later (the first of the block of patches being pushed, see [`Row::by_blocks`]).
     floor: u32,
+}
+
+/// The part of a patch shooter's row that geometry alone decides: its receiving patches'
+/// plans and every element's form factor without visibility, before any weighting.
+///
+/// When the shooter's spread is fixed again (see `first_shots`), its ray ends move and its
+/// rays are traced again, but none of this changes; a Cornell box's row spends about four
+/// fifths of its time here (plans a tenth, form factors nearly half, the near field's shares
+/// a quarter), and a third of its rows are such refreshes. The factors are kept in single
+/// precision and rounded so wherever they are computed, so a row built from them is the
+/// row computed afresh, bit for bit (`tests/suite/fast_paths.rs`).
+pub(super) struct Geometry {
+    plans: Vec<PatchPlan>,
+    /// Per mesh element, its unweighted form factor (0 where its patch does not receive or
+    /// takes its group's visibility).
+    unweighted: Vec<f32>,
+}
+
+impl Geometry {
+    fn bytes(&self) -> usize {
+        std::mem::size_of::<Self>()
+            + self.plans.len() * std::mem::size_of::<PatchPlan>()
+            + 4 * self.plans.iter().map(|p| p.candidates.len()).sum::<usize>()
+            + 4 * self.unweighted.len()
+    }
+
+    /// Geometry of `elements` zero factors and no plans, for the cache's tests.
+    #[cfg(test)]
+    pub(super) fn zeros(elements: usize) -> Self {
+        Self { plans: Vec::new(), unweighted: vec![0.0; elements] }
+    }
+
+    /// What kept geometry costs for a mesh of `patches` and `elements` (at most: candidate
+    /// lists aside, a few triangles per patch).
+    pub(super) fn estimate(patches: usize, elements: usize) -> usize {
+        patches * (std::mem::size_of::<PatchPlan>() + 16) + 4 * elements
+    }
 }
 
 /// The receiving elements that touch a patch shooter (across or on its plane: a floor strip
@@ -72,6 +112,9 @@ pub(super) struct NearField {
     pub(super) rest: f64,
 }
 
+/// A near receiver's terms: (part of the shooter, share).
+type Terms = Vec<(u32, f32)>;
+
 /// A [`NearField`] term whose part is a cluster (its index with this bit set).
 pub(super) const CLUSTER_TERM: u32 = 1 << 31;
 
@@ -97,7 +140,7 @@ const MAX_RUN: u32 = 1024;
 impl Row {
     /// An empty row.
     pub(super) fn new() -> Self {
-        Self { spans: Vec::new(), factors: Vec::new(), near: NearField::default(), floor: 0 }
+        Self { spans: Vec::new(), factors: Vec::new(), near: NearField::default(), geometry: None, floor: 0 }
     }
 
     /// Appends the factors of a receiving patch whose elements are `elements` (after those
@@ -158,14 +201,24 @@ impl Row {
 
     /// Heap and inline bytes the row holds.
     pub(super) fn bytes(&self) -> usize {
-        std::mem::size_of::<Self>() + 8 * self.spans.len() + 4 * self.factors.len() + self.near.bytes()
+        std::mem::size_of::<Self>()
+            + 8 * self.spans.len()
+            + 4 * self.factors.len()
+            + self.near.bytes()
+            + self.geometry.as_ref().map_or(0, |g| g.bytes())
     }
 }
 
 impl Solver {
     /// Computes `shooter`'s row: the form factor from every element to it, visibility
-    /// included.
-    pub(super) fn compute_row(&mut self, shooter: usize) -> Row {
+    /// included. `previous`, its row from before its spread was fixed again, lends what
+    /// geometry alone decided: its kept [`Geometry`] and its near field's shares. With
+    /// `keep_geometry` the new row keeps its geometry.
+    pub(super) fn compute_row(&mut self, shooter: usize, previous: Option<Row>, keep_geometry: bool) -> Row {
+        let (kept, previous_near) = match previous {
+            Some(row) => (row.geometry, Some(row.near)),
+            None => (None, None),
+        };
         let mesh = Arc::clone(&self.mesh);
         let patch = &mesh.patches[shooter];
         let first_of_solve = self.progress.shots == 0;
@@ -175,7 +228,7 @@ impl Solver {
         let share = self.params.clustering && self.params.shared_visibility;
         let emits = super::clusters::patch_emits(&mesh, shooter);
         self.scratch.sharing.choose(&self.clusters, patch.centre, shooter_radius, emits, share, None);
-        if self.rows.plans(shooter).is_none() {
+        if kept.is_none() && self.rows.plans(shooter).is_none() {
             let (sharing, patch_elements) = (&self.scratch.sharing, &self.tables.patch_elements);
             let shares = |q: usize| sharing.shares(patch_elements[q].start);
             let reference = self.params.reference_path;
@@ -232,8 +285,21 @@ impl Solver {
             patch_elements: &tables.patch_elements,
             penumbra: Strata::new(params.penumbra_rays),
         };
-        let plans: &[PatchPlan] = self.rows.plans(shooter).unwrap_or(&scratch.plans);
-        first_pass(&shot, plans, &tables.patch_blocks, &mut scratch.factors);
+        let plans: &[PatchPlan] = match &kept {
+            Some(kept) => &kept.plans,
+            None => self.rows.plans(shooter).unwrap_or(&scratch.plans),
+        };
+        first_pass(
+            &shot,
+            plans,
+            &tables.patch_blocks,
+            kept.as_ref().map(|k| &k.unweighted[..]),
+            &mut scratch.factors,
+        );
+        let fresh = (kept.is_none() && keep_geometry).then(|| {
+            let unweighted = scratch.factors.iter().map(|r| r.unweighted as f32).collect();
+            Box::new(Geometry { plans: plans.to_vec(), unweighted })
+        });
         let shared_rays = receive_shared(&shot, plans, &tables.element_area, &mut scratch.factors);
         if params.penumbra_rays > 0 && bright {
             penumbra_pass(&shot, plans, tables, &mut scratch.penumbra, &mut scratch.factors);
@@ -242,7 +308,8 @@ impl Solver {
             keep_uneven_power(tables, plans, &mut scratch.factors);
         }
         let (mut row, rays) = gather(tables, plans, &scratch.factors, |q| shot.shares(q));
-        row.near = near_field(&shot, plans, tables, &row);
+        row.near = near_field(&shot, plans, tables, &row, previous_near.as_ref());
+        row.geometry = kept.or(fresh);
         self.progress.rays += rays + shared_rays;
         row
     }
@@ -293,14 +360,20 @@ fn keep_uneven_power(tables: &MeshTables, plans: &[PatchPlan], factors: &mut [Re
 }
 
 /// First pass, patch by patch: each receiving patch writes its own elements' slice of
-/// `factors` (their form factors without visibility and their pilot rays), the mesh's
-/// blocks of patches in parallel.
-fn first_pass(shot: &Shot, plans: &[PatchPlan], blocks: &[Range<usize>], factors: &mut [Received]) {
+/// `factors` (their form factors without visibility, from `kept` when given, and their
+/// pilot rays), the mesh's blocks of patches in parallel.
+fn first_pass(
+    shot: &Shot,
+    plans: &[PatchPlan],
+    blocks: &[Range<usize>],
+    kept: Option<&[f32]>,
+    factors: &mut [Received],
+) {
     let patch_elements = shot.patch_elements;
     for_each_block_mut(blocks, patch_elements, factors, true, |patches, mut out| {
         for q in patches {
             let (own, rest) = std::mem::take(&mut out).split_at_mut(patch_elements[q].len());
-            receive_patch(shot, &plans[q], q, patch_elements[q].start, own);
+            receive_patch(shot, &plans[q], q, patch_elements[q].start, kept, own);
             out = rest;
         }
     });
@@ -418,7 +491,16 @@ pub(super) fn in_near_field(shot: &Shot, e: usize) -> bool {
 /// has tens of thousands of facets whose planes cut it (a bunny on a floor patch: 71 k): a
 /// 139 k-triangle room solved in 26.4 s with them, 24.3 s without, 23.5 s before any near
 /// field.
-fn near_field(shot: &Shot, plans: &[PatchPlan], tables: &MeshTables, row: &Row) -> NearField {
+///
+/// The shares are geometry: a receiver that was in `previous`, the shooter's near field
+/// before its spread was fixed again, takes its terms from there.
+fn near_field(
+    shot: &Shot,
+    plans: &[PatchPlan],
+    tables: &MeshTables,
+    row: &Row,
+    previous: Option<&NearField>,
+) -> NearField {
     let mut near = NearField::default();
     let elements = shot.shooter_elements;
     let first_shooter = shot.shooter.elements.start;
@@ -457,7 +539,7 @@ fn near_field(shot: &Shot, plans: &[PatchPlan], tables: &MeshTables, row: &Row) 
     // Each receiver's shares, receivers in parallel (they are a row's costliest part on a
     // small scene), gathered in receiver order.
     let ns = shot.shooter.normal;
-    let shares_of = |&(e, _): &(usize, f32)| -> Vec<(u32, f32)> {
+    let shares_of = |&(e, _): &(usize, f32)| -> Terms {
         let (p, n) = (shot.mesh.elements[e].centre, shot.mesh.elements[e].normal);
         // At most one term per shooter element: sized once, never grown.
         let mut shares: Vec<(u32, f64)> = Vec::with_capacity(elements.len());
@@ -482,11 +564,26 @@ fn near_field(shot: &Shot, plans: &[PatchPlan], tables: &MeshTables, row: &Row) 
         terms.extend(kept.map(|&(part, phi)| (part, (phi / sum) as f32)));
         terms
     };
-    let all: Vec<Vec<(u32, f32)>> = if receivers.len() < 64 || rayon::current_num_threads() == 1 {
-        receivers.iter().map(shares_of).collect()
-    } else {
-        receivers.par_iter().map(shares_of).collect()
+    // Receivers in element order, as `previous` holds them: a cursor finds each.
+    let mut before = previous.map_or(&[][..], |p| &p.receivers[..]);
+    let mut from_previous = |e: usize| -> Option<Terms> {
+        let p = previous?;
+        before = &before[before.partition_point(|r| (r.0 as usize) < e)..];
+        let &(_, _, start, count) = before.first().filter(|r| r.0 as usize == e)?;
+        Some(p.terms[start as usize..(start + count) as usize].to_vec())
     };
+    let mut all: Vec<Option<Terms>> = receivers.iter().map(|&(e, _)| from_previous(e)).collect();
+    let fill = |(r, terms): (&(usize, f32), &mut Option<Terms>)| {
+        if terms.is_none() {
+            *terms = Some(shares_of(r));
+        }
+    };
+    if receivers.len() < 64 || rayon::current_num_threads() == 1 {
+        receivers.iter().zip(&mut all).for_each(fill);
+    } else {
+        receivers.par_iter().zip(&mut all).for_each(fill);
+    }
+    let all = all.into_iter().map(Option::unwrap_or_default);
     for (&(e, f), terms) in receivers.iter().zip(all) {
         if terms.is_empty() {
             // Sees none of the shooter from its centre: it takes the mean with the rest.

@@ -1,10 +1,11 @@
 //! Rows kept across shots. A patch shoots several times as light comes back to it; its rays
 //! come from a stream keyed by the shooter and end where its unshot power was at its first
 //! shot, so its shots have the same row of form factors until that spread is fixed again
-//! (see `first_shots`; the row is then dropped, [`RowCache::forget`]). The row is kept (within
+//! (see `first_shots`; the row is then taken out, [`RowCache::take_out`], and lends the new
+//! one what geometry alone decided, see `row::Geometry`). The row is kept (within
 //! `SolverParams::row_cache_bytes`) and a later shot is one multiply-add per receiver; past
 //! the budget, the row's patch plans (geometry only) are kept instead, up to
-//! [`PLAN_CACHE_ENTRIES`].
+//! [`PLAN_CACHE_ENTRIES`]. A row's geometry is kept with it only in room the rows leave.
 //!
 //! When the rows do not all fit, the ones kept are those of the shooters that have shot most
 //! often: a shooter that has shot often (a big wall, lit from everywhere) will shoot again,
@@ -59,12 +60,18 @@ impl RowCache {
         self.rows[shooter].take().map(|row| *row)
     }
 
-    /// Drops `shooter`'s kept row, if any: it no longer holds.
-    pub(super) fn forget(&mut self, shooter: usize) {
-        if let Some(row) = self.rows[shooter].take() {
-            self.row_bytes -= row.bytes();
-            self.kept.retain(|&k| k != shooter);
-        }
+    /// Takes `shooter`'s kept row out for good, if it has one: it no longer holds (its
+    /// spread was fixed again), but what geometry decided in it still does.
+    pub(super) fn take_out(&mut self, shooter: usize) -> Option<Row> {
+        let row = self.rows[shooter].take()?;
+        self.row_bytes -= row.bytes();
+        self.kept.retain(|&k| k != shooter);
+        Some(*row)
+    }
+
+    /// Whether `bytes` more fit the budget beside the rows kept now.
+    pub(super) fn room_for(&self, bytes: usize) -> bool {
+        self.row_bytes + bytes <= self.budget
     }
 
     /// `shooter`'s kept plans, if its row was computed before and its plans kept.
@@ -89,6 +96,11 @@ impl RowCache {
             self.rows[shooter] = Some(Box::new(row));
             return;
         }
+        // Kept geometry only fills room the rows leave: it never displaces a row.
+        let mut row = row;
+        if row.geometry.is_some() && !self.room_for(row.bytes()) {
+            row.geometry = None;
+        }
         let bytes = row.bytes();
         if !params.reference_path && self.make_room(shooter, bytes) {
             self.row_bytes += bytes;
@@ -109,6 +121,20 @@ impl RowCache {
     /// that is enough; whether the row now fits.
     fn make_room(&mut self, shooter: usize, bytes: usize) -> bool {
         let budget = self.budget;
+        if self.row_bytes + bytes <= budget {
+            return true;
+        }
+        // Kept geometry goes first, oldest rows first: it only fills room rows leave.
+        for &k in &self.kept {
+            if self.row_bytes + bytes <= budget {
+                return true;
+            }
+            if let Some(row) = self.rows[k].as_deref_mut() {
+                let before = row.bytes();
+                row.geometry = None;
+                self.row_bytes -= before - row.bytes();
+            }
+        }
         if self.row_bytes + bytes <= budget {
             return true;
         }
@@ -168,5 +194,32 @@ mod tests {
         let mut cache = RowCache::new(1, usize::MAX);
         cache.keep(0, row(1), false, &[], &reference);
         assert!(cache.take(0).is_none());
+    }
+
+    /// Kept geometry fills the room rows leave and never displaces a row: a row that needs
+    /// the room takes it from the geometry first, and a row that does not fit with its
+    /// geometry is kept without it.
+    #[test]
+    fn geometry_gives_way_to_rows() {
+        let params = SolverParams::default();
+        let size = row(100).bytes();
+        let with_geometry = || {
+            let mut r = row(100);
+            r.geometry = Some(Box::new(super::super::row::Geometry::zeros(400)));
+            r
+        };
+        let heavy = with_geometry().bytes();
+        assert!(heavy > 2 * size);
+        let mut cache = RowCache::new(3, heavy + size - 1);
+        cache.keep(0, with_geometry(), false, &[], &params);
+        // Shooter 1 shot as often as 0: only 0's geometry can make room for its row.
+        cache.keep(1, row(100), false, &[], &params);
+        let (zero, one) = (cache.take(0).expect("row 0 kept"), cache.take(1).expect("row 1 kept"));
+        assert!(zero.geometry.is_none(), "the geometry gave way");
+        assert!(one.geometry.is_none());
+        // A row whose geometry does not fit is kept without it.
+        let mut cache = RowCache::new(1, heavy - 1);
+        cache.keep(0, with_geometry(), false, &[], &params);
+        assert!(cache.take(0).expect("kept").geometry.is_none());
     }
 }

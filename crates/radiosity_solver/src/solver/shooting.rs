@@ -51,15 +51,17 @@ impl Solver {
         //    since the row was computed (see `FirstShots::refresh_if_drifted`). Not when
         //    overshooting: what is left unshot then swings above and below zero, no spread of
         //    power to follow (the ρ = 0.8 furnace ended 0.2 % off).
+        //    The row it had then lends what geometry alone decided.
+        let mut previous = None;
         if let Shooter::Patch(p) = shooter
             && self.params.overshoot == Overshoot::Off
             && self.first_shots.refresh_if_drifted(&self.mesh, p, &self.tally)
         {
-            self.rows.forget(key);
+            previous = self.rows.take_out(key);
         }
         let kept = self.rows.take(key);
         let was_kept = kept.is_some();
-        let row = kept.unwrap_or_else(|| self.compute_any_row(key));
+        let row = kept.unwrap_or_else(|| self.compute_any_row(key, previous));
         // 3. Shoot ω ΔB_i through it (ω = 1 unless over-relaxing).
         let omega = self.params.overshoot.omega();
         let patch = key as u32;
@@ -83,10 +85,18 @@ impl Solver {
         self.progress.stagnation.record(self.tally.unshot_fraction);
     }
 
-    /// The row of shooter `key`: a patch's index, or the patch count plus a group's.
-    fn compute_any_row(&mut self, key: usize) -> super::row::Row {
+    /// The row of shooter `key`: a patch's index, or the patch count plus a group's. A patch
+    /// keeps its row's geometry when the row budget has room for it beside the rows and the
+    /// patches are few beside the elements (a model's facets, one patch each, would keep a
+    /// plan per facet: more than the row).
+    fn compute_any_row(&mut self, key: usize, previous: Option<super::row::Row>) -> super::row::Row {
         let Some(g) = key.checked_sub(self.mesh.patches.len()) else {
-            return self.compute_row(key);
+            let (patches, elements) = (self.mesh.patches.len(), self.mesh.elements.len());
+            let geometry = super::row::Geometry::estimate(patches, elements);
+            let keep_geometry = !self.params.reference_path
+                && geometry <= 8 * elements
+                && self.rows.room_for(geometry + 8 * elements);
+            return self.compute_row(key, previous, keep_geometry);
         };
         if self.progress.shots == 0 {
             self.first_shots.first_shot_power =
