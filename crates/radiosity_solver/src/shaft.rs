@@ -184,7 +184,8 @@ fn base_planes(a: &[DVec3], na: DVec3, b: &[DVec3], nb: DVec3, margin: f64) -> [
 /// all points of both on one side. Returns how many were written.
 fn hull_planes(a: &[DVec3], b: &[DVec3], margin: f64, out: &mut [(DVec3, f64); MAX_PLANES]) -> usize {
     let mut count = 0;
-    let scale = bounds(a.iter().chain(b)).1 - bounds(a.iter().chain(b)).0;
+    let (lo, hi) = bounds(a.iter().chain(b));
+    let scale = hi - lo;
     let tolerance = 1e-9 * scale.length();
     for (edges, others) in [(a, b), (b, a)] {
         for i in 0..edges.len() {
@@ -197,20 +198,20 @@ fn hull_planes(a: &[DVec3], b: &[DVec3], margin: f64, out: &mut [(DVec3, f64); M
                 }
                 let n = n / len;
                 let d = n.dot(p);
-                let side = |pts: &[DVec3]| {
-                    pts.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
-                        let h = n.dot(*x) - d;
-                        (lo.min(h), hi.max(h))
-                    })
-                };
-                let (sa, sb) = (side(a), side(b));
-                let (lo, hi) = (sa.0.min(sb.0), sa.1.max(sb.1));
-                let plane = if lo >= -tolerance {
-                    (n, d - margin)
-                } else if hi <= tolerance {
-                    (-n, -d - margin)
-                } else {
-                    continue;
+                // Which sides the points fall on; most planes split them, and stop early.
+                let (mut below, mut above) = (false, false);
+                for x in a.iter().chain(b) {
+                    let h = n.dot(*x) - d;
+                    below |= h < -tolerance;
+                    above |= h > tolerance;
+                    if below && above {
+                        break;
+                    }
+                }
+                let plane = match (below, above) {
+                    (false, _) => (n, d - margin),
+                    (true, false) => (-n, -d - margin),
+                    (true, true) => continue,
                 };
                 if count < MAX_PLANES {
                     out[count] = plane;
