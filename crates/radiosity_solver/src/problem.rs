@@ -17,6 +17,14 @@ use crate::{Solver, SolverError, SolverParams, occluder_triangles};
 /// falloff are in place long before convergence.
 pub const PROBE_UNSHOT: f64 = 0.2;
 
+/// Gauss cells per side at most in the probe solves' receivers (the solve's default is 2):
+/// the probe only tells steep from smooth. On the Cornell box the whole `solve` is 5 % faster
+/// (1.00 → 0.95 s on one core), the refined mesh 11 976 elements instead of 11 990, and
+/// neither the object means against the path tracer (four seeds) nor the pictures' error
+/// per pixel (`render --gather none` 2.90 %, `direct` 1.86 %) move. Stopping the probes
+/// later (30 % unshot) saved a fifth of the command but put `none` at 3.43 %.
+pub const PROBE_QUADRATURE: u32 = 1;
+
 /// Relative difference between neighbouring elements' radiosity above which adaptive
 /// subdivision quarters them: a shadow's edge, not the few percent of a smooth gradient or of
 /// the probe's visibility noise.
@@ -131,7 +139,11 @@ impl Problem {
         let mut refinement = Refinement::default();
         let mut problem = self;
         for _ in 0..params.adaptive_levels {
-            let probe_params = SolverParams { unshot_threshold: PROBE_UNSHOT, ..SolverParams::default() };
+            let probe_params = SolverParams {
+                unshot_threshold: PROBE_UNSHOT,
+                max_quadrature: PROBE_QUADRATURE,
+                ..SolverParams::default()
+            };
             let Ok(mut probe) = problem.solver(probe_params) else { break };
             probe.solve();
             let mesh = &problem.mesh;
