@@ -56,20 +56,24 @@ pub(super) struct Geometry {
     /// Per mesh element, its unweighted form factor (0 where its patch does not receive or
     /// takes its group's visibility).
     unweighted: Vec<f32>,
+    /// Heap and inline bytes, counted once: the row cache asks for every kept row's size
+    /// whenever it makes room, and the plans' candidate lists would be walked each time.
+    bytes: usize,
 }
 
 impl Geometry {
-    fn bytes(&self) -> usize {
-        std::mem::size_of::<Self>()
-            + self.plans.len() * std::mem::size_of::<PatchPlan>()
-            + 4 * self.plans.iter().map(|p| p.candidates.len()).sum::<usize>()
-            + 4 * self.unweighted.len()
+    fn new(plans: Vec<PatchPlan>, unweighted: Vec<f32>) -> Self {
+        let bytes = std::mem::size_of::<Self>()
+            + plans.len() * std::mem::size_of::<PatchPlan>()
+            + 4 * plans.iter().map(|p| p.candidates.len()).sum::<usize>()
+            + 4 * unweighted.len();
+        Self { plans, unweighted, bytes }
     }
 
     /// Geometry of `elements` zero factors and no plans, for the cache's tests.
     #[cfg(test)]
     pub(super) fn zeros(elements: usize) -> Self {
-        Self { plans: Vec::new(), unweighted: vec![0.0; elements] }
+        Self::new(Vec::new(), vec![0.0; elements])
     }
 
     /// What kept geometry costs for a mesh of `patches` and `elements` (at most: candidate
@@ -205,7 +209,7 @@ impl Row {
             + 8 * self.spans.len()
             + 4 * self.factors.len()
             + self.near.bytes()
-            + self.geometry.as_ref().map_or(0, |g| g.bytes())
+            + self.geometry.as_ref().map_or(0, |g| g.bytes)
     }
 }
 
@@ -298,7 +302,7 @@ impl Solver {
         );
         let fresh = (kept.is_none() && keep_geometry).then(|| {
             let unweighted = scratch.factors.iter().map(|r| r.unweighted as f32).collect();
-            Box::new(Geometry { plans: plans.to_vec(), unweighted })
+            Box::new(Geometry::new(plans.to_vec(), unweighted))
         });
         let shared_rays = receive_shared(&shot, plans, &tables.element_area, &mut scratch.factors);
         if params.penumbra_rays > 0 && bright {
