@@ -116,9 +116,6 @@ pub(super) struct NearField {
     pub(super) rest: f64,
 }
 
-/// A near receiver's terms: (part of the shooter, share).
-type Terms = Vec<(u32, f32)>;
-
 /// A [`NearField`] term whose part is a cluster (its index with this bit set).
 pub(super) const CLUSTER_TERM: u32 = 1 << 31;
 
@@ -127,6 +124,9 @@ pub(super) const CLUSTER_TERM: u32 = 1 << 31;
 /// pixel, 1 570 receivers per row and a third more solve time; at 3 radii 2.82 %, 490
 /// receivers; at 1.5, 2.95 %.
 const NEAR_REACH: f64 = 3.0;
+
+/// Near receivers whose shares one task computes when they are computed in parallel.
+const NEAR_RUN: usize = 32;
 
 /// Smallest share of a shooter part kept in a near receiver's terms.
 const MIN_SHARE: f64 = 1e-3;
@@ -540,62 +540,81 @@ fn near_field(
         near.members.extend(order[c.members.clone()].iter().map(|&i| first_shooter + i));
         near.clusters.push((start, near.members.len() as u32));
     }
-    // Each receiver's shares, receivers in parallel (they are a row's costliest part on a
-    // small scene), gathered in receiver order.
+    // Each receiver's shares, written straight after the terms before them: at most one
+    // share per shooter element, gathered in `scratch` and cut to those kept.
     let ns = shot.shooter.normal;
-    let shares_of = |&(e, _): &(usize, f32)| -> Terms {
+    let shares_of = |e: usize, scratch: &mut Vec<(u32, f64)>, out: &mut Vec<(u32, f32)>| {
         let (p, n) = (shot.mesh.elements[e].centre, shot.mesh.elements[e].normal);
-        // At most one term per shooter element: sized once, never grown.
-        let mut shares: Vec<(u32, f64)> = Vec::with_capacity(elements.len());
+        scratch.clear();
         for (c, cluster) in clusters.iter().enumerate() {
             if cluster.centre.distance_squared(p) >= 16.0 * cluster.radius * cluster.radius {
                 let phi = point_to_point(p, n, cluster.centre, ns, cluster.area);
-                shares.push((c as u32 | CLUSTER_TERM, phi.max(0.0)));
+                scratch.push((c as u32 | CLUSTER_TERM, phi.max(0.0)));
             } else {
-                shares.extend(
+                scratch.extend(
                     order[cluster.members.clone()]
                         .iter()
                         .map(|&i| (first_shooter + i, elements[i as usize].factor_from(p, n, ns).max(0.0))),
                 );
             }
         }
-        let sum: f64 = shares.iter().map(|s| s.1).sum();
-        if sum <= 0.0 {
-            return Vec::new();
+        let sum: f64 = scratch.iter().map(|s| s.1).sum();
+        if sum > 0.0 {
+            let kept = scratch.iter().filter(|s| s.1 >= MIN_SHARE * sum);
+            out.extend(kept.map(|&(part, phi)| (part, (phi / sum) as f32)));
         }
-        let kept = shares.iter().filter(|s| s.1 >= MIN_SHARE * sum);
-        let mut terms = Vec::with_capacity(kept.clone().count());
-        terms.extend(kept.map(|&(part, phi)| (part, (phi / sum) as f32)));
-        terms
     };
-    // Receivers in element order, as `previous` holds them: a cursor finds each.
+    // A receiver that was in `previous` (receivers in element order, as there: a cursor
+    // finds each) takes its terms from there.
     let mut before = previous.map_or(&[][..], |p| &p.receivers[..]);
-    let mut from_previous = |e: usize| -> Option<Terms> {
+    let mut from_previous = |e: usize| -> Option<&[(u32, f32)]> {
         let p = previous?;
         before = &before[before.partition_point(|r| (r.0 as usize) < e)..];
         let &(_, _, start, count) = before.first().filter(|r| r.0 as usize == e)?;
-        Some(p.terms[start as usize..(start + count) as usize].to_vec())
+        Some(&p.terms[start as usize..(start + count) as usize])
     };
-    let mut all: Vec<Option<Terms>> = receivers.iter().map(|&(e, _)| from_previous(e)).collect();
-    let fill = |(r, terms): (&(usize, f32), &mut Option<Terms>)| {
-        if terms.is_none() {
-            *terms = Some(shares_of(r));
+    let reused: Vec<Option<&[(u32, f32)]>> = receivers.iter().map(|&(e, _)| from_previous(e)).collect();
+    // The others' terms, in runs of receivers computed in parallel (they are a row's
+    // costliest part on a small scene), each run's terms one after another and its
+    // receivers' counts, joined in receiver order.
+    let fresh_run = |run: &[(usize, f32)], reused: &[Option<&[(u32, f32)]>]| {
+        let (mut scratch, mut terms, mut counts) = (Vec::new(), Vec::new(), Vec::with_capacity(run.len()));
+        for (&(e, _), old) in run.iter().zip(reused) {
+            let before = terms.len();
+            if old.is_none() {
+                shares_of(e, &mut scratch, &mut terms);
+            }
+            counts.push((terms.len() - before) as u32);
         }
+        (terms, counts)
     };
-    if receivers.len() < 64 || rayon::current_num_threads() == 1 {
-        receivers.iter().zip(&mut all).for_each(fill);
+    let runs: Vec<(Vec<(u32, f32)>, Vec<u32>)> = if receivers.len() < 64 || rayon::current_num_threads() == 1
+    {
+        vec![fresh_run(&receivers, &reused)]
     } else {
-        receivers.par_iter().zip(&mut all).for_each(fill);
-    }
-    let all = all.into_iter().map(Option::unwrap_or_default);
-    for (&(e, f), terms) in receivers.iter().zip(all) {
+        receivers
+            .par_chunks(NEAR_RUN)
+            .zip(reused.par_chunks(NEAR_RUN))
+            .map(|(r, o)| fresh_run(r, o))
+            .collect()
+    };
+    let mut next = runs.iter().flat_map(|(terms, counts)| {
+        let mut at = 0;
+        counts.iter().map(move |&n| {
+            at += n as usize;
+            &terms[at - n as usize..at]
+        })
+    });
+    for (&(e, f), old) in receivers.iter().zip(&reused) {
+        let computed = next.next().unwrap_or_default();
+        let terms = old.unwrap_or(computed);
         if terms.is_empty() {
             // Sees none of the shooter from its centre: it takes the mean with the rest.
             near.rest += tables.element_area[e] * f64::from(f);
             continue;
         }
         let start = near.terms.len() as u32;
-        near.terms.extend(terms);
+        near.terms.extend_from_slice(terms);
         near.receivers.push((e as u32, f, start, near.terms.len() as u32 - start));
     }
     near
