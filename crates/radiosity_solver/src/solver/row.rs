@@ -312,7 +312,7 @@ impl Solver {
             keep_uneven_power(tables, plans, &mut scratch.factors);
         }
         let (mut row, rays) = gather(tables, plans, &scratch.factors, |q| shot.shares(q));
-        row.near = near_field(&shot, plans, tables, &row, previous_near.as_ref());
+        row.near = near_field(&shot, plans, tables, &row, previous_near);
         row.geometry = kept.or(fresh);
         self.progress.rays += rays + shared_rays;
         row
@@ -497,13 +497,14 @@ pub(super) fn in_near_field(shot: &Shot, e: usize) -> bool {
 /// field.
 ///
 /// The shares are geometry: a receiver that was in `previous`, the shooter's near field
-/// before its spread was fixed again, takes its terms from there.
+/// before its spread was fixed again, takes its terms from there (all of them at once when
+/// the receivers are the same).
 fn near_field(
     shot: &Shot,
     plans: &[PatchPlan],
     tables: &MeshTables,
     row: &Row,
-    previous: Option<&NearField>,
+    previous: Option<NearField>,
 ) -> NearField {
     let mut near = NearField::default();
     let elements = shot.shooter_elements;
@@ -564,6 +565,17 @@ fn near_field(
             out.extend(kept.map(|&(part, phi)| (part, (phi / sum) as f32)));
         }
     };
+    if let Some(old) = previous.as_ref().filter(|p| {
+        p.receivers.len() == receivers.len()
+            && p.receivers.iter().zip(&receivers).all(|(a, b)| a.0 as usize == b.0)
+    }) {
+        // The same receivers, each with terms: they are the previous ones, in order.
+        near.receivers =
+            old.receivers.iter().zip(&receivers).map(|(&(e, _, s, n), &(_, f))| (e, f, s, n)).collect();
+        near.terms = previous.map(|p| p.terms).unwrap_or_default();
+        return near;
+    }
+    let previous = previous.as_ref();
     // A receiver that was in `previous` (receivers in element order, as there: a cursor
     // finds each) takes its terms from there.
     let mut before = previous.map_or(&[][..], |p| &p.receivers[..]);
@@ -588,16 +600,32 @@ fn near_field(
         }
         (terms, counts)
     };
-    let runs: Vec<(Vec<(u32, f32)>, Vec<u32>)> = if receivers.len() < 64 || rayon::current_num_threads() == 1
+    let mut runs: Vec<(Vec<(u32, f32)>, Vec<u32>)> =
+        if receivers.len() < 64 || rayon::current_num_threads() == 1 {
+            vec![fresh_run(&receivers, &reused)]
+        } else {
+            receivers
+                .par_chunks(NEAR_RUN)
+                .zip(reused.par_chunks(NEAR_RUN))
+                .map(|(r, o)| fresh_run(r, o))
+                .collect()
+        };
+    if let [(terms, counts)] = &mut runs[..]
+        && reused.iter().all(Option::is_none)
     {
-        vec![fresh_run(&receivers, &reused)]
-    } else {
-        receivers
-            .par_chunks(NEAR_RUN)
-            .zip(reused.par_chunks(NEAR_RUN))
-            .map(|(r, o)| fresh_run(r, o))
-            .collect()
-    };
+        // Every receiver's terms computed in one run: they are the field's, in order.
+        let mut start = 0;
+        for (&(e, f), &n) in receivers.iter().zip(counts.iter()) {
+            if n == 0 {
+                near.rest += tables.element_area[e] * f64::from(f);
+            } else {
+                near.receivers.push((e as u32, f, start, n));
+                start += n;
+            }
+        }
+        near.terms = std::mem::take(terms);
+        return near;
+    }
     let mut next = runs.iter().flat_map(|(terms, counts)| {
         let mut at = 0;
         counts.iter().map(move |&n| {
