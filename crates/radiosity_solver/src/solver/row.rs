@@ -125,6 +125,9 @@ pub(super) const CLUSTER_TERM: u32 = 1 << 31;
 /// receivers; at 1.5, 2.95 %.
 const NEAR_REACH: f64 = 3.0;
 
+/// Terms of near receivers, one after another: (part of the shooter, share).
+type Terms = Vec<(u32, f32)>;
+
 /// Near receivers whose shares one task computes when they are computed in parallel.
 const NEAR_RUN: usize = 32;
 
@@ -600,16 +603,15 @@ fn near_field(
         }
         (terms, counts)
     };
-    let mut runs: Vec<(Vec<(u32, f32)>, Vec<u32>)> =
-        if receivers.len() < 64 || rayon::current_num_threads() == 1 {
-            vec![fresh_run(&receivers, &reused)]
-        } else {
-            receivers
-                .par_chunks(NEAR_RUN)
-                .zip(reused.par_chunks(NEAR_RUN))
-                .map(|(r, o)| fresh_run(r, o))
-                .collect()
-        };
+    let mut runs: Vec<(Terms, Vec<u32>)> = if receivers.len() < 64 || rayon::current_num_threads() == 1 {
+        vec![fresh_run(&receivers, &reused)]
+    } else {
+        receivers
+            .par_chunks(NEAR_RUN)
+            .zip(reused.par_chunks(NEAR_RUN))
+            .map(|(r, o)| fresh_run(r, o))
+            .collect()
+    };
     if let [(terms, counts)] = &mut runs[..]
         && reused.iter().all(Option::is_none)
     {
