@@ -409,6 +409,26 @@ mod tests {
                 + y / (1.0 + y * y).sqrt() * (x / (1.0 + y * y).sqrt()).atan())
     }
 
+    /// A receiver beside the shooter, across the line where their planes meet (a wall's foot
+    /// on a floor patch), down to a ten-thousandth of the shooter's size from that line:
+    /// the four-lane kernel keeps the double-precision form's value to 4e-7 of it.
+    #[test]
+    fn simd_kernel_holds_beside_the_shooter() {
+        let shooter = [DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y];
+        for h in [1e-4, 1e-3, 1e-2, 0.1, 0.3] {
+            for i in 0..200 {
+                let p = DVec3::new(-0.5 + 2.0 * (f64::from(i) + 0.5) / 200.0, 0.0, h);
+                let exact = point_to_polygon_in_front(p, DVec3::Y, &shooter);
+                let fast = point_to_polygon_in_front_x4(p, DVec3::Y, &shooter);
+                assert!(
+                    (fast - exact).abs() <= 4e-7 * exact.max(1e-6),
+                    "h {h}, x {}: {fast} vs {exact}",
+                    p.x
+                );
+            }
+        }
+    }
+
     #[test]
     fn simd_kernel_matches_double_precision() {
         let mut rng = radiosity_core::random::XorShift64::new(0x1234_5678_9abc_def0u64);

@@ -100,11 +100,19 @@ fn unweighted(shot: &Shot, plan: &PatchPlan, e: usize) -> f64 {
                 let eval = if fast { point_to_polygon_in_front_x4 } else { point_to_polygon_in_front };
                 for_each_point(receiver, n, rule, |p, w| f += w * eval(p, el.normal, corners));
             } else {
-                // Clipped polygons keep the f64 loop: their receivers sit next to the shooter,
-                // where nearly parallel edge vectors make f32 lose digits.
+                // The receiver crosses the shooter's plane or the shooter its: points behind
+                // the shooter see none of it, and the shooter is clipped to the hemisphere
+                // of each point it is partly behind (in f64). A point that sees it whole
+                // takes the fast path's lanes: they keep their precision beside the shooter
+                // (`simd_kernel_holds_beside_the_shooter`).
                 for_each_point(receiver, n, rule, |p, w| {
                     if shooter.normal.dot(p - corners[0]) > 0.0 {
-                        f += w * point_to_polygon(p, el.normal, corners);
+                        let whole = fast && corners.iter().all(|v| el.normal.dot(*v - p) >= 0.0);
+                        f += w * if whole {
+                            point_to_polygon_in_front_x4(p, el.normal, corners)
+                        } else {
+                            point_to_polygon(p, el.normal, corners)
+                        };
                     }
                 });
             }
