@@ -5,7 +5,8 @@
 //! probed with a coarse grid of rays against the scene's own polygons and spheres, and the
 //! view whose rays meet the most front faces wins: from outside on each side (the open side
 //! of an open box), or from the middle looking along each horizontal axis (inside a closed
-//! room). `render` and `view` both take their default camera from here, so they agree.
+//! room), turned towards what stands in the room when it lies ahead. `render` and `view`
+//! both take their default camera from here, so they agree.
 //!
 //! The back face of a two-sided object (every OBJ face, by default) counts, but less than a
 //! front face: it is lit only where something lights it, and the outside of a room or of an
@@ -45,9 +46,14 @@ pub(crate) fn choose(scene: &Scene) -> Camera {
     // to show a room), along each horizontal axis; the view that shows the most objects
     // wins (from the middle along +z, the generated furnished room showed a bare wall and
     // the sofa, and none of the models on the table).
+    // Each view looks level, or at the room's contents when they stand ahead of it: a model
+    // on the floor of a tall room is then in the middle of the picture, not cut off by its
+    // bottom edge.
+    let contents = contents_centre(scene, lo, hi);
     let inside = [DVec3::Z, -DVec3::Z, DVec3::X, -DVec3::X].into_iter().filter_map(|d| {
         let from = centre - d * (INSIDE_STEP_BACK * (hi - lo).dot(d.abs()));
-        Camera::try_new(from, from + d, DVec3::Y, INSIDE_FOV_DEG).ok()
+        let view = contents.and_then(|c| aim(c - from, d)).unwrap_or(d);
+        Camera::try_new(from, from + view, DVec3::Y, INSIDE_FOV_DEG).ok()
     });
     let best_inside = best_of(scene, inside.collect(), true);
     if best_inside.1 > best_outside.1 { best_inside.0 } else { best_outside.0 }
@@ -56,6 +62,41 @@ pub(crate) fn choose(scene: &Scene) -> Camera {
 /// How far back from the middle an inside camera stands, as a share of the room's depth
 /// along its view (0.5 would be against the wall behind it; furniture stands there).
 const INSIDE_STEP_BACK: f64 = 0.3;
+
+/// An inside view along `d` (horizontal) turned towards `to` (from the camera): when `to`
+/// lies within 45° of `d` seen from above, the direction towards it, tilted at most 45° up
+/// or down; `None` otherwise (the view then looks level along `d`).
+fn aim(to: DVec3, d: DVec3) -> Option<DVec3> {
+    let level = DVec3::new(to.x, 0.0, to.z);
+    let across = level.length();
+    if across <= 0.0 || level.dot(d) < across * std::f64::consts::FRAC_1_SQRT_2 {
+        return None;
+    }
+    let tilt = to.y.atan2(across).clamp(-std::f64::consts::FRAC_PI_4, std::f64::consts::FRAC_PI_4);
+    Some(level / across * tilt.cos() + DVec3::Y * tilt.sin())
+}
+
+/// Share of the scene's extent along an axis from which an object spans that axis.
+const SPANS: f64 = 0.9;
+
+/// The centre of the bounds of what stands in a room: the objects that neither emit nor
+/// span two of the scene's axes (walls, floor, ceiling, the room's own box do). `None` when
+/// there are none.
+fn contents_centre(scene: &Scene, lo: DVec3, hi: DVec3) -> Option<DVec3> {
+    let extent = hi - lo;
+    let (mut a, mut b) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    for object in &scene.objects {
+        if scene.materials[object.material].is_emitter() {
+            continue;
+        }
+        let (olo, ohi) = object.bounds();
+        let spans = (ohi - olo).cmpge(extent * SPANS).bitmask().count_ones();
+        if spans < 2 {
+            (a, b) = (a.min(olo), b.max(ohi));
+        }
+    }
+    a.cmple(b).all().then(|| (a + b) * 0.5)
+}
 
 /// What a probe ray meets first.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
@@ -277,6 +318,31 @@ mod tests {
             assert!(view.dot(side) > 0.99, "{side}: {camera:?}");
             assert!((camera.position - (lo + hi) * 0.5).dot(side) < -0.2, "stands back: {camera:?}");
         }
+    }
+
+    /// A block standing in the middle of a closed room's floor is looked at, not over: the
+    /// view from inside aims down at it.
+    #[test]
+    fn inside_a_room_the_view_aims_at_what_stands_in_it() {
+        use crate::box_faces;
+        let mut scene = furnace_box(0.5, 1.0);
+        for o in &mut scene.objects {
+            let Shape::Polygons(ps) = &mut o.shape else { continue };
+            for p in ps.iter_mut() {
+                let room: Vec<DVec3> = p.vertices().iter().map(|v| *v * DVec3::new(4.0, 2.0, 4.0)).collect();
+                *p = Polygon::try_new(room).unwrap();
+            }
+        }
+        let grey = crate::Material::try_new("grey", crate::Rgb::splat(0.5), crate::Rgb::ZERO).unwrap();
+        scene.materials.push(grey);
+        let (min, max) = (DVec3::new(1.7, 0.0, 1.7), DVec3::new(2.3, 0.3, 2.3));
+        let block = box_faces(min, max, Facing::Outward, 0.0).unwrap();
+        scene.objects.push(crate::Object::new("block", 1, Shape::Polygons(block)));
+        let camera = scene.camera_or_framing();
+        let view = (camera.look_at - camera.position).normalize();
+        let to_block = ((min + max) * 0.5 - camera.position).normalize();
+        assert!(view.dot(to_block) > 0.999, "aims at the block: {camera:?}");
+        assert!(view.y < -0.3, "looks down: {camera:?}");
     }
 
     /// Two facing plates show their lit sides.

@@ -513,6 +513,24 @@ pub struct Object {
 }
 
 impl Object {
+    /// Axis-aligned bounds of its geometry (lowest corner, highest corner).
+    pub fn bounds(&self) -> (DVec3, DVec3) {
+        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        let mut take = |v: DVec3| {
+            lo = lo.min(v);
+            hi = hi.max(v);
+        };
+        match &self.shape {
+            Shape::Polygons(ps) => ps.iter().flat_map(|p| p.vertices()).for_each(|v| take(*v)),
+            Shape::Sphere(s) => {
+                take(s.center - DVec3::splat(s.radius));
+                take(s.center + DVec3::splat(s.radius));
+            }
+            Shape::Mesh(m) => m.positions().iter().for_each(|v| take(*v)),
+        }
+        (lo, hi)
+    }
+
     /// A one-sided object.
     pub fn new(name: impl Into<String>, material: usize, shape: Shape) -> Self {
         Self { name: name.into(), material, shape, sides: Sides::One }
@@ -694,29 +712,12 @@ impl Scene {
 
     /// Axis-aligned bounds `(min, max)` of all geometry.
     pub fn bounds(&self) -> (DVec3, DVec3) {
-        let mut lo = DVec3::splat(f64::INFINITY);
-        let mut hi = DVec3::splat(f64::NEG_INFINITY);
-        for o in &self.objects {
-            match &o.shape {
-                Shape::Polygons(ps) => {
-                    for v in ps.iter().flat_map(|p| p.vertices()) {
-                        lo = lo.min(*v);
-                        hi = hi.max(*v);
-                    }
-                }
-                Shape::Sphere(s) => {
-                    lo = lo.min(s.center - DVec3::splat(s.radius));
-                    hi = hi.max(s.center + DVec3::splat(s.radius));
-                }
-                Shape::Mesh(m) => {
-                    for v in m.positions() {
-                        lo = lo.min(*v);
-                        hi = hi.max(*v);
-                    }
-                }
-            }
-        }
-        (lo, hi)
+        self.objects
+            .iter()
+            .map(Object::bounds)
+            .fold((DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)), |(lo, hi), (a, b)| {
+                (lo.min(a), hi.max(b))
+            })
     }
 
     /// The scene's camera or, without one, a view that sees its lit faces: from outside on
