@@ -81,6 +81,17 @@ pub fn point_to_polygon(p: DVec3, n: DVec3, polygon: &[DVec3]) -> f64 {
     point_to_polygon_in_front(p, n, &clipped[..k])
 }
 
+/// [`point_to_polygon`] on the fast path: a polygon wholly in front of the receiver's tangent
+/// plane in four f32 lanes ([`point_to_polygon_in_front_x4`], which keeps its precision
+/// right beside the polygon too), one the plane cuts clipped in f64.
+pub fn point_to_polygon_x4(p: DVec3, n: DVec3, polygon: &[DVec3]) -> f64 {
+    if polygon.iter().all(|v| n.dot(*v - p) >= 0.0) {
+        point_to_polygon_in_front_x4(p, n, polygon)
+    } else {
+        point_to_polygon(p, n, polygon)
+    }
+}
+
 /// [`point_to_polygon`] for a polygon known to lie wholly in front of the receiver's tangent
 /// plane, so the clipping can be skipped (clipping such a polygon returns it unchanged, so
 /// both give the same bits).

@@ -15,7 +15,7 @@ use super::shot::Shot;
 use super::uneven::density_weight;
 use crate::form_factor::{
     Rule, for_each_point, point_to_point, point_to_polygon, point_to_polygon_in_front,
-    point_to_polygon_in_front_x4, points_to_polygon_in_front_x4,
+    point_to_polygon_in_front_x4, point_to_polygon_x4, points_to_polygon_in_front_x4,
 };
 use crate::shaft::{FEW, Visibility};
 
@@ -105,14 +105,10 @@ fn unweighted(shot: &Shot, plan: &PatchPlan, e: usize) -> f64 {
                 // of each point it is partly behind (in f64). A point that sees it whole
                 // takes the fast path's lanes: they keep their precision beside the shooter
                 // (`simd_kernel_holds_beside_the_shooter`).
+                let eval = if fast { point_to_polygon_x4 } else { point_to_polygon };
                 for_each_point(receiver, n, rule, |p, w| {
                     if shooter.normal.dot(p - corners[0]) > 0.0 {
-                        let whole = fast && corners.iter().all(|v| el.normal.dot(*v - p) >= 0.0);
-                        f += w * if whole {
-                            point_to_polygon_in_front_x4(p, el.normal, corners)
-                        } else {
-                            point_to_polygon(p, el.normal, corners)
-                        };
+                        f += w * eval(p, el.normal, corners);
                     }
                 });
             }

@@ -12,7 +12,7 @@ use super::rays::NearRuns;
 use super::receive::Received;
 use super::shared::Sharing;
 use super::uneven::{Cluster, Uneven};
-use crate::form_factor::{point_to_point, point_to_polygon, point_to_polygon_in_front_x4};
+use crate::form_factor::{point_to_point, point_to_polygon_x4};
 use crate::occluders::OccluderBoxes;
 use crate::sampling::Strata;
 use crate::shaft::Blockers;
@@ -52,21 +52,9 @@ impl ShooterElement {
     /// a tenth of the Cornell box's solve in f64); one the plane cuts is clipped in f64.
     pub(super) fn factor_from(&self, p: DVec3, n: DVec3, ns: DVec3) -> f64 {
         if self.centre.distance_squared(p) < 16.0 * self.radius * self.radius {
-            self.factor_to(p, n)
+            point_to_polygon_x4(p, n, self.corners())
         } else {
             point_to_point(p, n, self.centre, ns, self.area)
-        }
-    }
-
-    /// The exact form factor from a differential area at `p` (normal `n`) to this element:
-    /// in four f32 lanes when the element is wholly in front of the receiver's tangent
-    /// plane, clipped to it in f64 otherwise.
-    pub(super) fn factor_to(&self, p: DVec3, n: DVec3) -> f64 {
-        let corners = self.corners();
-        if corners.iter().all(|v| n.dot(*v - p) >= 0.0) {
-            point_to_polygon_in_front_x4(p, n, corners)
-        } else {
-            point_to_polygon(p, n, corners)
         }
     }
 }

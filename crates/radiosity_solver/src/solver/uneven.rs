@@ -7,7 +7,7 @@
 use glam::{DVec3, Vec4};
 
 use super::shot::ShooterElement;
-use crate::form_factor::point_to_point;
+use crate::form_factor::{point_to_point, point_to_polygon_x4};
 use crate::shaft::bounds;
 
 /// A shooter with an element whose unshot density strays from the mean by more than this
@@ -151,7 +151,7 @@ pub(super) fn density_weight(
             continue;
         }
         // Each element's point-to-point factor (`point_to_point`: cos θ cos θ' A / (π r²),
-        // at most 1), or its exact one within four radii (`ShooterElement::factor_to`).
+        // at most 1), or its exact one within four radii (`point_to_polygon_x4`).
         let q = (p - c.centre).as_vec3();
         for lanes in &c.lanes {
             let d = [lanes.x - Vec4::splat(q.x), lanes.y - Vec4::splat(q.y), lanes.z - Vec4::splat(q.z)];
@@ -166,7 +166,7 @@ pub(super) fn density_weight(
             let density = lanes.density.to_array();
             for k in 0..lanes.count {
                 let f = if exact >> k & 1 == 1 {
-                    elements[lanes.members[k] as usize].factor_to(p, n)
+                    point_to_polygon_x4(p, n, elements[lanes.members[k] as usize].corners())
                 } else {
                     f64::from(far[k])
                 };
