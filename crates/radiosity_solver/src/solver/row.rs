@@ -510,7 +510,7 @@ fn near_field(
     plans: &[PatchPlan],
     tables: &MeshTables,
     row: &Row,
-    previous: Option<NearField>,
+    mut previous: Option<NearField>,
 ) -> NearField {
     let mut near = NearField::default();
     let elements = shot.shooter_elements;
@@ -571,14 +571,15 @@ fn near_field(
             out.extend(kept.map(|&(part, phi)| (part, (phi / sum) as f32)));
         }
     };
-    if let Some(old) = previous.as_ref().filter(|p| {
+    let same = |p: &mut NearField| {
         p.receivers.len() == receivers.len()
             && p.receivers.iter().zip(&receivers).all(|(a, b)| a.0 as usize == b.0)
-    }) {
+    };
+    if let Some(old) = previous.take_if(same) {
         // The same receivers, each with terms: they are the previous ones, in order.
         near.receivers =
             old.receivers.iter().zip(&receivers).map(|(&(e, _, s, n), &(_, f))| (e, f, s, n)).collect();
-        near.terms = previous.map(|p| p.terms).unwrap_or_default();
+        near.terms = old.terms;
         return near;
     }
     let previous = previous.as_ref();
@@ -606,32 +607,16 @@ fn near_field(
         }
         (terms, counts)
     };
-    let mut runs: Vec<(Terms, Vec<u32>)> =
-        if receivers.len() < 2 * NEAR_RUN || rayon::current_num_threads() == 1 {
-            vec![fresh_run(&receivers, &reused)]
-        } else {
-            receivers
-                .par_chunks(NEAR_RUN)
-                .zip(reused.par_chunks(NEAR_RUN))
-                .map(|(r, o)| fresh_run(r, o))
-                .collect()
-        };
-    if let [(terms, counts)] = &mut runs[..]
-        && reused.iter().all(Option::is_none)
+    let runs: Vec<(Terms, Vec<u32>)> = if receivers.len() < 2 * NEAR_RUN || rayon::current_num_threads() == 1
     {
-        // Every receiver's terms computed in one run: they are the field's, in order.
-        let mut start = 0;
-        for (&(e, f), &n) in receivers.iter().zip(counts.iter()) {
-            if n == 0 {
-                near.rest += tables.element_area[e] * f64::from(f);
-            } else {
-                near.receivers.push((e as u32, f, start, n));
-                start += n;
-            }
-        }
-        near.terms = std::mem::take(terms);
-        return near;
-    }
+        vec![fresh_run(&receivers, &reused)]
+    } else {
+        receivers
+            .par_chunks(NEAR_RUN)
+            .zip(reused.par_chunks(NEAR_RUN))
+            .map(|(r, o)| fresh_run(r, o))
+            .collect()
+    };
     let mut next = runs.iter().flat_map(|(terms, counts)| {
         let mut at = 0;
         counts.iter().map(move |&n| {
