@@ -72,14 +72,14 @@ fn coarse_patches_agree_with_elements_shooting_for_themselves() {
 }
 
 /// Penumbra rays must not bias visibility. The lamp's one shot (direct light only) on the
-/// Cornell box at 15.6 k elements, with the default rays (8 per element, 56 more where the
-/// neighbours saw a penumbra), against 256 rays per element: area-weighted RMS of the
+/// Cornell box at 15.6 k elements, with the default rays (8 per element, 56 more from the
+/// one-patch lamp where the neighbours saw a penumbra), against 256 rays per element: area-weighted RMS of the
 /// per-object relative difference.
 ///
 /// Deciding from an element's own first rays and averaging them in (Ward 1991, used here
 /// before) pushes penumbra elements towards full light or full shadow: measured 0.47–0.84 %
 /// for seeds 0–2, the floor 0.9 % too bright. Deciding from the neighbours: 0.19–0.33 %
-/// with 4 first rays, 0.06 % with 8 (12 penumbra rays), 0.04 % with 8 and 56. Bound: 0.4 %.
+/// with 4 first rays, 0.06 % with 8 (12 penumbra rays), 0.02 % with 8 and 56. Bound: 0.4 %.
 #[test]
 fn penumbra_rays_leave_direct_light_unbiased() {
     let problem = cornell_15k();
@@ -149,8 +149,8 @@ fn penumbra_elements_take_enough_rays_to_stay_smooth() {
 /// RMS of the element radiosity between seeds 0 and 1, against the mean radiosity; bias:
 /// per-object area-weighted RMS against 64 rays per element from every shooter. Measured
 /// with 12 penumbra rays: 2.82 M rays against 8.39 M, noise 1.87 % against 2.31 %, bias
-/// 0.18 % against 0.18 %; with 56 (and today's mesh): 14.2 M against 112 M, noise 1.13 %
-/// against 1.60 %, bias 0.04 % against 0.06 %.
+/// 0.18 % against 0.18 %; with 56 for the lamp (and today's mesh): 12.7 M against 56.8 M,
+/// noise 1.13 % against 1.59 %, bias 0.03 % against 0.06 %.
 /// Bounds: at most half the rays, less noise, bias within 0.35 % (the spread of the
 /// shooters' ray-end tables between seeds alone is 0.2–0.5 %).
 #[test]

@@ -61,9 +61,11 @@ pub struct SolverParams {
     pub visibility_rays: u32,
     /// More rays from a bright shooter for a receiver whose neighbours' first
     /// `visibility_rays` saw a penumbra (one of them partly lit, or some lit and some dark),
-    /// 0 for none. Default 56: 64 rays in all for a penumbra element, whose own value the
-    /// viewer and a baked export show (on the Cornell box its seed-to-seed noise is 9 %
-    /// against 19 % with 12, for 4 % more solve time; see docs/PERFORMANCE.md).
+    /// 0 for none: this many from a shooter carrying half the emitted power or more, fewer in
+    /// proportion to its share below that, at least 12 (its noise in a receiver scales with
+    /// its share). Default 56: 64 rays in all for an element in a lamp's penumbra, whose own
+    /// value the viewer and a baked export show (on the Cornell box its seed-to-seed noise
+    /// is 9 % against 19 % with 12, for 2 % more solve time; see docs/PERFORMANCE.md).
     pub penumbra_rays: u32,
     /// Visibility rays per receiving element from a dim shooter, ≥ 1. Default 1.
     pub dim_rays: u32,

@@ -234,6 +234,7 @@ impl Solver {
         let first_of_solve = self.progress.shots == 0;
         self.first_shots.freeze(&mesh, shooter, &self.tally, first_of_solve, self.params.bright_share);
         let bright = self.first_shots.bright(shooter);
+        let penumbra_rays = self.first_shots.penumbra_rays(shooter, self.params.penumbra_rays);
         let shooter_radius = super::mesh_tables::patch_radius(patch);
         let share = self.params.clustering && self.params.shared_visibility;
         let emits = super::clusters::patch_emits(&mesh, shooter);
@@ -293,7 +294,7 @@ impl Solver {
             clusters: &self.clusters,
             sharing: &scratch.sharing,
             patch_elements: &tables.patch_elements,
-            penumbra: Strata::new(params.penumbra_rays),
+            penumbra: Strata::new(penumbra_rays),
         };
         let plans: &[PatchPlan] = match &kept {
             Some(kept) => &kept.plans,
@@ -311,7 +312,7 @@ impl Solver {
             Box::new(Geometry::new(plans.to_vec(), unweighted))
         });
         let shared_rays = receive_shared(&shot, plans, &tables.element_area, &mut scratch.factors);
-        if params.penumbra_rays > 0 && bright {
+        if penumbra_rays > 0 && bright {
             penumbra_pass(&shot, plans, tables, &mut scratch.penumbra, &mut scratch.factors);
         }
         if shot.uneven.is_some() {
