@@ -26,8 +26,8 @@ const DRIFT: f64 = 0.2;
 
 /// A bright shooter carrying at least this share of the power the solve started with (the
 /// emitted power) takes all of `SolverParams::penumbra_rays`; one carrying less, a part in
-/// proportion (see [`FirstShots::penumbra_rays`]). A half: the Cornell box's lamp is two
-/// patches.
+/// proportion (see [`FirstShots::penumbra_rays`]). A half: a lamp of one or two patches
+/// takes them all (the Cornell box's is one), each quarter of a lamp cut in four a half.
 ///
 /// The visibility noise a shooter leaves in a receiver grows with its share s of the power
 /// and falls as the square root of its rays n, and independent shooters' noises add in
@@ -56,15 +56,15 @@ pub(super) struct FirstShots {
     bright: Vec<bool>,
     /// Per patch, its first shot's share of [`Self::start_power`].
     share: Vec<f64>,
-    /// The unshot power at the solve's first shot: the emitted power.
+    /// The power the solve starts with unshot: the emitted power.
     start_power: f64,
     /// Power of the solve's first shot, the largest.
     pub(super) first_shot_power: f64,
 }
 
 impl FirstShots {
-    /// Nothing fixed yet, for `mesh`.
-    pub(super) fn new(mesh: &Mesh) -> Self {
+    /// Nothing fixed yet, for `mesh` and the solve's `tally` at shot 0.
+    pub(super) fn new(mesh: &Mesh, tally: &Tally) -> Self {
         let (n, patches) = (mesh.elements.len(), mesh.patches.len());
         Self {
             cdf: vec![0.0; n],
@@ -73,7 +73,7 @@ impl FirstShots {
             nonuniform: vec![false; patches],
             bright: vec![false; patches],
             share: vec![0.0; patches],
-            start_power: 0.0,
+            start_power: tally.patch_unshot_power.iter().map(|p| p.abs().sum()).sum(),
             first_shot_power: 0.0,
         }
     }
@@ -98,7 +98,6 @@ impl FirstShots {
         let power = tally.patch_unshot_power[shooter].abs().sum();
         if first_of_solve {
             self.first_shot_power = power;
-            self.start_power = tally.patch_unshot_power.iter().map(|p| p.abs().sum()).sum();
         }
         self.bright[shooter] = power >= bright_share * self.first_shot_power;
         self.share[shooter] = if self.start_power > 0.0 { power / self.start_power } else { 0.0 };
@@ -213,7 +212,7 @@ mod tests {
     fn penumbra_rays_follow_the_share_of_the_power() {
         let scene = two_plates(1.0, 1.0, 0.5, 1.0);
         let mesh = Mesh::build(&scene, &radiosity_core::MeshParams::try_new(1.0, 0.25).unwrap()).unwrap();
-        let mut shots = FirstShots::new(&mesh);
+        let mut shots = FirstShots::new(&mesh, &Tally::new(&mesh).unwrap());
         let rays = |shots: &mut FirstShots, share: f64, most: u32| {
             shots.share[0] = share;
             shots.penumbra_rays(0, most)
@@ -245,7 +244,7 @@ mod tests {
         let range = mesh.patches[plate].elements.clone();
         let (first, end) = (range.start as usize, range.end as usize);
         let mut tally = Tally::new(&mesh).unwrap();
-        let mut shots = FirstShots::new(&mesh);
+        let mut shots = FirstShots::new(&mesh, &tally);
         let set = |tally: &mut Tally, values: &dyn Fn(usize) -> f64| {
             for e in first..end {
                 tally.unshot[e] = Rgb::splat(values(e - first));

@@ -111,7 +111,7 @@ impl Solver {
         clusters.sum(&tally.patch_abs);
         Ok(Self {
             tables: MeshTables::new(&mesh),
-            first_shots: FirstShots::new(&mesh),
+            first_shots: FirstShots::new(&mesh, &tally),
             rows: RowCache::new(
                 mesh.patches.len() + clusters.len(),
                 params.row_cache_budget(mesh.elements.len()),
