@@ -27,7 +27,7 @@ const DRIFT: f64 = 0.2;
 /// A bright shooter carrying at least this share of the power the solve started with (the
 /// emitted power) takes all of `SolverParams::penumbra_rays`; one carrying less, a part in
 /// proportion (see [`FirstShots::penumbra_rays`]). A half: a lamp of one or two patches
-/// takes them all (the Cornell box's is one), each quarter of a lamp cut in four a half.
+/// takes them all (the Cornell box's is one); each patch of a lamp cut in four, half.
 ///
 /// The visibility noise a shooter leaves in a receiver grows with its share s of the power
 /// and falls as the square root of its rays n, and independent shooters' noises add in
@@ -57,7 +57,7 @@ pub(super) struct FirstShots {
     /// Per patch, its first shot's share of [`Self::start_power`].
     share: Vec<f64>,
     /// The power the solve starts with unshot: the emitted power.
-    start_power: f64,
+    pub(super) start_power: f64,
     /// Power of the solve's first shot, the largest.
     pub(super) first_shot_power: f64,
 }

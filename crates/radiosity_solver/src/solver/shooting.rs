@@ -99,8 +99,7 @@ impl Solver {
             return self.compute_row(key, previous, keep_geometry);
         };
         if self.progress.shots == 0 {
-            self.first_shots.first_shot_power =
-                self.tally.patch_unshot_power.iter().map(|p| p.abs().sum()).sum();
+            self.first_shots.first_shot_power = self.first_shots.start_power;
         }
         let (mesh, tables, params) = (&*self.mesh, &self.tables, &self.params);
         let first_power = self.first_shots.first_shot_power;
