@@ -238,6 +238,21 @@ pub fn write_report(path: &str, force: bool, text: &str) -> Result<()> {
     if path == "-" { stdout(&text) } else { write_file(Path::new(path), force, text.as_bytes()) }
 }
 
+/// A solve's power audit for the JSON reports, W per channel: where the emitted power went
+/// (absorbed, escaped, still unshot) and what the solve made on top (`created`), with the
+/// round-off `residual` of emitted + created − absorbed − unshot − escaped over emitted.
+pub fn energy_json(e: &radiosity_solver::EnergyBalance) -> serde_json::Value {
+    serde_json::json!({
+        "emitted": e.emitted.to_array(),
+        "absorbed": e.absorbed.to_array(),
+        "escaped": e.escaped.to_array(),
+        "unshot": e.unshot.to_array(),
+        "created": e.created.to_array(),
+        "created_fraction": e.created.sum() / e.emitted.sum(),
+        "residual": e.residual().to_array(),
+    })
+}
+
 /// Writes `text` to stdout and flushes it.
 ///
 /// # Errors

@@ -36,6 +36,7 @@ pub fn run(a: SolveArgs) -> Result<()> {
     let Prepared { scene, problem, .. } = &prepared;
     let mesh = problem.mesh();
     let objects = solver.object_radiosity();
+    let energy = solver.energy();
     drop(solver);
     let secs = report.elapsed.as_secs_f64();
     let stop = report.stop_reason.map_or("running", |s| s.as_str());
@@ -82,6 +83,7 @@ pub fn run(a: SolveArgs) -> Result<()> {
             "stop_reason": stop,
             "seconds": secs,
             "rays": report.rays,
+            "energy": output::energy_json(&energy),
             "objects": objects.iter().map(|o| {
                 let mut entry = json!({
                     "name": o.name,

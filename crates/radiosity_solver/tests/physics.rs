@@ -114,7 +114,7 @@ fn a_two_sided_furnace_is_unchanged_inside_and_black_outside() {
     assert_eq!(backs * 2, mesh.elements.len());
 }
 
-/// Energy: emitted = absorbed + unshot + escaped after every shot, to round-off.
+/// Energy: emitted + created = absorbed + unshot + escaped after every shot, to round-off.
 #[test]
 fn energy_is_conserved_after_every_shot() {
     for scene in [two_plates(1.0, 0.5, 0.7, 2.0), furnace_box(0.8, 1.0), two_sided_plate(0.7, 1.0, 2.0)] {
@@ -122,9 +122,8 @@ fn energy_is_conserved_after_every_shot() {
         for _ in 0..60 {
             s.step(StepBudget::Shots(1));
             let e = s.energy();
-            let total = e.absorbed + e.unshot + e.escaped;
-            for (a, b) in total.to_array().iter().zip(e.emitted.to_array()) {
-                assert!(rel(*a, b) < 1e-9, "{a} vs {b}");
+            for r in e.residual().to_array() {
+                assert!(r.abs() < 1e-9, "{e:?}");
             }
         }
     }
@@ -415,7 +414,7 @@ fn a_mesh_with_patches_out_of_order_is_refused() {
 /// slightly crooked edges let almost nothing out). Its floor patches half in the blocks'
 /// shadow are uneven shooters, whose weighting gives the block sides what they see of them;
 /// the power a side sees less of must go to the rest of the room, not vanish. Measured:
-/// 0.003 % escaped; 0.39 % when the weighting dropped it.
+/// 0.003 % lost net (escaped less created); 0.39 % when the weighting dropped it.
 #[test]
 fn a_closed_cornell_box_keeps_its_light() {
     use radiosity_core::{Object, Polygon, Shape};
@@ -430,10 +429,15 @@ fn a_closed_cornell_box_keeps_its_light() {
     scene.objects.push(Object::new("front_wall", 0, Shape::Polygons(vec![front])));
     let s = converged(&scene, 1e-3);
     let e = s.energy();
-    let escaped = e.escaped.sum() / e.emitted.sum();
+    // Shot by shot, the visibility rays' noise makes some rows deliver a little more than
+    // their shooter's power (created) and some a little less (escaped); what must not
+    // happen is a net loss.
+    let lost = (e.escaped.sum() - e.created.sum()) / e.emitted.sum();
     let unshot = e.unshot.sum() / e.emitted.sum();
     assert!(unshot < 1e-3 * 1.01, "unshot {unshot}");
-    assert!(escaped < 0.001, "{:.3} % of the emitted power escaped a closed box", escaped * 100.0);
+    assert!(lost < 0.001, "{:.3} % of the emitted power escaped a closed box", lost * 100.0);
+    let created = e.created.sum() / e.emitted.sum();
+    assert!(created < 0.005, "{:.3} % of the emitted power created", created * 100.0);
 }
 
 /// Form factor from a point `p` (unit normal `n`) to a convex polygon in front of it, by

@@ -9,7 +9,14 @@ use super::mesh_tables::MeshTables;
 use super::parallel::Carve;
 use super::row::{CLUSTER_TERM, NearField, Row};
 
-/// Power bookkeeping per channel: emitted = absorbed + unshot + escaped, to round-off.
+/// Power bookkeeping per channel: emitted + created = absorbed + unshot + escaped, to
+/// round-off.
+///
+/// A shot delivers Σ_j A_j F_ji ΔB_i to its receivers, and by reciprocity (Cohen & Wallace
+/// §2.5) Σ_j A_j F_ji = A_i Σ_j F_ij ≤ A_i: no shot can deliver more than the shooter's
+/// power. Discretisation breaks that bound where receivers' point form factors overstate
+/// what they see of a nearby shooter; the excess is `created`, kept apart from `escaped` so
+/// the two cannot hide each other in a closed room.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EnergyBalance {
     /// Σ E·A.
@@ -20,6 +27,18 @@ pub struct EnergyBalance {
     pub unshot: Rgb,
     /// Power shot that reached no element (left an open scene).
     pub escaped: Rgb,
+    /// Power delivered beyond what the shooters shot: Σ over shots of the receivers' excess,
+    /// per channel (zero for a solver that conserves energy shot by shot).
+    pub created: Rgb,
+}
+
+impl EnergyBalance {
+    /// (emitted + created) − (absorbed + unshot + escaped) per channel, relative to the
+    /// emitted power: round-off only.
+    pub fn residual(&self) -> Rgb {
+        let gap = self.emitted + self.created - self.absorbed - self.unshot - self.escaped;
+        gap.zip_map(self.emitted, |g, e| if e > 0.0 { g / e } else { 0.0 })
+    }
 }
 
 /// Who shoots: one patch, or a group of a model's facets (see `clusters`).
@@ -49,6 +68,8 @@ pub(super) struct Tally {
     pub(super) emitted: Rgb,
     absorbed: Rgb,
     escaped: Rgb,
+    /// Power delivered beyond a shot's own (see [`EnergyBalance::created`]).
+    created: Rgb,
     /// Σ |unshot power| / Σ emitted power, summed over channels.
     pub(super) unshot_fraction: f64,
     /// Per patch, its |unshot power| summed over channels, as last tallied.
@@ -142,6 +163,7 @@ impl Tally {
             emitted,
             absorbed: Rgb::ZERO,
             escaped: Rgb::ZERO,
+            created: Rgb::ZERO,
             unshot_fraction: 1.0,
             patch_abs: vec![0.0; mesh.patches.len()],
             abs_total: 0.0,
@@ -352,7 +374,11 @@ impl Tally {
             self.patch_unshot_power[patch] += reflected * area;
             self.changed(patch);
         }
-        self.escaped += mean_b * area - received;
+        // What left the shot unreceived escaped; a shot that delivered more than it carried
+        // created the excess (per channel: a coloured shot can do one and not the other).
+        let left = mean_b * area - received;
+        self.escaped += left.map(|x| x.max(0.0));
+        self.created += left.map(|x| (-x).max(0.0));
         self.tally_direct(tables, by, row, omega, near_scale, grouped);
     }
 
@@ -393,6 +419,12 @@ impl Tally {
     /// Power bookkeeping, with the unshot power summed fresh from the elements.
     pub(super) fn energy(&self, mesh: &Mesh) -> EnergyBalance {
         let unshot = self.unshot.iter().zip(&mesh.elements).map(|(u, el)| *u * el.area).sum();
-        EnergyBalance { emitted: self.emitted, absorbed: self.absorbed, unshot, escaped: self.escaped }
+        EnergyBalance {
+            emitted: self.emitted,
+            absorbed: self.absorbed,
+            unshot,
+            escaped: self.escaped,
+            created: self.created,
+        }
     }
 }
