@@ -51,10 +51,17 @@ mod tests {
     use super::*;
 
     fn rays(visible: u32, traced: u32) -> Received {
-        Received { unoccluded: 0.1, unweighted: 0.1, visible, traced }
+        Received { unoccluded: 0.1, unweighted: 0.1, visible, traced, ..Received::default() }
     }
 
-    const DARK: Received = Received { unoccluded: 0.0, unweighted: 0.0, visible: 0, traced: 0 };
+    const DARK: Received = Received {
+        unoccluded: 0.0,
+        unweighted: 0.0,
+        visible: 0,
+        traced: 0,
+        kernel_visible: 0.0,
+        kernel_traced: 0.0,
+    };
 
     /// Element 0 with neighbours 1..: penumbra rays when a neighbour saw part of the
     /// shooter, or one saw all and another none; never from its own rays alone.

@@ -32,6 +32,46 @@ pub(super) struct Received {
     pub(super) visible: u32,
     /// Rays traced; 0 when the pair needs none (nothing can block it).
     pub(super) traced: u32,
+    /// Σ of the unblocked rays' kernel weights (see [`Seen`]).
+    pub(super) kernel_visible: f32,
+    /// Σ of the traced rays' kernel weights; 0 when the rays carry none (the visibility is
+    /// then the plain fraction `visible / traced`).
+    pub(super) kernel_traced: f32,
+}
+
+/// What an element's rays to the shooter saw: how many were unblocked of how many traced,
+/// and the same weighted by each ray's form factor kernel (see [`super::rays::draw`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(super) struct Seen {
+    /// Unblocked rays.
+    pub(super) visible: u32,
+    /// Rays traced.
+    pub(super) traced: u32,
+    /// Σ kernel weight of the unblocked rays.
+    pub(super) kernel_visible: f32,
+    /// Σ kernel weight of all rays.
+    pub(super) kernel_traced: f32,
+}
+
+impl Seen {
+    /// One more ray of kernel weight `weight`, unblocked or not.
+    pub(super) fn add(&mut self, unblocked: bool, weight: f32) {
+        self.traced += 1;
+        self.kernel_traced += weight;
+        if unblocked {
+            self.visible += 1;
+            self.kernel_visible += weight;
+        }
+    }
+}
+
+impl std::ops::AddAssign<Seen> for Received {
+    fn add_assign(&mut self, seen: Seen) {
+        self.visible += seen.visible;
+        self.traced += seen.traced;
+        self.kernel_visible += seen.kernel_visible;
+        self.kernel_traced += seen.kernel_traced;
+    }
 }
 
 impl Received {
@@ -45,8 +85,16 @@ impl Received {
         self.unweighted * self.visibility()
     }
 
+    /// The unblocked share of the transfer: each ray counted by its form factor kernel
+    /// (Σ K V / Σ K), or by one where the rays carry no weights.
     fn visibility(&self) -> f64 {
-        if self.traced == 0 { 1.0 } else { f64::from(self.visible) / f64::from(self.traced) }
+        if self.traced == 0 {
+            1.0
+        } else if self.kernel_traced > 0.0 {
+            f64::from(self.kernel_visible) / f64::from(self.kernel_traced)
+        } else {
+            f64::from(self.visible) / f64::from(self.traced)
+        }
     }
 }
 
@@ -161,7 +209,7 @@ pub(super) fn receive_patch(
     }
     for (k, r) in out.iter_mut().enumerate() {
         if r.unoccluded > 0.0 {
-            (r.visible, r.traced) = trace(shot, plan, first + k, Rays::Pilot);
+            *r += trace(shot, plan, first + k, Rays::Pilot);
         }
     }
 }
@@ -229,12 +277,14 @@ fn single_rays_in_packets(shot: &Shot, plan: &PatchPlan, first: usize, out: &mut
     let candidates = &mut order[..plan.candidates.len()];
     candidates.copy_from_slice(&plan.candidates);
     let mut packet = Packet::default();
-    let mut test = |packet: &mut Packet, out: &mut [Received]| {
+    let mut weights = [0.0f32; 4];
+    let mut test = |packet: &mut Packet, weights: &[f32; 4], out: &mut [Received]| {
         let blocked =
             shot.blockers.occluded_x4(&Segments4::new(&packet.from, &packet.to, packet.n), candidates);
         for (lane, &k) in packet.owner[..packet.n].iter().enumerate() {
-            out[k as usize].visible += u32::from(blocked >> lane & 1 == 0);
-            out[k as usize].traced += 1;
+            let mut seen = Seen::default();
+            seen.add(blocked >> lane & 1 == 0, weights[lane]);
+            out[k as usize] += seen;
         }
         packet.n = 0;
     };
@@ -242,12 +292,15 @@ fn single_rays_in_packets(shot: &Shot, plan: &PatchPlan, first: usize, out: &mut
         if out[k].unoccluded <= 0.0 {
             continue;
         }
-        draw(shot, plan, first + k, Rays::Pilot, |from, to| packet.push(from, to, k as u32));
+        draw(shot, plan, first + k, Rays::Pilot, |from, to, weight| {
+            weights[packet.n] = weight;
+            packet.push(from, to, k as u32);
+        });
         if packet.n == 4 {
-            test(&mut packet, out);
+            test(&mut packet, &weights, out);
         }
     }
     if packet.n > 0 {
-        test(&mut packet, out);
+        test(&mut packet, &weights, out);
     }
 }

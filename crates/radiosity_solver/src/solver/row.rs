@@ -408,9 +408,7 @@ fn penumbra_pass(
         // A sharing group's members take its visibility, not rays of their own.
         if flags[e] && !shot.sharing.shares(e) {
             let plan = &plans[tables.element_patch[e] as usize];
-            let (visible, traced) = trace(shot, plan, e, Rays::Penumbra);
-            out.visible += visible;
-            out.traced += traced;
+            *out += trace(shot, plan, e, Rays::Penumbra);
         }
     });
 }
@@ -475,7 +473,8 @@ fn receive_shared(shot: &Shot, plans: &[PatchPlan], element_area: &[f64], factor
     let plan_of = |e: usize| &plans[mesh.elements[e].patch as usize];
     let (received, rays) =
         sharing.receive(clusters, element_area, (shot.params.seed, shot.stream), factors_of, |e| {
-            trace(shot, plan_of(e), e, Rays::Pilot)
+            let seen = trace(shot, plan_of(e), e, Rays::Pilot);
+            (seen.visible, seen.traced)
         });
     for_each_maybe_parallel(factors, |e, r| {
         if let Some((u, k)) = sharing.member(clusters, e) {
