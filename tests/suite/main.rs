@@ -12,5 +12,6 @@ mod model_fuzz;
 mod models;
 mod public_models;
 mod readme;
+mod rooms;
 mod verify;
 mod viewer;
