@@ -69,8 +69,9 @@ pub fn run(a: ExportArgs) -> Result<()> {
     drop(solver);
     let mesh = prepared.problem.mesh();
 
-    // The exposure for display colours: fixed, or the log-average radiance over the elements
-    // mapped to middle grey (there is no picture to measure, so the scene itself is used).
+    // The exposure for display colours: fixed, or the elements metered as a picture's pixels
+    // are (lit part to middle grey, capped under white; there is no picture to measure, so
+    // the scene itself is used).
     let radiance = HdrImage::from_pixels(
         solution.element_radiosity.len() as u32,
         1,

@@ -74,7 +74,9 @@ impl From<GatherArg> for Gather {
 /// Exposure and operator, shared by `render` and `tonemap`.
 #[derive(Args, Clone, Debug)]
 pub struct ToneOpts {
-    /// Exposure: `auto` maps the picture's log-average luminance to middle grey; `auto+1` or
+    /// Exposure: `auto` maps the log-average luminance of the picture's lit pixels (near-black
+    /// pixels and the brightest 2 %, where lamps are, left out) to middle grey, held down so
+    /// the brightest lit surfaces stay under display white; `auto+1` or
     /// `auto-0.5` is that many stops brighter or darker than auto; a plain number is a fixed
     /// exposure in stops (EV, radiance × 2^EV: `1` is brighter than `0`, not than auto).
     /// One exposure for the whole picture.

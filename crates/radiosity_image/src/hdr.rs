@@ -79,7 +79,9 @@ impl HdrImage {
     /// Pixels of zero luminance — background seen through an open side, or the unlit back of
     /// a surface — are left out rather than offset by a small δ: they carry no information
     /// about how bright the lit scene is, and a δ would make the result depend on how much
-    /// background the camera happens to see.
+    /// background the camera happens to see. Near-black pixels do still count here, as the
+    /// plain statistic; the automatic exposure ([`crate::auto_exposure_ev`]) meters the lit
+    /// pixels only.
     pub fn log_average_luminance(&self) -> Option<f64> {
         let (sum, count) = self
             .pixels

@@ -42,6 +42,7 @@ pub use render::{
     RECORD_RAYS_PER_GATHER_RAY, RenderError, RenderParams, Renderer, Rendering, Shading, SurfaceHit,
 };
 pub use tonemap::{
-    AUTO_EXPOSURE_KEY, Exposure, SrgbImage, ToneOperator, ToneParams, ToneParseError, auto_exposure_ev,
-    tone_map, tone_map_image,
+    AUTO_EXPOSURE_HIGHLIGHTS, AUTO_EXPOSURE_KEY, AUTO_EXPOSURE_WHITE, Exposure, MeterSample, SrgbImage,
+    ToneOperator, ToneParams, ToneParseError, auto_exposure_ev, metered_exposure_ev, tone_map,
+    tone_map_image,
 };

@@ -6,7 +6,10 @@
 //!
 //! * Exposure and the `auto` key: Reinhard, Stark, Shirley & Ferwerda 2002, "Photographic
 //!   tone reproduction for digital images", eq. 1–2: the log-average luminance L̄ is mapped to
-//!   the middle-grey key a = 0.18, i.e. scale = a / L̄, EV = log2(a / L̄).
+//!   the middle-grey key a = 0.18, i.e. scale = a / L̄, EV = log2(a / L̄). As a camera's
+//!   averaging meter does, L̄ is taken over the lit part of the picture only (see
+//!   [`metered_exposure_ev`]): near-black pixels and lamps are left out, and the exposure is
+//!   then held down so the brightest lit surfaces stay under display white.
 //! * [`ToneOperator::Reinhard`]: the same paper's simple operator, eq. 3, L_d = L / (1 + L),
 //!   applied to luminance with the colour scaled by L_d / L (so hue is kept), then clamped.
 //! * [`ToneOperator::Aces`]: Narkowicz 2015, "ACES Filmic Tone Mapping Curve", the rational fit
@@ -24,6 +27,121 @@ use crate::HdrImage;
 /// Middle grey: the display value the log-average luminance is mapped to by
 /// [`Exposure::Auto`] (Reinhard et al. 2002, the "key" a = 0.18).
 pub const AUTO_EXPOSURE_KEY: f64 = 0.18;
+
+/// The most an automatic exposure lets the brightest lit surfaces (the 98th percentile of the
+/// lit pixels that are not highlights, see [`metered_exposure_ev`]) reach after exposure,
+/// before the operator. On the default ACES curve 4 is display 0.973 (sRGB 252 of 255), just
+/// below its shoulder's clip at 7.24; with Reinhard it is 0.8. `linear` clips above 1 by its
+/// nature, so its brightest 2 % of surfaces may clip.
+pub const AUTO_EXPOSURE_WHITE: f64 = 4.0;
+
+/// The share of the lit picture (by weight) that [`metered_exposure_ev`] treats as
+/// highlights: the brightest 2 %, where a lamp seen directly and the surfaces right beside it
+/// lie. They set neither the key nor the cap, so a lamp does not darken the room.
+pub const AUTO_EXPOSURE_HIGHLIGHTS: f64 = 0.02;
+
+/// Samples more than this many stops below the 90th percentile are black to the meter.
+/// A display shows about 12 stops: sRGB code value 1 of 255 is linear 3.0e-4, 11.7 stops
+/// under white, and the ACES toe sends anything 7 stops under middle grey there. Such pixels
+/// (unlit insides and back faces, the residue a solver or an interpolation leaves on them,
+/// background) carry nothing about how bright the lit room is, yet 30 % of them at 1e-7
+/// pull a plain log-average down by 5 stops and blow the room out to white.
+const AUTO_EXPOSURE_DARK_STOPS: f64 = 12.0;
+
+/// Samples more than this many stops above the median of the lit ones are highlights
+/// whatever their share of the picture: 7 stops above middle grey is radiance 23 after
+/// exposure, far past white for every operator (ACES clips at 7.24), so only a lamp is ever
+/// that bright; holding it under white would darken the whole room by several stops.
+const AUTO_EXPOSURE_HIGHLIGHT_STOPS: f64 = 7.0;
+
+/// One reading for [`metered_exposure_ev`]: a pixel, or a surface element seen from the
+/// camera.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MeterSample {
+    /// Luminance of the radiance seen (`Rgb::luminance`, linear).
+    pub luminance: f64,
+    /// How much of the view it covers: 1 for a pixel, a solid angle for an element.
+    pub weight: f64,
+    /// Whether it is known to be an emitter (a lamp seen directly). A picture's pixels do not
+    /// know and pass `false`; the highlight rule then finds lamps by their brightness.
+    pub emitter: bool,
+}
+
+/// Automatic exposure in stops from what the camera sees, as a photographer's averaging meter
+/// reads a scene: the key of the lit, non-highlight part goes to middle grey, held down so the
+/// brightest lit surfaces stay under display white. `None` when nothing lit is seen.
+///
+/// 1. Lit samples: finite luminance > 0 and weight > 0, emitters left out (unless only
+///    emitters are seen, as in a furnace, where they are the scene), and those more than 12
+///    stops under the weighted 90th percentile left out as black (see the constant's note).
+///    The 90th percentile, not the median, is the reference so that a picture that is mostly
+///    black still has its lit part as the reference, and a lamp covering up to a tenth of it
+///    does not make the room look black.
+/// 2. Highlights: the lit samples lying wholly in the top [`AUTO_EXPOSURE_HIGHLIGHTS`] of the
+///    weight, and any more than 7 stops above the weighted median. What is left is the body.
+/// 3. Key: L̄ = exp(Σ w ln L / Σ w) over the body, EV_key = log2(0.18 / L̄) (Reinhard et al.
+///    2002, eq. 1–2, with the pixels weighted).
+/// 4. Cap: EV_cap = log2([`AUTO_EXPOSURE_WHITE`] / L_top), L_top the brightest of the body
+///    (about the 98th percentile of the lit samples), so a high-contrast room is never blown
+///    out; the exposure is min(EV_key, EV_cap). A dim scene keeps EV_key, which lifts it to
+///    middle grey whatever its scale.
+///
+/// Both the CPU renderer ([`auto_exposure_ev`], over pixels) and the viewer (over the
+/// elements in view, weighted by solid angle) meter through this function, so they agree.
+pub fn metered_exposure_ev(samples: impl IntoIterator<Item = MeterSample>) -> Option<f64> {
+    let mut lit: Vec<MeterSample> = samples
+        .into_iter()
+        .filter(|s| s.luminance.is_finite() && s.luminance > 0.0 && s.weight.is_finite() && s.weight > 0.0)
+        .collect();
+    if lit.iter().any(|s| !s.emitter) {
+        lit.retain(|s| !s.emitter);
+    }
+    if lit.is_empty() {
+        return None;
+    }
+    lit.sort_unstable_by(|a, b| a.luminance.total_cmp(&b.luminance));
+
+    // Weighted quantile: the luminance of the first sample (ascending) at which the running
+    // weight reaches q of the total.
+    let quantile = |lit: &[MeterSample], q: f64| -> f64 {
+        let total: f64 = lit.iter().map(|s| s.weight).sum();
+        let mut run = 0.0;
+        for s in lit {
+            run += s.weight;
+            if run >= q * total {
+                return s.luminance;
+            }
+        }
+        lit[lit.len() - 1].luminance // rounding left the running sum just short
+    };
+
+    let black = quantile(&lit, 0.9) * (-AUTO_EXPOSURE_DARK_STOPS).exp2();
+    let first_lit = lit.partition_point(|s| s.luminance < black);
+    let lit = &lit[first_lit..]; // never empty: the 90th percentile itself is above `black`
+
+    let too_bright = quantile(lit, 0.5) * AUTO_EXPOSURE_HIGHLIGHT_STOPS.exp2();
+    let total: f64 = lit.iter().map(|s| s.weight).sum();
+    let (mut end, mut above) = (lit.len(), 0.0);
+    // Whole samples only, so a small picture (or a uniform one) keeps every sample; the
+    // median sample is never above `too_bright` and a share of 2 % never covers all weight,
+    // so the body is never empty.
+    while end > 1 {
+        let s = lit[end - 1];
+        if s.luminance > too_bright || above + s.weight <= AUTO_EXPOSURE_HIGHLIGHTS * total {
+            above += s.weight;
+            end -= 1;
+        } else {
+            break;
+        }
+    }
+    let body = &lit[..end];
+
+    let (sum, weight) =
+        body.iter().fold((0.0, 0.0), |(s, w), m| (s + m.weight * m.luminance.ln(), w + m.weight));
+    let key_ev = (AUTO_EXPOSURE_KEY / (sum / weight).exp()).log2();
+    let cap_ev = (AUTO_EXPOSURE_WHITE / body[body.len() - 1].luminance).log2();
+    Some(key_ev.min(cap_ev))
+}
 
 /// How the compressed range is mapped into [0, 1].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -88,8 +206,10 @@ impl FromStr for ToneOperator {
 pub enum Exposure {
     /// A fixed exposure in stops: radiance is multiplied by 2^EV before the operator.
     Ev(f64),
-    /// From the picture itself: its log-average luminance is mapped to middle grey
-    /// ([`AUTO_EXPOSURE_KEY`]). Still one exposure for the whole picture. The default.
+    /// From the picture itself: the log-average luminance of its lit pixels is mapped to
+    /// middle grey ([`AUTO_EXPOSURE_KEY`]), held down so the brightest lit surfaces stay under
+    /// display white ([`auto_exposure_ev`]). Still one exposure for the whole picture. The
+    /// default.
     #[default]
     Auto,
     /// [`Exposure::Auto`] plus this many stops (`auto+1` is one stop brighter than auto):
@@ -141,10 +261,18 @@ impl FromStr for Exposure {
     }
 }
 
-/// The exposure (stops) that maps the log-average luminance of `image` to middle grey:
-/// EV = log2(0.18 / L̄) (Reinhard et al. 2002, eq. 2). 0 for a black picture.
+/// The automatic exposure (stops) of `image`: [`metered_exposure_ev`] over its pixels, each
+/// of weight 1 (a picture does not know which pixels are lamps; the highlight rule finds
+/// them). The key of the lit pixels goes to middle grey, EV = log2(0.18 / L̄) (Reinhard et
+/// al. 2002, eq. 2), held down so their 98th percentile stays under display white.
+/// 0 for a black picture.
 pub fn auto_exposure_ev(image: &HdrImage) -> f64 {
-    image.log_average_luminance().map_or(0.0, |l| (AUTO_EXPOSURE_KEY / l).log2())
+    metered_exposure_ev(image.pixels().iter().map(|p| MeterSample {
+        luminance: p.luminance(),
+        weight: 1.0,
+        emitter: false,
+    }))
+    .unwrap_or(0.0)
 }
 
 /// Tone mapping settings: one exposure for the whole picture and an operator.
@@ -324,6 +452,150 @@ mod tests {
         assert!((auto_exposure_ev(&with_background) - ev).abs() < 1e-12);
         assert_eq!(auto_exposure_ev(&HdrImage::new(3, 3)), 0.0);
         assert_eq!(Exposure::Ev(-1.5).ev_for(&img), -1.5);
+    }
+
+    /// The exposure the rule before the meter picked: the plain log-average of every pixel
+    /// above zero to middle grey.
+    fn plain_log_average_ev(image: &HdrImage) -> f64 {
+        image.log_average_luminance().map_or(0.0, |l| (AUTO_EXPOSURE_KEY / l).log2())
+    }
+
+    /// A fixed, well-spread value in [0, 1) for pixel `i` (the golden-ratio sequence), so the
+    /// synthetic pictures need no random generator.
+    fn spread(i: u32) -> f64 {
+        (f64::from(i) * 0.618_033_988_749_895).fract()
+    }
+
+    /// The sRGB display value (0..1) of one grey pixel's green channel, and whether any of
+    /// its channels is at 255.
+    fn display(p: [u8; 3]) -> (f64, bool) {
+        (f64::from(p[1]) / 255.0, p.contains(&255))
+    }
+
+    /// A furnished room lit by one bright panel, as `render` sees it: 70 % of the pixels lit
+    /// surfaces between 0.5 and 2 (walls, floor, table, chairs), 1 % the panel at 500, 25 %
+    /// unlit insides and back faces holding a residue of 1e-7 and 5 % background at 0. The old
+    /// rule let the residue drag the log-average down 6 stops and drew the room white.
+    #[test]
+    fn auto_exposure_keeps_a_bright_lamp_room_off_white() {
+        #[derive(Clone, Copy, PartialEq)]
+        enum Kind {
+            Lit,
+            Lamp,
+            Residue,
+            Background,
+        }
+        let kind = |i: u32| match i % 100 {
+            0 => Kind::Lamp,
+            1..=25 => Kind::Residue,
+            26..=30 => Kind::Background,
+            _ => Kind::Lit,
+        };
+        let (w, h) = (200, 150);
+        let picture = HdrImage::from_fn(w, h, |x, y| {
+            let i = y * w + x;
+            match kind(i) {
+                Kind::Lit => grey(0.5 * 4.0_f64.powf(spread(i))),
+                Kind::Lamp => grey(500.0),
+                Kind::Residue => grey(1e-7),
+                Kind::Background => Rgb::ZERO,
+            }
+        });
+        let ev = auto_exposure_ev(&picture);
+        let old = plain_log_average_ev(&picture);
+        eprintln!("lamp room: auto {ev:+.2} EV, plain log-average {old:+.2} EV");
+        for op in ToneOperator::ALL {
+            let srgb = tone_map_image(&picture, &ToneParams::new(ev, op));
+            let mut lit: Vec<(f64, bool)> = (0..w * h)
+                .filter(|i| kind(*i) == Kind::Lit)
+                .map(|i| display(srgb.pixels[i as usize]))
+                .collect();
+            let clipped = lit.iter().filter(|(_, white)| *white).count() as f64 / lit.len() as f64;
+            lit.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let median = lit[lit.len() / 2].0;
+            assert!(clipped < 0.02, "{op}: {:.1} % of the lit pixels clip to white", clipped * 100.0);
+            assert!((0.25..=0.75).contains(&median), "{op}: median lit pixel at display {median:.3}");
+        }
+        // The plain log-average would have blown the room out: its median lit pixel clips.
+        let srgb = tone_map_image(&picture, &ToneParams::new(old, ToneOperator::Aces));
+        let lit: Vec<_> =
+            (0..w * h).filter(|i| kind(*i) == Kind::Lit).map(|i| display(srgb.pixels[i as usize])).collect();
+        assert!(old > ev + 5.0, "old {old:+.2} EV vs {ev:+.2} EV");
+        assert!(
+            lit.iter().filter(|(_, white)| *white).count() * 2 > lit.len(),
+            "old rule: most lit pixels white"
+        );
+    }
+
+    /// A dim scene (radiance 1e-4 everywhere) is lifted to middle grey by the key, not left
+    /// black, and the cap does not hold it down.
+    #[test]
+    fn auto_exposure_lifts_a_dim_scene() {
+        let picture = HdrImage::from_fn(64, 48, |x, y| grey(1e-4 * (1.0 + 0.2 * spread(y * 64 + x))));
+        let ev = auto_exposure_ev(&picture);
+        let srgb = tone_map_image(&picture, &ToneParams::new(ev, ToneOperator::Aces));
+        let mut values: Vec<f64> = srgb.pixels.iter().map(|p| display(*p).0).collect();
+        values.sort_by(f64::total_cmp);
+        let median = values[values.len() / 2];
+        assert!(median > 0.2, "dim scene drawn at display {median:.3} (EV {ev:+.2})");
+        let flat = HdrImage::from_fn(8, 8, |_, _| grey(1e-4));
+        assert!((auto_exposure_ev(&flat) - (AUTO_EXPOSURE_KEY / 1e-4).log2()).abs() < 1e-9);
+    }
+
+    /// A high-contrast room: 90 % dim surfaces around 0.01 and a sunlit patch at 1.0 on 10 %
+    /// of the picture. The key alone would put the patch at 11 (past ACES white); the cap holds
+    /// it at [`AUTO_EXPOSURE_WHITE`], and the dim part stays visible.
+    #[test]
+    fn auto_exposure_holds_bright_surfaces_under_white() {
+        let picture = HdrImage::from_fn(100, 100, |x, y| {
+            let i = y * 100 + x;
+            if i % 10 == 0 { grey(1.0) } else { grey(0.005 * 4.0_f64.powf(spread(i))) }
+        });
+        let ev = auto_exposure_ev(&picture);
+        assert!((ev - AUTO_EXPOSURE_WHITE.log2()).abs() < 1e-9, "capped at the patch: {ev:+.3} EV");
+        let srgb = tone_map_image(&picture, &ToneParams::new(ev, ToneOperator::Aces));
+        assert!(srgb.pixels.iter().all(|p| !display(*p).1), "nothing clips");
+        assert!(srgb.pixels.iter().all(|p| display(*p).0 > 0.02), "the dim part is not black");
+        // The plain log-average clips the patch.
+        let old = plain_log_average_ev(&picture);
+        let srgb = tone_map_image(&picture, &ToneParams::new(old, ToneOperator::Aces));
+        assert!(srgb.pixels.iter().filter(|p| display(**p).1).count() >= 1000, "old {old:+.2} EV");
+    }
+
+    /// A Cornell-box-like picture — 30 % background at 0, the lamp at 250× the median on
+    /// 0.7 %, the rest spread over 6 stops — meters within a fifth of a stop of the plain
+    /// log-average, which served it well (a little brighter: the lamp no longer counts).
+    #[test]
+    fn auto_exposure_of_a_cornell_like_picture_is_close_to_the_plain_key() {
+        let picture = HdrImage::from_fn(200, 150, |x, y| {
+            let i = y * 200 + x;
+            match i % 1000 {
+                0..=299 => Rgb::ZERO,
+                300..=306 => grey(12.4),
+                _ => Rgb::new(0.9, 1.0, 1.1) * (0.0035 * 64.0_f64.powf(spread(i))),
+            }
+        });
+        let (ev, old) = (auto_exposure_ev(&picture), plain_log_average_ev(&picture));
+        assert!(ev >= old && ev - old < 0.2, "{ev:+.3} EV vs {old:+.3} EV");
+    }
+
+    /// Samples flagged as emitters are left out (the viewer knows its lamps), unless nothing
+    /// else is seen; weights count as pixel shares; nothing lit gives `None`.
+    #[test]
+    fn the_meter_leaves_out_emitters_and_weighs_samples() {
+        let sample = |luminance, weight, emitter| MeterSample { luminance, weight, emitter };
+        let room = [sample(0.5, 1.0, false), sample(2.0, 1.0, false)];
+        let ev = metered_exposure_ev(room).unwrap();
+        assert!((ev - (AUTO_EXPOSURE_KEY / 1.0).log2()).abs() < 1e-12);
+        let with_lamp = [room[0], room[1], sample(1e4, 5.0, true)];
+        assert_eq!(metered_exposure_ev(with_lamp), Some(ev));
+        let only_lamp = [sample(1e4, 5.0, true)];
+        assert!((metered_exposure_ev(only_lamp).unwrap() - (AUTO_EXPOSURE_KEY / 1e4).log2()).abs() < 1e-12);
+        // Weight 3 on 0.5 and 1 on 8: L̄ = exp((3 ln 0.5 + ln 8) / 4) = 1.
+        let weighted = [sample(0.5, 3.0, false), sample(8.0, 1.0, false)];
+        assert!((metered_exposure_ev(weighted).unwrap() - AUTO_EXPOSURE_KEY.log2()).abs() < 1e-12);
+        assert_eq!(metered_exposure_ev([sample(0.0, 1.0, false), sample(f64::NAN, 1.0, false)]), None);
+        assert_eq!(metered_exposure_ev([sample(1.0, 0.0, false)]), None);
     }
 
     #[test]

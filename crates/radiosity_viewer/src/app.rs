@@ -46,8 +46,9 @@ pub const KEY_HINT: &str = "WASD/arrows move · Q/E or Ctrl/Space down/up · dra
 pub struct ViewState {
     /// The fly-through camera.
     pub camera: FlyCamera,
-    /// Exposure follows what the camera sees (its log-average luminance goes to middle grey),
-    /// as `render`'s default `--exposure auto` does for its picture.
+    /// Exposure follows what the camera sees (the log-average luminance of its lit surfaces,
+    /// lamps left out, goes to middle grey, held down so the brightest stay under white), as
+    /// `render`'s default `--exposure auto` does for its picture.
     pub auto_exposure: bool,
     /// Exposure in stops when not automatic.
     pub exposure_ev: f64,

@@ -64,7 +64,8 @@ pub struct ViewerOptions {
     pub wireframe: Wireframe,
     /// How much of a big mesh is drawn, at start.
     pub detail: Detail,
-    /// Exposure in stops at start; `None`: automatic (log-average luminance to middle grey).
+    /// Exposure in stops at start; `None`: automatic (the log-average luminance of the lit
+    /// surfaces in view to middle grey, see `render::auto_exposure_ev`).
     pub exposure_ev: Option<f64>,
     /// Tone-map operator at start.
     pub operator: radiosity_image::ToneOperator,

@@ -815,37 +815,41 @@ pub fn false_colour_range(solution: &Solution, mode: DisplayMode) -> (f64, f64) 
 /// the estimate stays a fraction of a millisecond.
 pub const AUTO_EXPOSURE_SAMPLES: usize = 50_000;
 
-/// Automatic exposure for what the camera sees, in stops: the log-average luminance of the
-/// visible radiance (B/π) goes to middle grey, as `render --exposure auto` does over its
-/// pixels (Reinhard et al. 2002). Each element in front of the camera, inside the view and
-/// facing it counts with its solid angle, area·cosθ/d² — the share of pixels it would cover,
-/// occlusion aside. `None` when nothing lit is in view.
+/// Automatic exposure for what the camera sees, in stops: the same meter as
+/// `render --exposure auto` over its pixels ([`radiosity_image::metered_exposure_ev`]: the
+/// log-average luminance of the lit, non-highlight radiance B/π goes to middle grey, held down
+/// so the brightest lit surfaces stay under display white). Each element in front of the
+/// camera, inside the view and facing it counts with its solid angle, area·cosθ/d² — the
+/// share of pixels it would cover, occlusion aside — and is flagged as an emitter when its
+/// material emits, so a lamp in view is left out of the meter. `None` when nothing lit is in
+/// view.
 pub fn auto_exposure_ev(mesh: &Mesh, solution: &Solution, clip_from_world: DMat4, eye: DVec3) -> Option<f64> {
     if solution.element_radiosity.len() != mesh.elements.len() {
         return None;
     }
     let step = mesh.elements.len().div_ceil(AUTO_EXPOSURE_SAMPLES).max(1);
-    let (mut sum, mut weight) = (0.0, 0.0);
-    for (el, b) in mesh.elements.iter().zip(&solution.element_radiosity).step_by(step) {
-        let to_eye = eye - el.centre;
-        let d2 = to_eye.length_squared();
-        let cos = el.normal.dot(to_eye) / d2.sqrt();
-        // Back faces are culled, so only the lit side is ever seen (NaN: a degenerate element).
-        if cos.is_nan() || cos <= 0.0 {
-            continue;
-        }
-        let c = clip_from_world * el.centre.extend(1.0);
-        if c.w <= 0.0 || c.x.abs() > c.w || c.y.abs() > c.w {
-            continue;
-        }
-        let l = b.luminance() / std::f64::consts::PI;
-        if l > 0.0 && l.is_finite() {
-            let w = el.area * cos / d2;
-            sum += w * l.ln();
-            weight += w;
-        }
-    }
-    (weight > 0.0).then(|| (radiosity_image::AUTO_EXPOSURE_KEY / (sum / weight).exp()).log2())
+    let samples = mesh.elements.iter().zip(&solution.element_radiosity).enumerate().step_by(step).filter_map(
+        |(e, (el, b))| {
+            let to_eye = eye - el.centre;
+            let d2 = to_eye.length_squared();
+            let cos = el.normal.dot(to_eye) / d2.sqrt();
+            // Back faces are culled, so only the lit side is ever seen (NaN: a degenerate
+            // element).
+            if cos.is_nan() || cos <= 0.0 {
+                return None;
+            }
+            let c = clip_from_world * el.centre.extend(1.0);
+            if c.w <= 0.0 || c.x.abs() > c.w || c.y.abs() > c.w {
+                return None;
+            }
+            Some(radiosity_image::MeterSample {
+                luminance: b.luminance() / std::f64::consts::PI,
+                weight: el.area * cos / d2,
+                emitter: mesh.element_material(e).emission.max_channel() > 0.0,
+            })
+        },
+    );
+    radiosity_image::metered_exposure_ev(samples)
 }
 
 /// The Turbo false-colour ramp at t in [0, 1], display values in [0, 1]; the same polynomial
@@ -926,7 +930,7 @@ mod tests {
     }
 
     /// From the Cornell box's camera, the viewer's automatic exposure is that of
-    /// `render --exposure auto` (the CPU renderer's log-average over its pixels) within a
+    /// `render --exposure auto` (the same meter over the CPU renderer's pixels) within a
     /// quarter of a stop: the solid-angle weights stand in for pixel counts, occlusion by the
     /// blocks aside.
     #[test]
