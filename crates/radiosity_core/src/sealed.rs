@@ -29,8 +29,8 @@ use glam::DVec3;
 use crate::planar::{bounds, key};
 use crate::scene::{Polygon, Scene, Shape, Sides};
 
-/// Emitter points tested against each closed object, spread over the emitters.
-const MAX_EMITTER_POINTS: usize = 32;
+/// Emitting polygon sides tested against each closed object, spread over the emitters.
+const MAX_EMITTER_SIDES: usize = 32;
 
 /// Directions of the rays cast from each emitter point (normalised where used), off the axes
 /// and diagonals a model is built along; a majority decides, so that one ray that slips along
@@ -66,7 +66,7 @@ pub struct Sealed {
 /// area, with no emitter on its back side, or with every emitter on it (then its faces are
 /// turned, so that the side the light is on is their front); returns them in scene order.
 pub fn seal_closed_objects(scene: &mut Scene) -> Vec<Sealed> {
-    let points = emitter_points(scene);
+    let sides = emitter_points(scene);
     let mut sealed = Vec::new();
     for (i, o) in scene.objects.iter_mut().enumerate() {
         let polygons = match &o.shape {
@@ -80,12 +80,20 @@ pub fn seal_closed_objects(scene: &mut Scene) -> Vec<Sealed> {
         }
         let Some(holes) = Holes::of(polygons) else { continue };
         let surface = Closed::new(polygons, &holes.caps);
-        let behind = points.iter().filter(|&&p| surface.behind(p)).count();
-        let turned = match behind {
-            0 => false,
-            n if n == points.len() => true,
-            _ => continue,
-        };
+        // Each lamp side by the majority of its points: a closed object touching the lamp
+        // (a pendant's rod, a housing around the panel) may hold one of them.
+        let mut verdicts = sides.iter().map(|points| {
+            let behind = points.iter().filter(|&&p| surface.behind(p)).count();
+            match 2 * behind {
+                b if b < points.len() => Some(false),
+                b if b > points.len() => Some(true),
+                _ => None,
+            }
+        });
+        let Some(Some(turned)) = verdicts.next() else { continue };
+        if !verdicts.all(|v| v == Some(turned)) {
+            continue;
+        }
         if turned {
             o.shape = match &o.shape {
                 Shape::Polygons(ps) => Shape::Polygons(ps.iter().map(Polygon::flipped).collect()),
@@ -178,39 +186,45 @@ impl Holes {
 }
 
 /// Points just in front of the scene's emitters (and behind those that emit from both
-/// sides), at most [`MAX_EMITTER_POINTS`], spread over every emitting polygon in turn.
-fn emitter_points(scene: &Scene) -> Vec<DVec3> {
+/// sides), one group per emitting side of a polygon (at most [`MAX_EMITTER_SIDES`], spread
+/// over every emitting polygon in turn): its centre and the points halfway from it to each
+/// corner. One point per side was not enough: a pendant's rod standing on the middle of a
+/// ceiling panel held it, so the fixture seemed to enclose the lamp and was turned inside
+/// out, and its faces read 0 against the path tracer's 0.25.
+fn emitter_points(scene: &Scene) -> Vec<Vec<DVec3>> {
     let (lo, hi) = scene.bounds();
     let step = 1e-6 * lo.distance(hi).max(f64::MIN_POSITIVE);
-    let mut points = Vec::new();
+    let mut sides = Vec::new();
     for o in scene.objects.iter().filter(|o| scene.materials[o.material].is_emitter()) {
         let both = matches!(o.sides, Sides::Two { emits_back: true });
         match &o.shape {
             Shape::Sphere(s) => {
                 // Light leaves the outside of a ball and the inside of a dome.
                 let out = if s.facing == crate::scene::Facing::Outward { 1.0 + 1e-6 } else { 0.0 };
-                points.push(s.center + DVec3::Y * (s.radius * out));
+                sides.push(vec![s.center + DVec3::Y * (s.radius * out)]);
             }
-            Shape::Polygons(ps) => push_fronts(&mut points, ps, both, step),
-            Shape::Mesh(m) => push_fronts(&mut points, m.polygons(), both, step),
+            Shape::Polygons(ps) => push_fronts(&mut sides, ps, both, step),
+            Shape::Mesh(m) => push_fronts(&mut sides, m.polygons(), both, step),
         }
     }
-    if points.len() > MAX_EMITTER_POINTS {
-        let stride = points.len().div_ceil(MAX_EMITTER_POINTS);
-        points = points.into_iter().step_by(stride).collect();
+    if sides.len() > MAX_EMITTER_SIDES {
+        let stride = sides.len().div_ceil(MAX_EMITTER_SIDES);
+        sides = sides.into_iter().step_by(stride).collect();
     }
-    points
+    sides
 }
 
-fn push_fronts(points: &mut Vec<DVec3>, polygons: &[Polygon], both: bool, step: f64) {
+fn push_fronts(sides: &mut Vec<Vec<DVec3>>, polygons: &[Polygon], both: bool, step: f64) {
     // A mesh lamp of thousands of facets: a spread of them is enough to place it.
-    let stride = polygons.len().div_ceil(MAX_EMITTER_POINTS).max(1);
+    let stride = polygons.len().div_ceil(MAX_EMITTER_SIDES).max(1);
     for p in polygons.iter().step_by(stride) {
         let v = p.vertices();
         let centre = v.iter().sum::<DVec3>() / v.len() as f64;
-        points.push(centre + p.normal() * step);
+        let on_face: Vec<DVec3> =
+            std::iter::once(centre).chain(v.iter().map(|c| centre + (*c - centre) * 0.5)).collect();
+        sides.push(on_face.iter().map(|q| *q + p.normal() * step).collect());
         if both {
-            points.push(centre - p.normal() * step);
+            sides.push(on_face.iter().map(|q| *q - p.normal() * step).collect());
         }
     }
 }
@@ -374,6 +388,24 @@ mod tests {
         }
         let shape = Shape::Mesh(shared_mesh(quads));
         Object { name: "scan".into(), material: 1, shape, sides: Sides::Two { emits_back: false } }
+    }
+
+    /// A pendant's rod standing on the middle of a ceiling lamp holds the point just below
+    /// the lamp's centre: decided by that point alone, the closed rod seemed to enclose the
+    /// lamp and was turned inside out. The lamp's other points see its outside.
+    #[test]
+    fn a_rod_touching_the_middle_of_a_lamp_is_sealed_not_turned() {
+        let faces = box_faces(DVec3::new(0.48, 0.2, 0.48), DVec3::new(0.52, 1.0, 0.52), Facing::Outward, 0.0);
+        let rod = Object {
+            name: "rod".into(),
+            material: 1,
+            shape: Shape::Mesh(shared_mesh(faces.unwrap().iter().map(|f| f.vertices().to_vec()))),
+            sides: Sides::Two { emits_back: false },
+        };
+        let mut s = scene(vec![lamp(DVec3::new(0.5, 1.0, 0.5), true), rod]);
+        let got = seal_closed_objects(&mut s);
+        assert_eq!(got.len(), 1, "{got:?}");
+        assert!(!got[0].turned, "the rod's outside faces the lamp: {got:?}");
     }
 
     /// A scan with small holes (two cells of one face, 2/96 of the area) is sealed, its
