@@ -81,11 +81,18 @@ impl Targets {
 
     /// Checks that `path` (given as `option`) can be written at the end of the run: its folder
     /// exists and takes a new file, it is not an existing file without `--force` nor anything
-    /// but a regular file, and no other target of this run is the same file.
+    /// but a regular file, and no other target of this run is the same file. An existing
+    /// character device or named pipe (`/dev/null`, `/dev/stdout`, a FIFO) is taken as it
+    /// is: writing to it replaces nothing.
     ///
     /// # Errors
     /// Each problem as an [`InputError`] naming the option and the path (exit code 2).
     pub fn file(&mut self, path: &Path, option: &str) -> Result<()> {
+        if is_stream(path) {
+            // /dev/null, a terminal, a named pipe: written straight through, nothing stored
+            // is replaced (see `write_file`).
+            return Ok(());
+        }
         let id = Self::identity(path, option)?;
         match std::fs::metadata(path) {
             Ok(meta) if !meta.is_file() => {
@@ -142,6 +149,13 @@ impl Targets {
     }
 }
 
+/// Whether `path` is an existing character device or named pipe: a stream to write into,
+/// not a file to replace (`/dev/null` to discard a report).
+fn is_stream(path: &Path) -> bool {
+    use std::os::unix::fs::FileTypeExt;
+    std::fs::metadata(path).is_ok_and(|m| m.file_type().is_char_device() || m.file_type().is_fifo())
+}
+
 /// Writes `bytes` to `path` atomically (see the module doc). Without `force`, a file that
 /// appeared at `path` during the run is kept and the run fails.
 ///
@@ -149,6 +163,13 @@ impl Targets {
 /// The temporary file cannot be made, written or synced (full disk, permissions), or the
 /// rename fails or would replace a file without `force`.
 pub fn write_file(path: &Path, force: bool, bytes: &[u8]) -> Result<()> {
+    if is_stream(path) {
+        let mut out = std::fs::OpenOptions::new()
+            .write(true)
+            .open(path)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        return out.write_all(bytes).with_context(|| format!("cannot write {}", path.display()));
+    }
     let folder = folder_of(path);
     let mut prefix = OsString::from(".");
     prefix.push(path.file_name().unwrap_or_default());
@@ -314,6 +335,18 @@ mod tests {
         let e = Targets::new(true).file(dir.path(), "-o").unwrap_err();
         assert!(e.to_string().contains("not a regular file"), "{e}");
         assert!(e.is::<InputError>());
+    }
+
+    /// `/dev/null` takes a report with or without `--force`, twice in one run too: it is a
+    /// stream, not a file that could be replaced.
+    #[test]
+    fn dev_null_takes_a_report() {
+        let null = Path::new("/dev/null");
+        let mut targets = Targets::new(false);
+        targets.file(null, "--json").unwrap();
+        targets.file(null, "-o").unwrap();
+        write_file(null, false, b"{}\n").unwrap();
+        write_file(null, true, b"{}\n").unwrap();
     }
 
     #[test]

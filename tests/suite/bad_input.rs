@@ -285,7 +285,6 @@ fn output_targets_are_checked_before_the_solve() {
         (vec!["solve", "cornell", "--json", &missing], "no/such/folder"),
         (vec!["solve", "cornell", "--json", &folder], "not a regular file"),
         (vec!["export", "cornell", "-o", &missing], "no/such/folder"),
-        (vec!["render", "cornell", "--pfm", "/dev/null"], "not a regular file"),
     ];
     for (mut args, needle) in cases {
         args.extend(slow);
@@ -293,6 +292,31 @@ fn output_targets_are_checked_before_the_solve() {
         assert_input_error(&o, &args.join(" "), &[needle]);
     }
     assert!(!d.join("x.png").exists());
+}
+
+/// `/dev/null` (a stream, not a file that could be replaced) takes a report or a picture,
+/// with or without `--force`: the common way to discard one.
+#[test]
+fn outputs_to_dev_null_are_discarded() {
+    for args in [
+        vec!["solve", "cornell", "--max-shots", "5", "--json", "/dev/null"],
+        vec!["solve", "cornell", "--max-shots", "5", "--json", "/dev/null", "--force"],
+        vec![
+            "render",
+            "cornell",
+            "--max-shots",
+            "5",
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--pfm",
+            "/dev/null",
+        ],
+    ] {
+        let o = run(&args);
+        assert!(o.status.success(), "{}: {}", args.join(" "), String::from_utf8_lossy(&o.stderr));
+    }
 }
 
 #[cfg(unix)]
@@ -490,4 +514,22 @@ fn nothing_is_overwritten_that_appeared_during_the_run() {
     ]);
     assert_input_error(&o, "existing png", &["a.png", "--force"]);
     assert_eq!(std::fs::read_to_string(&png).unwrap(), "precious");
+}
+
+/// A threshold no solve can reach (1e-300) stops where shooting changes nothing the solution
+/// can show (`UNSHOT_FLOOR`, 1e-12), converged, saying so, instead of running until a time
+/// limit with its progress at 0.000 %.
+#[test]
+fn an_unreachable_threshold_stops_at_the_floor() {
+    let o = run(&["solve", "cornell", "--unshot-threshold", "1e-300", "--json", "-"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("stops at 1e-12"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(report["stop_reason"], "converged", "{report}");
+    let unshot = report["unshot_fraction"].as_f64().unwrap();
+    assert!(unshot <= 1e-12 && unshot > 0.0, "{unshot}");
 }
