@@ -465,7 +465,14 @@ pub fn run_solver(p: &Prepared) -> Result<(Solver, StepReport)> {
     } else {
         ProgressBar::hidden()
     };
-    let threshold = p.params.unshot_threshold;
+    let threshold = p.params.unshot_threshold.max(radiosity_solver::UNSHOT_FLOOR);
+    if p.params.unshot_threshold < radiosity_solver::UNSHOT_FLOOR {
+        crate::output::note(format_args!(
+            "note: an unshot threshold of {:e} is below what the solution can show: the solve stops at {:e}, where a shot changes no radiosity by more than round-off",
+            p.params.unshot_threshold,
+            radiosity_solver::UNSHOT_FLOOR
+        ))?;
+    }
     let start = Instant::now();
     let mut last_log = start;
     let report = loop {

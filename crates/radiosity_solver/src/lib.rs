@@ -32,5 +32,5 @@ pub use problem::Problem;
 pub use solution::{ObjectRadiosity, Solution};
 pub use solver::{
     Ambient, EnergyBalance, FormFactorMethod, Overshoot, Solver, SolverError, SolverParams, StepBudget,
-    StepReport, StopReason, shooter_groups,
+    StepReport, StopReason, UNSHOT_FLOOR, shooter_groups,
 };

@@ -58,7 +58,7 @@ mod uneven;
 
 pub use error::SolverError;
 pub use params::{Ambient, FormFactorMethod, Overshoot, SolverParams};
-pub use stop::{StepBudget, StepReport, StopReason};
+pub use stop::{StepBudget, StepReport, StopReason, UNSHOT_FLOOR};
 pub use tally::EnergyBalance;
 
 use crate::solution::{Solution, vertex_average};

@@ -6,6 +6,13 @@ use std::time::Duration;
 
 use super::SolverParams;
 
+/// The least unshot fraction a solve shoots down to, whatever its threshold asks. Below it
+/// a shot changes no radiosity by more than this share of the emitted power's: far under
+/// the single-precision form factors the rows keep (1e-7), so shooting on moves nothing the
+/// solution can show, and the unshot power falls geometrically for ever (to 1e-300 it
+/// would run until the time limit, its progress reading 0.000 %).
+pub const UNSHOT_FLOOR: f64 = 1e-12;
+
 /// Why a solve stopped.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum StopReason {
@@ -128,7 +135,7 @@ impl Progress {
     /// limit, time limit, not converging.
     pub(super) fn check(&mut self, params: &SolverParams, unshot_fraction: f64) -> Option<StopReason> {
         if self.stop.is_none() {
-            self.stop = if unshot_fraction <= params.unshot_threshold {
+            self.stop = if unshot_fraction <= params.unshot_threshold.max(UNSHOT_FLOOR) {
                 Some(StopReason::Converged)
             } else if params.max_shots.is_some_and(|m| self.shots >= m) {
                 Some(StopReason::ShotLimit)
