@@ -10,7 +10,9 @@
 //! elements (fast and reference path), ~15 k on one thread and ~100 k elements to unshot
 //! 1e-3; (d) the peak heap of every solve case and the bytes per element; (e) with `--big`,
 //! models from files (load, mesh and solve to 1 % unshot, peak heap per triangle), and with
-//! `--big-baseline` the same without clustering.
+//! `--big-baseline` the same without clustering; (f) with `--real`, real rooms solved as
+//! `solve` does and judged against `verify`'s path tracer (`bench_real.rs`); given `--real`,
+//! the fixed cases (a)–(d) are left out, as a real room is what that run is for.
 
 use std::f64::consts::PI;
 use std::io::Write;
@@ -54,6 +56,15 @@ pub struct BenchArgs {
     /// clustering), and print the ratio. Slow on big models: that is the point.
     #[arg(long)]
     pub big_baseline: bool,
+    /// A real room (scene file, OBJ, glTF; e.g. one written by `scripts/real_rooms.py`):
+    /// load and mesh it as `solve` does, time the solve to 1 % and 0.1 % unshot, peak heap,
+    /// energy audit, and `verify`'s comparison with the path tracer. Repeatable; leaves out
+    /// the fixed cases.
+    #[arg(long, value_name = "SCENE")]
+    pub real: Vec<String>,
+    /// With --real: seconds of path tracing for each scene's reference.
+    #[arg(long, default_value_t = 60.0, value_name = "S", allow_negative_numbers = true)]
+    pub real_reference_seconds: f64,
 }
 
 /// Triangles of a UV sphere with `stacks × slices` cells.
@@ -275,8 +286,49 @@ pub fn run(a: BenchArgs) -> Result<()> {
     if let Some(path) = a.dump_rays.as_deref() {
         targets.file(std::path::Path::new(path), "--dump-rays")?;
     }
+    if !a.real.is_empty() {
+        crate::bench_real::check_reference_seconds(a.real_reference_seconds)?;
+    }
     let threads = rayon::current_num_threads();
     output::stdout(&format!("radiosity bench ({threads} threads)\n"))?;
+    let mut cases = if a.real.is_empty() { fixed_cases(&a)? } else { Vec::new() };
+
+    for scene in &a.big {
+        let clustered = big_case(scene, true)?;
+        if a.big_baseline {
+            let alone = big_case(scene, false)?;
+            let ratio = alone["solve_seconds"].as_f64().unwrap_or(f64::NAN)
+                / clustered["solve_seconds"].as_f64().unwrap_or(f64::NAN);
+            output::stdout(&format!(
+                "    clustered facets solve {ratio:.1}× faster than facets shooting alone\n"
+            ))?;
+            cases.push(json!({"case": "big_clustered_vs_alone", "clustered": clustered, "alone": alone,
+                "speedup": ratio}));
+        } else {
+            cases.push(clustered);
+        }
+    }
+
+    if !a.real.is_empty() {
+        output::stdout(&crate::bench_real::header())?;
+    }
+    for scene in &a.real {
+        cases.push(crate::bench_real::real_case(scene, a.real_reference_seconds)?);
+    }
+
+    if let Some(path) = &a.json {
+        let text = serde_json::to_string_pretty(&json!({"threads": threads, "cases": cases}))? + "\n";
+        if path == "-" {
+            output::stdout(&text)?;
+        } else {
+            output::write_file(std::path::Path::new(path), a.force, text.as_bytes())?;
+        }
+    }
+    Ok(())
+}
+
+/// Cases (a)–(d).
+fn fixed_cases(a: &BenchArgs) -> Result<Vec<serde_json::Value>> {
     let cornell = radiosity_core::cornell_box();
     let mut cases = vec![occlusion_case(&cornell, a.dump_rays.as_deref(), a.force)?];
 
@@ -336,29 +388,5 @@ pub fn run(a: BenchArgs) -> Result<()> {
         )?);
     }
 
-    for scene in &a.big {
-        let clustered = big_case(scene, true)?;
-        if a.big_baseline {
-            let alone = big_case(scene, false)?;
-            let ratio = alone["solve_seconds"].as_f64().unwrap_or(f64::NAN)
-                / clustered["solve_seconds"].as_f64().unwrap_or(f64::NAN);
-            output::stdout(&format!(
-                "    clustered facets solve {ratio:.1}× faster than facets shooting alone\n"
-            ))?;
-            cases.push(json!({"case": "big_clustered_vs_alone", "clustered": clustered, "alone": alone,
-                "speedup": ratio}));
-        } else {
-            cases.push(clustered);
-        }
-    }
-
-    if let Some(path) = &a.json {
-        let text = serde_json::to_string_pretty(&json!({"threads": threads, "cases": cases}))? + "\n";
-        if path == "-" {
-            output::stdout(&text)?;
-        } else {
-            output::write_file(std::path::Path::new(path), a.force, text.as_bytes())?;
-        }
-    }
-    Ok(())
+    Ok(cases)
 }

@@ -2,6 +2,7 @@
 
 mod alloc;
 mod bench_cmd;
+mod bench_real;
 mod compare_cmd;
 mod export_cmd;
 mod info_cmd;

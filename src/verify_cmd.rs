@@ -85,7 +85,7 @@ pub fn scale_solver_reflectance(mesh: &mut Mesh, factor: f64) -> Result<()> {
 
 /// `objects`, then the back face of every two-sided one as an object of its own named
 /// `NAME (back)`: the order of [`Reference::objects`].
-fn with_back_faces(objects: Vec<ObjectRadiosity>) -> Vec<ObjectRadiosity> {
+pub(crate) fn with_back_faces(objects: Vec<ObjectRadiosity>) -> Vec<ObjectRadiosity> {
     let backs: Vec<ObjectRadiosity> = objects
         .iter()
         .filter_map(|o| {
@@ -104,7 +104,7 @@ fn with_back_faces(objects: Vec<ObjectRadiosity>) -> Vec<ObjectRadiosity> {
 /// Each object's means spread over its whole input area: the mesh leaves out what solids
 /// standing on a surface cover (`Mesh::hidden_area`), while the reference samples the whole
 /// input polygon, whose covered part no light reaches (it sees only the inside of the solid).
-fn over_whole_area(mut objects: Vec<ObjectRadiosity>, hidden: &[f64]) -> Vec<ObjectRadiosity> {
+pub(crate) fn over_whole_area(mut objects: Vec<ObjectRadiosity>, hidden: &[f64]) -> Vec<ObjectRadiosity> {
     for (o, &hidden) in objects.iter_mut().zip(hidden) {
         let whole = o.area + hidden;
         if hidden > 0.0 && whole > 0.0 {
@@ -118,7 +118,7 @@ fn over_whole_area(mut objects: Vec<ObjectRadiosity>, hidden: &[f64]) -> Vec<Obj
 }
 
 /// A progress bar for the reference on stderr when it is a terminal.
-fn reference_bar(what: &str) -> ProgressBar {
+pub(crate) fn reference_bar(what: &str) -> ProgressBar {
     if !std::io::stderr().is_terminal() {
         return ProgressBar::hidden();
     }
@@ -128,7 +128,8 @@ fn reference_bar(what: &str) -> ProgressBar {
     bar
 }
 
-fn report_progress(bar: &ProgressBar, p: Progress) {
+/// Shows the reference's paths done, its rate and time on `bar`.
+pub(crate) fn report_progress(bar: &ProgressBar, p: Progress) {
     bar.set_length(p.paths_planned.max(1));
     bar.set_position(p.paths_done);
     let secs = p.elapsed.as_secs_f64();
@@ -142,9 +143,11 @@ fn report_progress(bar: &ProgressBar, p: Progress) {
 
 /// One solve value against its reference estimate.
 #[derive(Clone, Copy, Debug)]
-struct Comparison {
-    solve: Rgb,
-    reference: Estimate,
+pub(crate) struct Comparison {
+    /// The solver's value.
+    pub(crate) solve: Rgb,
+    /// The reference's estimate of it.
+    pub(crate) reference: Estimate,
 }
 
 impl Comparison {
@@ -162,12 +165,15 @@ impl Comparison {
         [0, 1, 2].map(|i| z_score(s[i] - r[i], e[i], r[i]))
     }
 
-    fn luminance_percent(&self) -> Option<f64> {
+    /// (solve − reference) / reference in luminance, in per cent (`None` where the
+    /// reference is 0).
+    pub(crate) fn luminance_percent(&self) -> Option<f64> {
         let r = self.reference.luminance;
         (r != 0.0).then(|| (self.solve.luminance() - r) / r * 100.0)
     }
 
-    fn luminance_sigma(&self) -> f64 {
+    /// (solve − reference) / standard error in luminance.
+    pub(crate) fn luminance_sigma(&self) -> f64 {
         let r = self.reference.luminance;
         z_score(self.solve.luminance() - r, self.reference.luminance_stderr, r)
     }
@@ -188,7 +194,7 @@ fn z_score(diff: f64, stderr: f64, reference: f64) -> f64 {
 }
 
 /// A number for JSON: non-finite values become null.
-fn num(x: f64) -> Value {
+pub(crate) fn num(x: f64) -> Value {
     if x.is_finite() { json!(x) } else { Value::Null }
 }
 
@@ -305,12 +311,7 @@ pub fn run(a: VerifyArgs) -> Result<()> {
             per[2]
         );
     }
-    // Objects that are dark in both (nothing to compare) are left out of the summary.
-    let judged: Vec<(usize, f64, f64)> = rows
-        .iter()
-        .enumerate()
-        .filter_map(|(i, c)| c.luminance_percent().map(|p| (i, p, c.luminance_sigma())))
-        .collect();
+    let judged = judged(&rows);
     // Back faces (the insides of models, the far sides of two-sided sheets) get little
     // light and large relative differences; summed with the front faces they would set the
     // median a reader takes for the whole scene, so each side is summed on its own too.
@@ -402,22 +403,35 @@ pub fn run(a: VerifyArgs) -> Result<()> {
     Ok(())
 }
 
+/// `(index, difference %, difference σ)` of every row with light to compare: objects that
+/// are dark in both (nothing to compare) are left out of the summary.
+pub(crate) fn judged(rows: &[Comparison]) -> Vec<(usize, f64, f64)> {
+    rows.iter()
+        .enumerate()
+        .filter_map(|(i, c)| c.luminance_percent().map(|p| (i, p, c.luminance_sigma())))
+        .collect()
+}
+
 /// The verdict over some of the compared objects: how many differ by more than 3 σ, the
 /// worst, the median |difference| and the area-weighted mean difference.
-struct Summary {
-    objects: usize,
-    over: usize,
+pub(crate) struct Summary {
+    /// Objects judged.
+    pub(crate) objects: usize,
+    /// Of them, those more than 3 σ off.
+    pub(crate) over: usize,
     /// `(name, difference %, difference σ)`.
-    worst: Option<(String, f64, f64)>,
-    median_abs: Option<f64>,
-    area_weighted: Option<f64>,
+    pub(crate) worst: Option<(String, f64, f64)>,
+    /// Median |difference|, per cent.
+    pub(crate) median_abs: Option<f64>,
+    /// Area-weighted mean difference, per cent.
+    pub(crate) area_weighted: Option<f64>,
     /// The one-line verdict.
-    text: String,
+    pub(crate) text: String,
 }
 
 impl Summary {
     /// The verdict over `judged` (`(index into solved, difference %, difference σ)`).
-    fn of(judged: &[(usize, f64, f64)], solved: &[ObjectRadiosity]) -> Self {
+    pub(crate) fn of(judged: &[(usize, f64, f64)], solved: &[ObjectRadiosity]) -> Self {
         let over = judged.iter().filter(|(_, _, z)| z.abs() > 3.0).count();
         let worst = judged
             .iter()
@@ -446,7 +460,7 @@ impl Summary {
     }
 
     /// The report's form of it, with `text` as its text.
-    fn json(&self, text: &str) -> Value {
+    pub(crate) fn json(&self, text: &str) -> Value {
         json!({
             "text": text,
             "objects": self.objects,

@@ -3,6 +3,7 @@
 //! another. Each file is a module of its own.
 
 mod bad_input;
+mod bench_real;
 mod cli;
 mod dependencies;
 mod discretisation;
