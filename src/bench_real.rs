@@ -207,17 +207,7 @@ pub fn real_case(scene_arg: &str, reference_seconds: f64) -> Result<Value> {
     let estimates = reference.estimate_objects(&ref_params, &|p| verify_cmd::report_progress(&bar, p));
     bar.finish_and_clear();
     let ref_secs = estimates.elapsed.as_secs_f64();
-    output::note(format_args!(
-        "reference: {:.1} M paths in {:.1} s{}",
-        estimates.paths as f64 / 1e6,
-        ref_secs,
-        if estimates.timed_out { ", stopped by the time limit" } else { "" }
-    ))?;
-    let rows: Vec<Comparison> = solved
-        .iter()
-        .zip(&estimates.objects)
-        .map(|(s, r)| Comparison { solve: s.radiosity, reference: r.estimate })
-        .collect();
+    let rows = verify_cmd::compare_objects(&estimates, &solved)?;
     let judged = verify_cmd::judged(&rows);
     let large: Vec<(usize, f64, f64)> =
         judged.iter().copied().filter(|&(i, ..)| solved[i].area >= MIN_AREA_SHARE * front_area).collect();

@@ -141,6 +141,30 @@ pub(crate) fn report_progress(bar: &ProgressBar, p: Progress) {
     ));
 }
 
+/// Says what the reference ran (paths, time, whether its time limit stopped it) and pairs
+/// each solved object with its reference estimate.
+///
+/// # Errors
+/// The note cannot be written (a closed stderr).
+pub(crate) fn compare_objects(
+    estimates: &radiosity_reference::Estimates,
+    solved: &[radiosity_solver::ObjectRadiosity],
+) -> Result<Vec<Comparison>> {
+    let secs = estimates.elapsed.as_secs_f64();
+    crate::output::note(format_args!(
+        "reference: {:.1} M paths in {:.1} s ({:.2} M paths/s){}",
+        estimates.paths as f64 / 1e6,
+        secs,
+        estimates.paths as f64 / secs.max(1e-9) / 1e6,
+        if estimates.timed_out { ", stopped by the time limit" } else { "" }
+    ))?;
+    Ok(solved
+        .iter()
+        .zip(&estimates.objects)
+        .map(|(s, r)| Comparison { solve: s.radiosity, reference: r.estimate })
+        .collect())
+}
+
 /// One solve value against its reference estimate.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Comparison {
@@ -271,19 +295,7 @@ pub fn run(a: VerifyArgs) -> Result<()> {
     let estimates = reference.estimate_objects(&params, &|p| report_progress(&bar, p));
     bar.finish_and_clear();
     let ref_secs = estimates.elapsed.as_secs_f64();
-    crate::output::note(format_args!(
-        "reference: {:.1} M paths in {:.1} s ({:.2} M paths/s){}",
-        estimates.paths as f64 / 1e6,
-        ref_secs,
-        estimates.paths as f64 / ref_secs.max(1e-9) / 1e6,
-        if estimates.timed_out { ", stopped by the time limit" } else { "" }
-    ))?;
-
-    let rows: Vec<Comparison> = solved
-        .iter()
-        .zip(&estimates.objects)
-        .map(|(s, r)| Comparison { solve: s.radiosity, reference: r.estimate })
-        .collect();
+    let rows = compare_objects(&estimates, &solved)?;
 
     // The table: luminance for the eye, per-channel differences beside it.
     let mut table = format!(
