@@ -533,3 +533,69 @@ fn an_unreachable_threshold_stops_at_the_floor() {
     let unshot = report["unshot_fraction"].as_f64().unwrap();
     assert!(unshot <= 1e-12 && unshot > 0.0, "{unshot}");
 }
+
+/// Points beyond ±1e12 (`MAX_COORDINATE`) are refused where they are written: a sphere at
+/// 1e308 used to abort on a 25 GB allocation while meshing.
+#[test]
+fn coordinates_beyond_the_limit_name_their_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let sphere = |center: &str, radius: &str| {
+        format!(
+            "{SCENE}[[object]]\nname = \"s\"\ntype = \"sphere\"\nmaterial = \"grey\"\ncenter = {center}\nradius = {radius}\n"
+        )
+    };
+    let cases = [
+        ("far_sphere.toml", sphere("[1e308, 0, 0]", "1"), "far_sphere.toml:22:", "object[2].center", "1e308"),
+        (
+            "wide_sphere.toml",
+            sphere("[0, 0, 0]", "1e13"),
+            "wide_sphere.toml:23:",
+            "object[2].radius",
+            "10000000000000",
+        ),
+        ("reach.toml", sphere("[9.9e11, 0, 0]", "1e11"), "reach.toml:23:", "object[2].radius", "1e12"),
+        ("corner.toml", SCENE.replace("[1, 0, 1]", "[1, 0, 1e20]"), "corner.toml:17:", "vertices[2]", "1e20"),
+        (
+            "camera.toml",
+            format!("{SCENE}[camera]\nposition = [0, 0, -1e300]\nlook_at = [0, 0, 0]\n"),
+            "camera.toml:19:",
+            "camera.position",
+            "-1e300",
+        ),
+    ];
+    for (name, text, at, key, value) in cases {
+        let path = write(dir.path(), name, &text);
+        let o = run(&["info", path.to_str().unwrap()]);
+        assert_input_error(&o, name, &[at, key, value]);
+    }
+    let obj = write(dir.path(), "far.obj", &format!("{OBJ_BODY}v 1e300 0 0\nf 1 2 9\n"));
+    let o = run(&["info", obj.to_str().unwrap()]);
+    assert_input_error(&o, "far.obj", &["far.obj:15", "vertex 9", "1e300"]);
+}
+
+/// Long slivers beside many short edges: the search for T-junctions walked each long edge in
+/// steps of the median edge, 27 cells a step (a 5 000-corner concave face's ear-clipped
+/// slivers asked for 3 GB). Now its cells are bounded by the edges' total length, so this
+/// model (3 000 tiny triangles, 500 slivers 10⁵ times as long: 86 GB of cells before) meshes
+/// at once.
+#[test]
+fn long_slivers_beside_short_edges_mesh_without_a_huge_table() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut text = String::from("v 0 1 0\nv 0 1 1\nv 1 1 1\nv 1 1 0\nf 1 2 3 4\n");
+    let mut v = 4;
+    // Spread over the floor, so that no cell of the mesher's grids holds many of them.
+    for k in 0..3_000 {
+        let (x, z) = ((k % 60) as f64 * 16.0, (k / 60) as f64 * 20.0);
+        let (x1, z1) = (x + 0.01, z + 0.01);
+        text += &format!("v {x} 0 {z}\nv {x1} 0 {z}\nv {x} 0 {z1}\nf {} {} {}\n", v + 1, v + 3, v + 2);
+        v += 3;
+    }
+    for k in 0..500 {
+        let (x, x1) = (k as f64 * 2.0 + 1.0, k as f64 * 2.0 + 1.01);
+        text += &format!("v {x} 0 0\nv {x1} 0 1000\nv {x1} 0 0\nf {} {} {}\n", v + 1, v + 2, v + 3);
+        v += 3;
+    }
+    let obj = write(dir.path(), "slivers.obj", &text);
+    let o = run(&["info", obj.to_str().unwrap(), "--patch-size", "100", "--element-size", "100"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}

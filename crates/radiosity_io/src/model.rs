@@ -352,11 +352,15 @@ impl PartBuilder {
     /// The welded index of model-space point `p`.
     ///
     /// # Errors
-    /// The message for a non-finite point (before or after the transform).
+    /// The message for a non-finite point (before or after the transform), or one placed
+    /// beyond ±[`radiosity_core::MAX_COORDINATE`].
     pub(crate) fn vertex(&mut self, p: DVec3) -> Result<u32, String> {
         let w = self.world_from_model.transform_point3(p);
         if !p.is_finite() || !w.is_finite() {
             return Err(format!("coordinates must be finite numbers, got {:?}", p.to_array()));
+        }
+        if let Err(e) = radiosity_core::check_coordinate(w) {
+            return Err(format!("{e} (placed from {:?})", p.to_array()));
         }
         // -0.0 and 0.0 are one point.
         let w = w + DVec3::ZERO;

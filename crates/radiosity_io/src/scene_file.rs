@@ -36,6 +36,11 @@ fn all_finite(a: &[f64; 3]) -> bool {
     a.iter().all(|c| c.is_finite())
 }
 
+/// Finite and within ±[`radiosity_core::MAX_COORDINATE`]: a point the core accepts.
+fn in_range(a: &[f64; 3]) -> bool {
+    radiosity_core::coordinate_in_range(*a)
+}
+
 /// A scene and what the loader dropped or defaulted on the way (degenerate faces of a model,
 /// a missing MTL file), one line each, for the user to read. What every scene loader returns:
 /// a caller that shows nothing to a user may take `.scene` alone.
@@ -362,9 +367,9 @@ fn camera(loc: &Locator, c: &Spanned<CameraDesc>) -> Result<Camera, LoadError> {
         // The core says what is wrong; name the field it is about, checking in the core's
         // order (finite, distinct points, up, field of view). Whether `up` is at fault is
         // asked of the core itself, with a field of view known to be good.
-        let field = if !all_finite(&position) {
+        let field = if !in_range(&position) {
             "position"
-        } else if !all_finite(&look_at) || position == look_at {
+        } else if !in_range(&look_at) || position == look_at {
             "look_at"
         } else if !all_finite(&up)
             || Camera::try_new(v3(position), v3(look_at), v3(up), DEFAULT_FOV_Y_DEG).is_err()
@@ -403,7 +408,9 @@ fn polygon(loc: &Locator, face: &Face, key: &str) -> Result<Polygon, LoadError> 
     let points = face.get_ref();
     Polygon::try_new(points.iter().map(|p| v3(*p.get_ref())).collect()).map_err(|e| {
         let vertex = match &e {
-            SceneError::NonFiniteCoordinate { .. } => points.iter().position(|p| !all_finite(p.get_ref())),
+            SceneError::NonFiniteCoordinate { .. } | SceneError::CoordinateOutOfRange { .. } => {
+                points.iter().position(|p| !in_range(p.get_ref()))
+            }
             SceneError::NonConvexPolygon { vertex } => Some(*vertex),
             _ => None,
         };
@@ -495,8 +502,8 @@ fn object(
             let facing = facing(loc, &key, d.normals.as_ref())?;
             let faces =
                 box_faces(v3(*min.get_ref()), v3(*max.get_ref()), facing, rotate_y_deg).map_err(|e| {
-                    // A non-finite corner is named; otherwise (min ≥ max) both are in the message.
-                    let (field, span) = if all_finite(min.get_ref()) && !all_finite(max.get_ref()) {
+                    // A corner out of range is named; otherwise (min ≥ max) both are in the message.
+                    let (field, span) = if in_range(min.get_ref()) && !in_range(max.get_ref()) {
                         ("max", max.span())
                     } else {
                         ("min", min.span())
@@ -510,7 +517,11 @@ fn object(
             let r = d.radius.as_ref().ok_or_else(|| missing("radius"))?;
             let facing = facing(loc, &key, d.normals.as_ref())?;
             let s = Sphere::try_new(v3(*c.get_ref()), *r.get_ref(), facing).map_err(|e| {
-                let (field, span) = if matches!(e, SceneError::BadRadius { .. }) {
+                // A sphere reaching past the coordinate limit from a centre within it: its
+                // radius takes it there.
+                let (field, span) = if matches!(e, SceneError::BadRadius { .. })
+                    || (matches!(e, SceneError::CoordinateOutOfRange { .. }) && in_range(c.get_ref()))
+                {
                     ("radius", r.span())
                 } else {
                     ("center", c.span())
