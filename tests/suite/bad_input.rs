@@ -599,3 +599,74 @@ fn long_slivers_beside_short_edges_mesh_without_a_huge_table() {
     let o = run(&["info", obj.to_str().unwrap(), "--patch-size", "100", "--element-size", "100"]);
     assert!(o.status.success(), "{}", stderr(&o));
 }
+
+/// Runs `args` as [`run`] does, failing the test past `limit` instead of [`DEADLINE`]: for
+/// inputs whose quadratic paths took minutes, where a linear pass takes a second.
+fn run_within(args: &[&str], limit: Duration) -> Output {
+    let mut child =
+        bin().args(args).stdin(Stdio::null()).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+    let start = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            panic!("{}: still running after {limit:?}", args.join(" "));
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.wait_with_output().unwrap()
+}
+
+/// Material names are looked up, not searched for: 200 000 unused materials (a search per
+/// material: minutes), and 30 000 objects in a row using the last of 30 000 materials (a
+/// search per object, and the ray tracer's tree builder merging one pair of equal tiles per
+/// pass: minutes) load and mesh in about a second.
+#[test]
+fn many_materials_and_objects_load_in_linear_time() {
+    let dir = tempfile::tempdir().unwrap();
+    let materials = |n: usize| {
+        (0..n)
+            .map(|i| format!("[[material]]\nname = \"m{i}\"\nreflectance = [0.5, 0.5, 0.5]\n"))
+            .collect::<String>()
+    };
+    let unused = write(dir.path(), "unused.toml", &format!("{}{SCENE}", materials(200_000)));
+    let n = 30_000;
+    let mut row = format!("{}{SCENE}", materials(n));
+    for i in 0..n {
+        row += &format!(
+            "[[object]]\nname = \"o{i}\"\ntype = \"polygon\"\nmaterial = \"m{}\"\nvertices = [[{i}, 0, 2], [{}, 0, 2], [{}, 0, 3], [{i}, 0, 3]]\n",
+            n - 1,
+            i + 1,
+            i + 1
+        );
+    }
+    let row = write(dir.path(), "row.toml", &row);
+    for path in [unused, row] {
+        let o = run_within(&["info", path.to_str().unwrap()], Duration::from_secs(20));
+        assert!(o.status.success(), "{}: {}", path.display(), stderr(&o));
+    }
+}
+
+/// A disc of 60 000 triangles about one centre vertex (a cylinder's cap as exporters write
+/// it): the solver's tables looked at every element around each vertex of each element, and
+/// each rim vertex fitted the whole fan (quadratic in the centre's valence: 26 GB at 10⁵).
+#[test]
+fn a_fan_of_many_triangles_solves() {
+    let dir = tempfile::tempdir().unwrap();
+    let n = 60_000;
+    let mut text =
+        String::from("mtllib m.mtl\nv 0 1 0\nv 0 1 1\nv 1 1 1\nv 1 1 0\nusemtl lamp\nf 1 2 3 4\nv 0 0 0\n");
+    for k in 0..n {
+        let a = std::f64::consts::TAU * k as f64 / n as f64;
+        text += &format!("v {:.12} 0 {:.12}\n", 2.0 * a.cos(), -2.0 * a.sin());
+    }
+    text += "usemtl grey\n";
+    for k in 0..n {
+        text += &format!("f 5 {} {}\n", 6 + k, 6 + (k + 1) % n);
+    }
+    write(dir.path(), "m.mtl", "newmtl lamp\nKd 0 0 0\nKe 1 1 1\nnewmtl grey\nKd 0.5 0.5 0.5\n");
+    let obj = write(dir.path(), "fan.obj", &text);
+    let args =
+        ["solve", obj.to_str().unwrap(), "--max-shots", "3", "--patch-size", "10", "--element-size", "10"];
+    let o = run_within(&args, Duration::from_secs(30));
+    assert!(o.status.success(), "{}", stderr(&o));
+}

@@ -401,6 +401,9 @@ pub struct Mesh {
     /// True when the scene had too many large faces to look for contacts on all of them:
     /// some were meshed whole.
     pub contacts_incomplete: bool,
+    /// True when looking for geometry near elements ([`MeshParams::proximity_refinement`])
+    /// ran out of its budget: some elements near other geometry were left unrefined.
+    pub proximity_incomplete: bool,
 }
 
 /// Which vertices of *different* surfaces share their radiosity in smooth shading: those in
@@ -1208,7 +1211,8 @@ impl Mesh {
                 }
             }
         }
-        mesh.contacts_incomplete = contacts.is_some_and(|c| c.budget_spent());
+        mesh.contacts_incomplete = contacts.as_ref().is_some_and(|c| c.budget_spent());
+        mesh.proximity_incomplete = contacts.as_ref().is_some_and(|c| c.proximity_budget_spent());
         mesh.shrink_to_fit();
         mesh.smoothing = Smoothing::new(&mesh, params.crease_angle_deg);
         Ok(mesh)
