@@ -437,7 +437,9 @@ pub(crate) fn parse_obj(
                 };
                 face.push(v);
             }
-            b.face(face);
+            b.face(face).map_err(|m| {
+                model_error(origin, face_line(face_number - 1), format!("face {face_number}: {m}"))
+            })?;
         }
         dropped += b.dropped;
         let name = if model.name.is_empty() || model.name == "unnamed_object" {
