@@ -701,3 +701,25 @@ fn a_fan_of_many_triangles_solves() {
     let o = run_within(&args, Duration::from_secs(30));
     assert!(o.status.success(), "{}", stderr(&o));
 }
+
+/// `--lightmap a/b/c` makes the missing folders, as `mkdir -p` would (making folders replaces
+/// nothing); a folder an earlier run wrote into still needs `--force`, and a file in the way
+/// is named.
+#[test]
+fn lightmaps_go_into_new_nested_folders() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let s = |p: PathBuf| p.to_str().unwrap().to_owned();
+    let (ply, nested) = (s(d.join("a.ply")), s(d.join("a/b/c")));
+    let o = run(&["export", "two-plates", "--max-shots", "2", "-o", &ply, "--lightmap", &nested]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(d.join("a/b/c/lightmapped.obj").is_file());
+    let again = s(d.join("b.ply"));
+    let o = run(&["export", "two-plates", "--max-shots", "2", "-o", &again, "--lightmap", &nested]);
+    assert_input_error(&o, "again", &["lightmapped.obj", "--force"]);
+    std::fs::write(d.join("file"), "in the way").unwrap();
+    let blocked = s(d.join("file/x/y"));
+    let o = run(&["export", "two-plates", "--max-shots", "2", "-o", &again, "--lightmap", &blocked]);
+    assert_input_error(&o, "blocked", &["file", "not a folder"]);
+    assert!(!d.join("b.ply").exists());
+}
