@@ -26,7 +26,8 @@ pub struct ExportArgs {
     /// radiosity_r/g/b (PLY).
     #[arg(long)]
     pub tonemapped: bool,
-    /// Also write per-object lightmaps (linear EXR) and an OBJ mapping them into this folder.
+    /// Also write per-object lightmaps (linear EXR) and an OBJ mapping them into this folder
+    /// (made if missing, with the folders above it).
     #[arg(long)]
     pub lightmap: Option<PathBuf>,
     /// Lightmap texels: `none` interpolated from the solution, `direct` with direct light by

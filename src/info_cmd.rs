@@ -109,6 +109,12 @@ pub fn run(a: InfoArgs) -> Result<()> {
         warnings
             .push("too many large faces to look for contacts on all of them: some are meshed whole".into());
     }
+    if mesh.proximity_incomplete {
+        warnings.push(
+            "too much geometry near too many elements to refine them all for it: some are left as meshed"
+                .into(),
+        );
+    }
     if scene.camera.is_none() {
         warnings.push("no [camera]: views frame the whole scene".into());
     }

@@ -117,8 +117,9 @@ impl Targets {
         self.remember(id, path, option)
     }
 
-    /// Checks a folder target (created if missing; its parent must exist): `marker` is the file
-    /// in it that says an earlier run wrote there, which needs `--force`.
+    /// Checks a folder target (created if missing, with any missing folders above it, as
+    /// `mkdir -p` does: the nearest existing one must be a folder that takes new files):
+    /// `marker` is the file in it that says an earlier run wrote there, which needs `--force`.
     ///
     /// # Errors
     /// As [`Targets::file`].
@@ -142,8 +143,38 @@ impl Targets {
                 self.remember(id, dir, option)
             }
             Err(_) => {
-                // Missing: it is made in its parent at the end, so the parent is what must work.
-                self.file(dir, option)
+                // Missing: it and the missing folders above it are made at the end, in the
+                // nearest folder that exists, so that is what must take new files. Making
+                // folders replaces nothing.
+                let mut existing = folder_of(dir);
+                while std::fs::symlink_metadata(existing).is_err() {
+                    match existing.parent() {
+                        Some(p) if !p.as_os_str().is_empty() => existing = p,
+                        _ => {
+                            existing = Path::new(".");
+                            break;
+                        }
+                    }
+                }
+                if !std::fs::metadata(existing).is_ok_and(|m| m.is_dir()) {
+                    return Err(input(format!(
+                        "{option} {}: {} is not a folder",
+                        dir.display(),
+                        existing.display()
+                    )));
+                }
+                tempfile::Builder::new().prefix(".radiosity-check").tempfile_in(existing).map_err(|e| {
+                    input(format!(
+                        "{option} {}: cannot write into {}: {e}",
+                        dir.display(),
+                        existing.display()
+                    ))
+                })?;
+                let id = existing
+                    .canonicalize()
+                    .with_context(|| format!("{}", existing.display()))?
+                    .join(dir.strip_prefix(existing).unwrap_or(dir));
+                self.remember(id, dir, option)
             }
         }
     }
@@ -194,7 +225,7 @@ pub fn write_file(path: &Path, force: bool, bytes: &[u8]) -> Result<()> {
 }
 
 /// Writes a folder of files: `fill` writes into a fresh temporary folder, whose files are
-/// then moved into `dir` (made if missing) one rename each. Without `force`, a file of the
+/// then moved into `dir` (made if missing, with the folders above it) one rename each. Without `force`, a file of the
 /// same name that appeared meanwhile is kept and the run fails. Returns how many files moved.
 ///
 /// # Errors
@@ -205,6 +236,8 @@ pub fn write_folder(
     fill: impl FnOnce(&Path) -> std::result::Result<Vec<PathBuf>, String>,
 ) -> Result<usize> {
     let parent = folder_of(dir);
+    // The folders above it that were missing when the run was checked (`Targets::folder`).
+    std::fs::create_dir_all(parent).with_context(|| format!("cannot create {}", parent.display()))?;
     let staging =
         tempfile::Builder::new().prefix(".radiosity-staging").tempdir_in(parent).with_context(|| {
             format!("cannot write {}: cannot make a folder in {}", dir.display(), parent.display())

@@ -389,7 +389,7 @@ fn name_list(scene: &Scene, objects: &[usize]) -> String {
 /// # Errors
 /// Bad scene files, out-of-range options, meshes that would be too large (exit code 2).
 pub fn prepare(scene_arg: &str, o: &SolveOpts) -> Result<Prepared> {
-    mesh(settings(scene_arg, o)?, o)
+    mesh(scene_arg, settings(scene_arg, o)?, o)
 }
 
 /// [`prepare`] for a command that describes a scene: one without a light is meshed too,
@@ -399,11 +399,11 @@ pub fn prepare(scene_arg: &str, o: &SolveOpts) -> Result<Prepared> {
 /// As [`prepare`], except a missing light.
 pub fn prepare_unlit(scene_arg: &str, o: &SolveOpts) -> Result<(Prepared, Option<radiosity_io::LoadError>)> {
     let (settings, no_light) = load_settings(scene_arg, o)?;
-    Ok((mesh(settings, o)?, no_light))
+    Ok((mesh(scene_arg, settings, o)?, no_light))
 }
 
-/// The light scale and the [`Problem`] of checked settings.
-fn mesh(settings: Settings, o: &SolveOpts) -> Result<Prepared> {
+/// The light scale and the [`Problem`] of checked settings of the scene `scene_arg` names.
+fn mesh(scene_arg: &str, settings: Settings, o: &SolveOpts) -> Result<Prepared> {
     let Settings { mut scene, mesh_params, solver_params } = settings;
     if let Some(t) = o.threads {
         // One call per process: an error is the system refusing the threads.
@@ -413,7 +413,10 @@ fn mesh(settings: Settings, o: &SolveOpts) -> Result<Prepared> {
             .with_context(|| format!("cannot start {t} worker threads (--threads)"))?;
     }
     scene.scale_emission(o.light_scale);
-    let problem = Problem::new(&scene, &mesh_params)?;
+    // The scene's loader names the line of a mesh over the element limit; one that only the
+    // command's options make too large (or a model file's, which has no [mesh]) is named by
+    // its file here.
+    let problem = Problem::new(&scene, &mesh_params).with_context(|| scene_arg.to_owned())?;
     Ok(Prepared { scene, problem, params: solver_params })
 }
 

@@ -242,31 +242,62 @@ fn picture_headers_are_checked_before_allocating() {
     assert!(!out.exists());
 }
 
-/// A very many-cornered polygon (a 10⁵-gon: 80 s to validate when it was quadratic) loads,
-/// meshes and reports within the deadline.
-#[test]
-fn a_polygon_of_many_corners_meshes() {
-    let dir = tempfile::tempdir().unwrap();
-    let n = 100_000;
+/// A polygon of `n` corners on the unit circle, as a scene file's `vertices`.
+fn disc(n: usize) -> String {
     let corners: Vec<String> = (0..n)
         .map(|k| {
             let a = std::f64::consts::TAU * k as f64 / n as f64;
             format!("[{:.12}, 0, {:.12}]", a.cos(), -a.sin())
         })
         .collect();
-    let text = format!(
-        "[[material]]\nname = \"lamp\"\nreflectance = [0.5, 0.5, 0.5]\nemission = [1, 1, 1]\n\
-         [[object]]\nname = \"disc\"\ntype = \"polygon\"\nmaterial = \"lamp\"\nvertices = [{}]\n\
-         [mesh]\npatch_size = 10\nelement_size = 10\n",
-        corners.join(", ")
-    );
-    let path = write(dir.path(), "disc.toml", &text);
+    format!("[{}]", corners.join(", "))
+}
+
+/// A light of the most corners a polygon may have (1024) meshes into its fan; one of 10⁵ or
+/// 10⁶ corners, which never finished solving (a patch per fan triangle, each shot visiting
+/// every patch), is refused at its line, as is a model face of 5 000 (concave) or 20 000
+/// (convex) corners, before anything is triangulated.
+#[test]
+fn polygons_of_many_corners_mesh_or_name_the_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let light = |n: usize| {
+        format!(
+            "[[material]]\nname = \"lamp\"\nreflectance = [0.5, 0.5, 0.5]\nemission = [1, 1, 1]\n\
+             [[object]]\nname = \"disc\"\ntype = \"polygon\"\nmaterial = \"lamp\"\nvertices = {}\n\
+             [mesh]\npatch_size = 10\nelement_size = 10\n",
+            disc(n)
+        )
+    };
+    let path = write(dir.path(), "disc.toml", &light(1024));
     let o = run(&["info", path.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
     let out = String::from_utf8_lossy(&o.stdout);
     let elements: usize =
         out.lines().find_map(|l| l.strip_prefix("elements")).unwrap().trim().parse().unwrap();
-    assert_eq!(elements, n - 2, "one element per fan triangle");
+    assert_eq!(elements, 1022, "one element per fan triangle");
+    for n in [100_000, 1_000_000] {
+        let path = write(dir.path(), "big.toml", &light(n));
+        let o = run(&["info", path.to_str().unwrap()]);
+        assert_input_error(&o, "big.toml", &["big.toml:9:", "object[0].vertices", &n.to_string(), "1024"]);
+    }
+    write(dir.path(), "m.mtl", "newmtl lamp\nKd 0 0 0\nKe 1 1 1\nnewmtl grey\nKd 0.5 0.5 0.5\n");
+    for (n, inner) in [(5_000, 0.5), (20_000, 1.0), (20_000, 0.5)] {
+        let mut text =
+            String::from("mtllib m.mtl\nv 0 1 0\nv 0 1 1\nv 1 1 1\nv 1 1 0\nusemtl lamp\nf 1 2 3 4\n");
+        for k in 0..n {
+            let (a, r) = (std::f64::consts::TAU * k as f64 / n as f64, if k % 2 == 0 { 1.0 } else { inner });
+            text += &format!("v {:.12} 0 {:.12}\n", r * a.cos(), -r * a.sin());
+        }
+        text += "usemtl grey\nf";
+        for k in 0..n {
+            text += &format!(" {}", 5 + k);
+        }
+        text += "\n";
+        let obj = write(dir.path(), "star.obj", &text);
+        let o = run(&["info", obj.to_str().unwrap()]);
+        let line = format!("star.obj:{}", n + 9);
+        assert_input_error(&o, "star.obj", &[&line, "face 2", &n.to_string(), "1024"]);
+    }
 }
 
 #[test]
@@ -532,4 +563,163 @@ fn an_unreachable_threshold_stops_at_the_floor() {
     assert_eq!(report["stop_reason"], "converged", "{report}");
     let unshot = report["unshot_fraction"].as_f64().unwrap();
     assert!(unshot <= 1e-12 && unshot > 0.0, "{unshot}");
+}
+
+/// Points beyond ±1e12 (`MAX_COORDINATE`) are refused where they are written: a sphere at
+/// 1e308 used to abort on a 25 GB allocation while meshing.
+#[test]
+fn coordinates_beyond_the_limit_name_their_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let sphere = |center: &str, radius: &str| {
+        format!(
+            "{SCENE}[[object]]\nname = \"s\"\ntype = \"sphere\"\nmaterial = \"grey\"\ncenter = {center}\nradius = {radius}\n"
+        )
+    };
+    let cases = [
+        ("far_sphere.toml", sphere("[1e308, 0, 0]", "1"), "far_sphere.toml:22:", "object[2].center", "1e308"),
+        (
+            "wide_sphere.toml",
+            sphere("[0, 0, 0]", "1e13"),
+            "wide_sphere.toml:23:",
+            "object[2].radius",
+            "10000000000000",
+        ),
+        ("reach.toml", sphere("[9.9e11, 0, 0]", "1e11"), "reach.toml:23:", "object[2].radius", "1e12"),
+        ("corner.toml", SCENE.replace("[1, 0, 1]", "[1, 0, 1e20]"), "corner.toml:17:", "vertices[2]", "1e20"),
+        (
+            "camera.toml",
+            format!("{SCENE}[camera]\nposition = [0, 0, -1e300]\nlook_at = [0, 0, 0]\n"),
+            "camera.toml:19:",
+            "camera.position",
+            "-1e300",
+        ),
+    ];
+    for (name, text, at, key, value) in cases {
+        let path = write(dir.path(), name, &text);
+        let o = run(&["info", path.to_str().unwrap()]);
+        assert_input_error(&o, name, &[at, key, value]);
+    }
+    let obj = write(dir.path(), "far.obj", &format!("{OBJ_BODY}v 1e300 0 0\nf 1 2 9\n"));
+    let o = run(&["info", obj.to_str().unwrap()]);
+    assert_input_error(&o, "far.obj", &["far.obj:15", "vertex 9", "1e300"]);
+}
+
+/// Long slivers beside many short edges: the search for T-junctions walked each long edge in
+/// steps of the median edge, 27 cells a step (a 5 000-corner concave face's ear-clipped
+/// slivers asked for 3 GB). Now its cells are bounded by the edges' total length, so this
+/// model (3 000 tiny triangles, 500 slivers 10⁵ times as long: 86 GB of cells before) meshes
+/// at once.
+#[test]
+fn long_slivers_beside_short_edges_mesh_without_a_huge_table() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut text = String::from("v 0 1 0\nv 0 1 1\nv 1 1 1\nv 1 1 0\nf 1 2 3 4\n");
+    let mut v = 4;
+    // Spread over the floor, so that no cell of the mesher's grids holds many of them.
+    for k in 0..3_000 {
+        let (x, z) = ((k % 60) as f64 * 16.0, (k / 60) as f64 * 20.0);
+        let (x1, z1) = (x + 0.01, z + 0.01);
+        text += &format!("v {x} 0 {z}\nv {x1} 0 {z}\nv {x} 0 {z1}\nf {} {} {}\n", v + 1, v + 3, v + 2);
+        v += 3;
+    }
+    for k in 0..500 {
+        let (x, x1) = (k as f64 * 2.0 + 1.0, k as f64 * 2.0 + 1.01);
+        text += &format!("v {x} 0 0\nv {x1} 0 1000\nv {x1} 0 0\nf {} {} {}\n", v + 1, v + 2, v + 3);
+        v += 3;
+    }
+    let obj = write(dir.path(), "slivers.obj", &text);
+    let o = run(&["info", obj.to_str().unwrap(), "--patch-size", "100", "--element-size", "100"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+/// Runs `args` as [`run`] does, failing the test past `limit` instead of [`DEADLINE`]: for
+/// inputs whose quadratic paths took minutes, where a linear pass takes a second.
+fn run_within(args: &[&str], limit: Duration) -> Output {
+    let mut child =
+        bin().args(args).stdin(Stdio::null()).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+    let start = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            panic!("{}: still running after {limit:?}", args.join(" "));
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.wait_with_output().unwrap()
+}
+
+/// Material names are looked up, not searched for: 200 000 unused materials (a search per
+/// material: minutes), and 30 000 objects in a row using the last of 30 000 materials (a
+/// search per object, and the ray tracer's tree builder merging one pair of equal tiles per
+/// pass: minutes) load and mesh in about a second.
+#[test]
+fn many_materials_and_objects_load_in_linear_time() {
+    let dir = tempfile::tempdir().unwrap();
+    let materials = |n: usize| {
+        (0..n)
+            .map(|i| format!("[[material]]\nname = \"m{i}\"\nreflectance = [0.5, 0.5, 0.5]\n"))
+            .collect::<String>()
+    };
+    let unused = write(dir.path(), "unused.toml", &format!("{}{SCENE}", materials(200_000)));
+    let n = 30_000;
+    let mut row = format!("{}{SCENE}", materials(n));
+    for i in 0..n {
+        row += &format!(
+            "[[object]]\nname = \"o{i}\"\ntype = \"polygon\"\nmaterial = \"m{}\"\nvertices = [[{i}, 0, 2], [{}, 0, 2], [{}, 0, 3], [{i}, 0, 3]]\n",
+            n - 1,
+            i + 1,
+            i + 1
+        );
+    }
+    let row = write(dir.path(), "row.toml", &row);
+    for path in [unused, row] {
+        let o = run_within(&["info", path.to_str().unwrap()], Duration::from_secs(20));
+        assert!(o.status.success(), "{}: {}", path.display(), stderr(&o));
+    }
+}
+
+/// A disc of 60 000 triangles about one centre vertex (a cylinder's cap as exporters write
+/// it): the solver's tables looked at every element around each vertex of each element, and
+/// each rim vertex fitted the whole fan (quadratic in the centre's valence: 26 GB at 10⁵).
+#[test]
+fn a_fan_of_many_triangles_solves() {
+    let dir = tempfile::tempdir().unwrap();
+    let n = 60_000;
+    let mut text =
+        String::from("mtllib m.mtl\nv 0 1 0\nv 0 1 1\nv 1 1 1\nv 1 1 0\nusemtl lamp\nf 1 2 3 4\nv 0 0 0\n");
+    for k in 0..n {
+        let a = std::f64::consts::TAU * k as f64 / n as f64;
+        text += &format!("v {:.12} 0 {:.12}\n", 2.0 * a.cos(), -2.0 * a.sin());
+    }
+    text += "usemtl grey\n";
+    for k in 0..n {
+        text += &format!("f 5 {} {}\n", 6 + k, 6 + (k + 1) % n);
+    }
+    write(dir.path(), "m.mtl", "newmtl lamp\nKd 0 0 0\nKe 1 1 1\nnewmtl grey\nKd 0.5 0.5 0.5\n");
+    let obj = write(dir.path(), "fan.obj", &text);
+    let args =
+        ["solve", obj.to_str().unwrap(), "--max-shots", "3", "--patch-size", "10", "--element-size", "10"];
+    let o = run_within(&args, Duration::from_secs(30));
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+/// `--lightmap a/b/c` makes the missing folders, as `mkdir -p` would (making folders replaces
+/// nothing); a folder an earlier run wrote into still needs `--force`, and a file in the way
+/// is named.
+#[test]
+fn lightmaps_go_into_new_nested_folders() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let s = |p: PathBuf| p.to_str().unwrap().to_owned();
+    let (ply, nested) = (s(d.join("a.ply")), s(d.join("a/b/c")));
+    let o = run(&["export", "two-plates", "--max-shots", "2", "-o", &ply, "--lightmap", &nested]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(d.join("a/b/c/lightmapped.obj").is_file());
+    let again = s(d.join("b.ply"));
+    let o = run(&["export", "two-plates", "--max-shots", "2", "-o", &again, "--lightmap", &nested]);
+    assert_input_error(&o, "again", &["lightmapped.obj", "--force"]);
+    std::fs::write(d.join("file"), "in the way").unwrap();
+    let blocked = s(d.join("file/x/y"));
+    let o = run(&["export", "two-plates", "--max-shots", "2", "-o", &again, "--lightmap", &blocked]);
+    assert_input_error(&o, "blocked", &["file", "not a folder"]);
+    assert!(!d.join("b.ply").exists());
 }

@@ -30,6 +30,7 @@
 //! the triangle's own box), as between any two ray kernels.
 
 use glam::{Vec3A, Vec4};
+use obvhs::aabb::Aabb;
 use obvhs::{BvhBuildParams, bvh2::Bvh2, triangle::Triangle};
 
 use crate::lanes::{RayLanes, TriangleLanes, hit_x4};
@@ -256,17 +257,71 @@ fn leaf_range(child: u32) -> std::ops::Range<usize> {
     first..first + (child & 3) as usize + 1
 }
 
+/// obvhs's binary tree over `triangles` (as its `build_bvh2_from_tris`: spatial pre-splits
+/// when `params` ask, PLOC, reinsertion, leaf collapse), with every primitive's box widened by
+/// its own hair, under 10⁻⁴ of its size (see [`tie_breaker`]).
+///
+/// Why: PLOC merges two nodes when each is the other's cheapest neighbour, and takes the
+/// later of equal costs. Where costs tie exactly (a row of equal tiles, equally spaced) every
+/// node picks its right neighbour, only the last pair agrees, and each pass merges one pair:
+/// 50 000 tiles in a row took minutes. Widths that differ break the ties, a box that is a
+/// little too large is still a bound, and the leaf test decides hits.
+fn build_bvh2(triangles: &[Triangle], params: BvhBuildParams) -> Bvh2 {
+    use obvhs::Boundable;
+    let mut aabbs: Vec<Aabb> = triangles.iter().map(Boundable::aabb).collect();
+    let mut indices: Vec<u32> = (0..triangles.len() as u32).collect();
+    if params.pre_split {
+        let halves = aabbs.iter().map(Aabb::half_area);
+        let largest = halves.clone().fold(0.0, f32::max);
+        let mean = halves.sum::<f32>() / aabbs.len().max(1) as f32;
+        obvhs::splits::split_aabbs_preset(&mut aabbs, &mut indices, triangles, mean, largest);
+    }
+    for (k, aabb) in aabbs.iter_mut().enumerate() {
+        let size = aabb.diagonal().max_element().max(f32::MIN_POSITIVE);
+        aabb.max += glam::Vec3A::splat(size * tie_breaker(k as u64));
+    }
+    let mut bvh2 = obvhs::ploc::PlocBuilder::with_capacity(aabbs.len()).build(
+        params.ploc_search_distance,
+        &aabbs,
+        indices,
+        params.sort_precision,
+        params.search_depth_threshold,
+    );
+    bvh2.uses_spatial_splits = params.pre_split;
+    let mut reinsertion = obvhs::bvh2::reinsertion::ReinsertionOptimizer::default();
+    reinsertion.run(&mut bvh2, params.reinsertion_batch_ratio, None);
+    obvhs::bvh2::leaf_collapser::collapse(
+        &mut bvh2,
+        params.max_prims_per_leaf.clamp(1, 255),
+        params.collapse_traversal_cost,
+    );
+    reinsertion.run(
+        &mut bvh2,
+        params.reinsertion_batch_ratio * params.post_collapse_reinsertion_batch_ratio_multiplier,
+        None,
+    );
+    bvh2
+}
+
+/// A fraction in [10⁻⁶, 10⁻⁴) fixed by `k` (SplitMix64's finaliser): far above single
+/// precision's step, so that two widened boxes' costs differ, and far below anything that
+/// changes which boxes a ray meets in practice. The same for every run: trees are
+/// reproducible.
+fn tie_breaker(k: u64) -> f32 {
+    let mut z = k.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^= z >> 31;
+    1e-6 + 99e-6 * ((z >> 40) as f32 / (1u64 << 24) as f32)
+}
+
 impl WideBvh {
     /// Builds the tree over `triangles` with obvhs's `params` for the binary tree.
     pub(crate) fn new(triangles: &[Triangle], params: BvhBuildParams) -> Self {
         if triangles.is_empty() {
             return Self { root: EMPTY, ..Self::default() };
         }
-        let bvh2 = obvhs::bvh2::builder::build_bvh2_from_tris(
-            triangles,
-            params,
-            &mut std::time::Duration::default(),
-        );
+        let bvh2 = build_bvh2(triangles, params);
         let mut tree = Self::default();
         // Boxes are widened by a relative hair so that single-precision rounding in the slab
         // test can never drop a triangle that touches a box's face; the leaf test decides.

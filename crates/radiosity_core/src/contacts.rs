@@ -44,6 +44,12 @@ const MAX_FOOTPRINT_CORNERS: usize = 8;
 /// many large faces would otherwise cost targets × faces. Past it, surfaces are meshed uncut.
 const PAIR_BUDGET: u64 = 200_000_000;
 
+/// Most candidates looked at by [`Contacts::geometry_within`] (bounding boxes first), apart
+/// from [`PAIR_BUDGET`]: a fan of 60 000 slivers about one vertex lists each in every query
+/// near it (their boxes span the fan), and its refinement took elements × slivers. Past it,
+/// no more elements are quartered for nearby geometry.
+const PROXIMITY_BUDGET: u64 = 50_000_000;
+
 /// An inside corner needs the other polygon's front to turn at least this much towards the
 /// surface (the cosine between its normal and the direction into the surface): 0.1 leaves out
 /// faces within 6° of lying flat, whose corner with the surface is hardly a corner.
@@ -55,6 +61,8 @@ pub(crate) struct Contacts<'a> {
     /// The candidates by where they are, so that a query visits those near it only.
     grid: Grid,
     pairs_left: std::cell::Cell<u64>,
+    /// What is left of [`PROXIMITY_BUDGET`].
+    proximity_left: std::cell::Cell<u64>,
     /// Per object, whether its material emits (see [`Contacts::geometry_within`]).
     emits: Vec<bool>,
 }
@@ -75,6 +83,8 @@ struct Grid {
 impl Grid {
     /// Most cells a candidate is listed in; one over more goes to `large`.
     const SPREAD: usize = 64;
+    /// Most cells in a grid (64³: 6 MB of empty lists).
+    const MAX_CELLS: usize = 64 * 64 * 64;
 
     /// The grid of the candidates' bounding `boxes`, in candidate order.
     fn new(boxes: impl ExactSizeIterator<Item = (DVec3, DVec3)> + Clone) -> Self {
@@ -82,17 +92,9 @@ impl Grid {
         let (lo, hi) = boxes
             .clone()
             .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), (a, b)| (lo.min(a), hi.max(b)));
-        // About four candidates a cell, at most 64 cells a side.
-        let side = ((count as f64 / 4.0).cbrt().ceil() as usize).clamp(1, 64);
-        let extent = (hi - lo).max(DVec3::splat(1e-9));
-        let cell = extent / side as f64;
-        let mut grid = Self {
-            lo,
-            cell,
-            dims: [side; 3],
-            cells: vec![Vec::new(); side * side * side],
-            large: Vec::new(),
-        };
+        let (cell, dims) = Self::shape(hi - lo, count);
+        let mut grid =
+            Self { lo, cell, dims, cells: vec![Vec::new(); dims.iter().product()], large: Vec::new() };
         if count == 0 {
             return grid;
         }
@@ -106,6 +108,34 @@ impl Grid {
             grid.for_cells(from, to, |c| c.push(k as u32));
         }
         grid
+    }
+
+    /// Cell size and cells per axis for `count` candidates spread over `extent`: about four
+    /// candidates a cell, at most [`Grid::MAX_CELLS`] cells, and cubic cells, so that a long
+    /// thin scene is cut along its length. (The same number of cells on every axis made a
+    /// row of 50 000 tiles 2 000 tiles a cell, and the search for each tile's neighbours
+    /// quadratic.)
+    fn shape(extent: DVec3, count: usize) -> (DVec3, [usize; 3]) {
+        let extent =
+            DVec3::from_array(extent.to_array().map(|e| if e.is_finite() { e.max(0.0) } else { 0.0 }));
+        let longest = extent.max_element();
+        if longest <= 0.0 {
+            return (DVec3::splat(1e-9), [1; 3]);
+        }
+        let target = (count as f64 / 4.0).clamp(1.0, Self::MAX_CELLS as f64);
+        // A flat scene (every candidate in one plane) has no volume: its thin axes count as a
+        // millionth of the longest, so the cells are sized by its area.
+        let thick = extent.max(DVec3::splat(longest * 1e-6));
+        let mut size = (thick.x * thick.y * thick.z / target).cbrt();
+        let dims_for = |size: f64| extent.to_array().map(|e| ((e / size).ceil() as usize).max(1));
+        let mut dims = dims_for(size);
+        // Rounding up on each axis may pass the bound: coarsen until it holds.
+        while dims.iter().map(|&d| d as f64).product::<f64>() > Self::MAX_CELLS as f64 {
+            size *= 1.25;
+            dims = dims_for(size);
+        }
+        let cell = extent / DVec3::new(dims[0] as f64, dims[1] as f64, dims[2] as f64);
+        (cell.max(DVec3::splat(1e-9)), dims)
     }
 
     /// The length of the grid's diagonal: no two candidates lie farther apart.
@@ -195,12 +225,24 @@ impl<'a> Contacts<'a> {
         let grid = Grid::new(candidates.iter().map(|c| (c.2, c.3)));
         let emits =
             scene.objects.iter().map(|o| scene.materials[o.material].emission.max_channel() > 0.0).collect();
-        Self { candidates, grid, pairs_left: std::cell::Cell::new(PAIR_BUDGET), emits }
+        Self {
+            candidates,
+            grid,
+            pairs_left: std::cell::Cell::new(PAIR_BUDGET),
+            proximity_left: std::cell::Cell::new(PROXIMITY_BUDGET),
+            emits,
+        }
     }
 
     /// Whether the budget of polygon pairs ran out (some surfaces were meshed uncut).
     pub(crate) fn budget_spent(&self) -> bool {
         self.pairs_left.get() == 0
+    }
+
+    /// Whether [`PROXIMITY_BUDGET`] ran out (some elements near other geometry were left
+    /// unrefined).
+    pub(crate) fn proximity_budget_spent(&self) -> bool {
+        self.proximity_left.get() == 0
     }
 
     /// The candidates whose bounding boxes touch `[lo, hi]` widened by `eps`, in candidate
@@ -296,8 +338,16 @@ impl<'a> Contacts<'a> {
         eps: f64,
         corners: &[(DVec3, DVec3)],
     ) -> bool {
+        if self.proximity_budget_spent() {
+            return false;
+        }
         let r = DVec3::splat(reach);
         self.grid.any_near(c - r, c + r, |k| {
+            let left = self.proximity_left.get();
+            if left == 0 {
+                return false;
+            }
+            self.proximity_left.set(left - 1);
             let (id, p, lo, hi) = &self.candidates[k as usize];
             if self.emits[id.object] || c.clamp(*lo, *hi).distance_squared(c) >= reach * reach {
                 return false;

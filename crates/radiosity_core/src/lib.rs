@@ -37,8 +37,9 @@ pub use mesh::{
 pub use one_line::{MAX_PART_CHARS, escape_controls, one_line};
 pub use planar::distance_to_polygon;
 pub use scene::{
-    Camera, Facing, MAX_POLYGON_VERTICES, MAX_TIME_LIMIT_SECONDS, Material, Object, Polygon, PolygonMesh,
-    Scene, SceneError, Shape, Sides, SolverSettings, Sphere, box_faces, unique_names,
+    Camera, Facing, MAX_COORDINATE, MAX_POLYGON_VERTICES, MAX_TIME_LIMIT_SECONDS, Material, Object, Polygon,
+    PolygonMesh, Scene, SceneError, Shape, Sides, SolverSettings, Sphere, box_faces, check_coordinate,
+    coordinate_in_range, unique_names,
 };
 pub use sealed::{MAX_HOLE_SHARE, Sealed, seal_closed_objects};
 pub use srgb::{encode_srgb, srgb_decode, srgb_encode};

@@ -401,6 +401,9 @@ pub struct Mesh {
     /// True when the scene had too many large faces to look for contacts on all of them:
     /// some were meshed whole.
     pub contacts_incomplete: bool,
+    /// True when looking for geometry near elements ([`MeshParams::proximity_refinement`])
+    /// ran out of its budget: some elements near other geometry were left unrefined.
+    pub proximity_incomplete: bool,
 }
 
 /// Which vertices of *different* surfaces share their radiosity in smooth shading: those in
@@ -466,10 +469,12 @@ impl Smoothing {
         let diagonal = (hi - lo).length().max(f64::MIN_POSITIVE);
         let grid = 1e-7 * diagonal;
         // Vertices sorted by place, those in one place side by side (sorting millions of them
-        // is faster than a map of lists, which allocated a list per place).
+        // is faster than a map of lists, which allocated a list per place). Places are counted
+        // from the lowest corner, so indices stay below 2·10⁷: from the origin, a scene far
+        // away saturated them, and all its vertices shared one place (every pair a partner).
         let mut places: Vec<([i64; 3], u32)> = (0..mesh.positions.len())
             .filter(|&v| vertex_surface[v] != u32::MAX)
-            .map(|v| (mesh.positions[v].to_array().map(|c| (c / grid).round() as i64), v as u32))
+            .map(|v| ((mesh.positions[v] - lo).to_array().map(|c| (c / grid).round() as i64), v as u32))
             .collect();
         places.sort_unstable();
         let mut pairs: Vec<(u32, u32, f32)> = Vec::new();
@@ -560,12 +565,26 @@ fn t_junctions(
     if lengths.is_empty() {
         return;
     }
+    let total_length: f64 = lengths.iter().sum();
     let middle = lengths.len() / 2;
-    let size = *lengths.select_nth_unstable_by(middle, f64::total_cmp).1;
-    if size <= 0.0 {
+    let median = *lengths.select_nth_unstable_by(middle, f64::total_cmp).1;
+    // The median edge, but no smaller than:
+    // * an eighth of the mean edge: a long slanted edge enters a cell per `size` of its
+    //   length, so the (cell, edge) entries below number at most 27 · (8 + 1) per edge
+    //   whatever the lengths (a 5 000-corner star's ear-clipped slivers, each as long as the
+    //   star, beside its finely meshed outline, asked for 3 GB of entries);
+    // * twice the tolerance, which the long-edge walk assumes is below a cell, and which keeps
+    //   every cell index below 10⁶ (the tolerance is a millionth of the mesh's diagonal), so
+    //   cell arithmetic cannot overflow whatever the coordinates.
+    let size = median.max(total_length / (8.0 * lengths.len() as f64)).max(2.0 * tolerance);
+    if !(size > 0.0 && size.is_finite()) {
         return;
     }
-    let cell = |p: DVec3| (p / size).floor().as_i64vec3().to_array();
+    // Cells are counted from the mesh's lowest corner, not the origin: far from the origin,
+    // indices of points divided by a small cell would saturate the integer conversion, and
+    // every point out there would share one cell.
+    let (origin, _) = mesh.bounds();
+    let cell = |p: DVec3| ((p - origin) / size).floor().as_i64vec3().to_array();
     // (cell, segment) for every cell a segment passes near, sorted by cell: a cell's segments
     // are one run, found by binary search.
     let mut cells: Vec<([i64; 3], u32)> = Vec::new();
@@ -1192,7 +1211,8 @@ impl Mesh {
                 }
             }
         }
-        mesh.contacts_incomplete = contacts.is_some_and(|c| c.budget_spent());
+        mesh.contacts_incomplete = contacts.as_ref().is_some_and(|c| c.budget_spent());
+        mesh.proximity_incomplete = contacts.as_ref().is_some_and(|c| c.proximity_budget_spent());
         mesh.shrink_to_fit();
         mesh.smoothing = Smoothing::new(&mesh, params.crease_angle_deg);
         Ok(mesh)

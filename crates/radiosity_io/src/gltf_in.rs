@@ -420,7 +420,7 @@ pub(crate) fn parse_gltf(
                     };
                     face.push(v);
                 }
-                b.face(face);
+                b.face(face).map_err(|m| err(format!("{what}: triangle {t}: {m}")))?;
             }
             dropped += b.dropped;
             let material = material_index(prim.material(), &mut warnings)?;

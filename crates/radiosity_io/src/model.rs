@@ -352,11 +352,15 @@ impl PartBuilder {
     /// The welded index of model-space point `p`.
     ///
     /// # Errors
-    /// The message for a non-finite point (before or after the transform).
+    /// The message for a non-finite point (before or after the transform), or one placed
+    /// beyond ±[`radiosity_core::MAX_COORDINATE`].
     pub(crate) fn vertex(&mut self, p: DVec3) -> Result<u32, String> {
         let w = self.world_from_model.transform_point3(p);
         if !p.is_finite() || !w.is_finite() {
             return Err(format!("coordinates must be finite numbers, got {:?}", p.to_array()));
+        }
+        if let Err(e) = radiosity_core::check_coordinate(w) {
+            return Err(format!("{e} (placed from {:?})", p.to_array()));
         }
         // -0.0 and 0.0 are one point.
         let w = w + DVec3::ZERO;
@@ -369,7 +373,16 @@ impl PartBuilder {
     }
 
     /// Adds a face of welded indices, counter-clockwise in model space.
-    pub(crate) fn face(&mut self, mut f: Vec<u32>) {
+    ///
+    /// # Errors
+    /// The message for a face of more than [`radiosity_core::MAX_POLYGON_VERTICES`] corners
+    /// (before anything is triangulated: ear clipping is quadratic in the corners).
+    pub(crate) fn face(&mut self, mut f: Vec<u32>) -> Result<(), String> {
+        if f.len() > radiosity_core::MAX_POLYGON_VERTICES {
+            let e =
+                SceneError::TooManyVertices { count: f.len(), limit: radiosity_core::MAX_POLYGON_VERTICES };
+            return Err(e.to_string());
+        }
         if self.mirrored {
             f.reverse();
         }
@@ -380,7 +393,7 @@ impl PartBuilder {
         }
         if f.len() < 3 {
             self.dropped += 1;
-            return;
+            return Ok(());
         }
         let pts: Vec<DVec3> = f.iter().map(|&i| self.positions[i as usize]).collect();
         match Polygon::try_new(pts.clone()) {
@@ -404,6 +417,7 @@ impl PartBuilder {
             }
             Err(_) => self.dropped += 1,
         }
+        Ok(())
     }
 
     fn triangle(&mut self, t: [u32; 3]) {
@@ -448,10 +462,13 @@ fn ear_clip(pts: &[DVec3]) -> Vec<[usize; 3]> {
             && (a - c).cross(p - c).dot(n) >= 0.0
     };
     let mut guard = 0;
+    // The search for the next ear starts where the last was clipped, where the next one
+    // usually is: from the start of the list every time, each clip could rescan it all.
+    let mut from = 0;
     while idx.len() > 3 && guard < pts.len() * pts.len() {
         guard += 1;
         let k = idx.len();
-        let ear = (0..k).find(|&i| {
+        let ear = (from.min(k)..k).chain(0..from.min(k)).find(|&i| {
             let (a, b, c) = (idx[(i + k - 1) % k], idx[i], idx[(i + 1) % k]);
             convex(pts[a], pts[b], pts[c])
                 && idx.iter().all(|&j| j == a || j == b || j == c || !inside(pts[j], pts[a], pts[b], pts[c]))
@@ -459,6 +476,7 @@ fn ear_clip(pts: &[DVec3]) -> Vec<[usize; 3]> {
         let Some(i) = ear else { break };
         out.push([idx[(i + k - 1) % k], idx[i], idx[(i + 1) % k]]);
         idx.remove(i);
+        from = i.saturating_sub(1);
     }
     if idx.len() == 3 {
         out.push([idx[0], idx[1], idx[2]]);
@@ -485,7 +503,7 @@ mod tests {
         let mut b = PartBuilder::new(DMat4::IDENTITY);
         let l = [(0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (1.0, 1.0), (1.0, 2.0), (0.0, 2.0)];
         let f = l.map(|(x, y)| b.vertex(DVec3::new(x, y, 0.0)).unwrap()).to_vec();
-        b.face(f);
+        b.face(f).unwrap();
         assert_eq!(b.dropped, 0);
         let m = b.build().unwrap();
         assert_eq!(m.faces().len(), 4);
@@ -497,7 +515,7 @@ mod tests {
         let t = Transform { scale: [-1.0, 1.0, 1.0], ..Transform::default() };
         let mut b = PartBuilder::new(t.matrix());
         let f = [DVec3::ZERO, DVec3::X, DVec3::Y].map(|p| b.vertex(p).unwrap()).to_vec();
-        b.face(f);
+        b.face(f).unwrap();
         let m = b.build().unwrap();
         assert!((m.polygons()[0].normal() - DVec3::Z).length() < 1e-12);
     }

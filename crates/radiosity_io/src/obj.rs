@@ -147,6 +147,16 @@ fn scan(text: &str, origin: &str) -> Result<Scan, LoadError> {
                         format!("vertex {vertices}: coordinates must be finite numbers, got {p:?}"),
                     ));
                 }
+                if p.iter().any(|v| v.abs() > radiosity_core::MAX_COORDINATE) {
+                    return Err(model_error(
+                        origin,
+                        Some(line_no),
+                        format!(
+                            "vertex {vertices}: coordinates must be within ±{:e} of the origin, got {p:?}",
+                            radiosity_core::MAX_COORDINATE
+                        ),
+                    ));
+                }
             }
             Some("f") => {
                 let face = face_lines.len() + 1;
@@ -427,7 +437,9 @@ pub(crate) fn parse_obj(
                 };
                 face.push(v);
             }
-            b.face(face);
+            b.face(face).map_err(|m| {
+                model_error(origin, face_line(face_number - 1), format!("face {face_number}: {m}"))
+            })?;
         }
         dropped += b.dropped;
         let name = if model.name.is_empty() || model.name == "unnamed_object" {

@@ -6,6 +6,7 @@
 //! obey the same rules; this module only decides *where* in the file each error points: the
 //! offending value's span, down to the vertex for a non-finite or non-convex corner.
 
+use rustc_hash::FxHashMap as HashMap;
 use std::ops::Range;
 use std::path::Path;
 
@@ -34,6 +35,11 @@ fn v3(a: [f64; 3]) -> DVec3 {
 
 fn all_finite(a: &[f64; 3]) -> bool {
     a.iter().all(|c| c.is_finite())
+}
+
+/// Finite and within ±[`radiosity_core::MAX_COORDINATE`]: a point the core accepts.
+fn in_range(a: &[f64; 3]) -> bool {
+    radiosity_core::coordinate_in_range(*a)
 }
 
 /// A scene and what the loader dropped or defaulted on the way (degenerate faces of a model,
@@ -186,18 +192,23 @@ pub fn parse_scene_with(text: &str, origin: &str, opts: &LoadOptions) -> Result<
 
     let (mut materials, material_sides) = materials(&loc, &desc.material)?;
     let declared = materials.len();
+    // Names are unique by now; objects look theirs up here (a search of the list per object
+    // was quadratic: 50 000 objects using the last of 50 000 materials ran for minutes).
+    let by_name: HashMap<&str, usize> =
+        desc.material.iter().enumerate().map(|(i, m)| (m.get_ref().name.get_ref().as_str(), i)).collect();
     let mut objects = Vec::new();
     // For each object, the `[[object]]` it came from (a `mesh` object gives several).
     let mut origins = Vec::new();
     let mut warnings = Vec::new();
     for (i, o) in desc.object.iter().enumerate() {
         if o.get_ref().kind.get_ref() == "mesh" {
-            let declared = Declared { descs: &desc.material[..declared], sides: &material_sides };
+            let declared =
+                Declared { descs: &desc.material[..declared], sides: &material_sides, by_name: &by_name };
             let parts = mesh_object(&loc, i, o, &declared, opts, &mut materials, &mut warnings)?;
             objects.extend(parts);
         } else {
-            let declared = Declared { descs: &desc.material, sides: &material_sides };
-            objects.push(object(&loc, i, o, &declared, &materials[..declared.descs.len()])?);
+            let declared = Declared { descs: &desc.material, sides: &material_sides, by_name: &by_name };
+            objects.push(object(&loc, i, o, &declared)?);
         }
         origins.resize(objects.len(), i);
     }
@@ -210,11 +221,13 @@ pub fn parse_scene_with(text: &str, origin: &str, opts: &LoadOptions) -> Result<
 
     // Whole-scene rules come last, once every local error has had its say. The unused light
     // is found before `materials` and `objects` move into the scene, to explain a dark scene.
-    let unused_light = materials
-        .iter()
-        .enumerate()
-        .find(|(i, m)| m.is_emitter() && !objects.iter().any(|o| o.material == *i))
-        .map(|(i, _)| i);
+    let mut used = vec![false; materials.len()];
+    for o in &objects {
+        if let Some(u) = used.get_mut(o.material) {
+            *u = true;
+        }
+    }
+    let unused_light = materials.iter().enumerate().position(|(i, m)| m.is_emitter() && !used[i]);
     let lit = objects.iter().any(|o| materials.get(o.material).is_some_and(Material::is_emitter));
     let build = if opts.allow_no_light { Scene::try_new_unlit } else { Scene::try_new };
     let scene_error = |e: SceneError| match e {
@@ -252,6 +265,8 @@ pub fn parse_scene_with(text: &str, origin: &str, opts: &LoadOptions) -> Result<
 struct Declared<'a> {
     descs: &'a [Spanned<MaterialDesc>],
     sides: &'a [Option<Sides>],
+    /// Index of each name in `descs`.
+    by_name: &'a HashMap<&'a str, usize>,
 }
 
 /// `1` or `2` from a `sides` or `emission_sides` key, or an error at its value.
@@ -324,11 +339,14 @@ fn materials(
 ) -> Result<(Vec<Material>, Vec<Option<Sides>>), LoadError> {
     let mut materials: Vec<Material> = Vec::with_capacity(descs.len());
     let mut sides = Vec::with_capacity(descs.len());
+    // First index of each name: a search of the list per material was quadratic (100 000
+    // materials took 36 s).
+    let mut first_of: HashMap<&str, usize> = HashMap::default();
     for (i, m) in descs.iter().enumerate() {
         let m = m.get_ref();
         let key = format!("material[{i}]");
         let name = m.name.get_ref();
-        if let Some(first) = materials.iter().position(|o| o.name == *name) {
+        if let Some(&first) = first_of.get(name.as_str()) {
             return Err(loc.at(
                 m.name.span(),
                 format!("{key}.name"),
@@ -347,6 +365,7 @@ fn materials(
                     _ => loc.at(m.reflectance.span(), format!("{key}.reflectance"), e.to_string()),
                 })?;
         materials.push(material);
+        first_of.insert(name, i);
         sides.push(material_sides(loc, &key, m)?);
     }
     Ok((materials, sides))
@@ -362,9 +381,9 @@ fn camera(loc: &Locator, c: &Spanned<CameraDesc>) -> Result<Camera, LoadError> {
         // The core says what is wrong; name the field it is about, checking in the core's
         // order (finite, distinct points, up, field of view). Whether `up` is at fault is
         // asked of the core itself, with a field of view known to be good.
-        let field = if !all_finite(&position) {
+        let field = if !in_range(&position) {
             "position"
-        } else if !all_finite(&look_at) || position == look_at {
+        } else if !in_range(&look_at) || position == look_at {
             "look_at"
         } else if !all_finite(&up)
             || Camera::try_new(v3(position), v3(look_at), v3(up), DEFAULT_FOV_Y_DEG).is_err()
@@ -403,7 +422,9 @@ fn polygon(loc: &Locator, face: &Face, key: &str) -> Result<Polygon, LoadError> 
     let points = face.get_ref();
     Polygon::try_new(points.iter().map(|p| v3(*p.get_ref())).collect()).map_err(|e| {
         let vertex = match &e {
-            SceneError::NonFiniteCoordinate { .. } => points.iter().position(|p| !all_finite(p.get_ref())),
+            SceneError::NonFiniteCoordinate { .. } | SceneError::CoordinateOutOfRange { .. } => {
+                points.iter().position(|p| !in_range(p.get_ref()))
+            }
             SceneError::NonConvexPolygon { vertex } => Some(*vertex),
             _ => None,
         };
@@ -431,9 +452,7 @@ fn object(
     i: usize,
     o: &Spanned<ObjectDesc>,
     declared: &Declared,
-    materials: &[Material],
 ) -> Result<Object, LoadError> {
-    let material_descs = declared.descs;
     let d = o.get_ref();
     let name = d.name.get_ref().clone();
     let key = format!("object[{i}]");
@@ -451,7 +470,7 @@ fn object(
     let Some(material_name) = d.material.as_ref() else {
         return Err(loc.at(o.span(), format!("{key}.material"), format!("object '{name}' needs 'material'")));
     };
-    let material = material_index(loc, &key, &name, material_name, material_descs, materials)?;
+    let material = material_index(loc, &key, &name, material_name, declared)?;
     let missing = |field: &str| {
         loc.at(
             o.span(),
@@ -495,8 +514,8 @@ fn object(
             let facing = facing(loc, &key, d.normals.as_ref())?;
             let faces =
                 box_faces(v3(*min.get_ref()), v3(*max.get_ref()), facing, rotate_y_deg).map_err(|e| {
-                    // A non-finite corner is named; otherwise (min ≥ max) both are in the message.
-                    let (field, span) = if all_finite(min.get_ref()) && !all_finite(max.get_ref()) {
+                    // A corner out of range is named; otherwise (min ≥ max) both are in the message.
+                    let (field, span) = if in_range(min.get_ref()) && !in_range(max.get_ref()) {
                         ("max", max.span())
                     } else {
                         ("min", min.span())
@@ -510,7 +529,11 @@ fn object(
             let r = d.radius.as_ref().ok_or_else(|| missing("radius"))?;
             let facing = facing(loc, &key, d.normals.as_ref())?;
             let s = Sphere::try_new(v3(*c.get_ref()), *r.get_ref(), facing).map_err(|e| {
-                let (field, span) = if matches!(e, SceneError::BadRadius { .. }) {
+                // A sphere reaching past the coordinate limit from a centre within it: its
+                // radius takes it there.
+                let (field, span) = if matches!(e, SceneError::BadRadius { .. })
+                    || (matches!(e, SceneError::CoordinateOutOfRange { .. }) && in_range(c.get_ref()))
+                {
                     ("radius", r.span())
                 } else {
                     ("center", c.span())
@@ -566,16 +589,16 @@ fn check_fields(
     Ok(())
 }
 
+/// The index of the declared material an object names, or an error at the name.
 fn material_index(
     loc: &Locator,
     key: &str,
     name: &str,
     material: &Spanned<String>,
-    material_descs: &[Spanned<MaterialDesc>],
-    materials: &[Material],
+    declared: &Declared,
 ) -> Result<usize, LoadError> {
-    materials.iter().position(|m| m.name == *material.get_ref()).ok_or_else(|| {
-        let known = material_descs.iter().map(|m| m.get_ref().name.get_ref().as_str()).collect::<Vec<_>>();
+    declared.by_name.get(material.get_ref().as_str()).copied().ok_or_else(|| {
+        let known = declared.descs.iter().map(|m| m.get_ref().name.get_ref().as_str()).collect::<Vec<_>>();
         let known = if known.is_empty() { "none".to_owned() } else { known.join(", ") };
         loc.at(
             material.span(),
@@ -648,7 +671,6 @@ fn mesh_object(
     materials: &mut Vec<Material>,
     warnings: &mut Vec<String>,
 ) -> Result<Vec<Object>, LoadError> {
-    let material_descs = declared.descs;
     let d = o.get_ref();
     let name = d.name.get_ref().clone();
     let key = format!("object[{i}]");
@@ -660,11 +682,8 @@ fn mesh_object(
             format!("object '{name}' of type 'mesh' needs 'file'"),
         ));
     };
-    let override_material = d
-        .material
-        .as_ref()
-        .map(|m| material_index(loc, &key, &name, m, material_descs, &materials[..material_descs.len()]))
-        .transpose()?;
+    let override_material =
+        d.material.as_ref().map(|m| material_index(loc, &key, &name, m, declared)).transpose()?;
     let object_sides = d.sides.as_ref().map(|v| side_count(loc, format!("{key}.sides"), v)).transpose()?;
     let transform = d
         .transform

@@ -138,6 +138,12 @@ pub(crate) struct RimFits {
     terms: Vec<(u32, f64)>,
 }
 
+/// Most elements around a vertex whose elements join a rim vertex's second ring (see
+/// [`RimFits::new`]): far above a mesh's usual six or eight, reached only by fans of many
+/// triangles about one vertex, whose rim vertices have their first ring and the other
+/// second-ring elements to fit, so that the fits cost time linear in the mesh.
+const MAX_RING_VALENCE: usize = 256;
+
 impl RimFits {
     /// The fits of `mesh`'s rim vertices: those whose elements' angles at them sum to less
     /// than a full turn (by more than 0.1 rad) and that are pooled with no other vertex.
@@ -165,9 +171,16 @@ impl RimFits {
                 continue;
             }
             ring.clear();
+            ring.extend_from_slice(first);
             for &e in first {
                 for &u in mesh.elements[e as usize].vertex_indices() {
-                    ring.extend_from_slice(elements_at(u));
+                    // The second ring leaves out the elements around a vertex of more than
+                    // `MAX_RING_VALENCE` (the centre of a fan of 10⁵ triangles): each of the
+                    // fan's rim vertices took in the whole fan, 26 GB of terms.
+                    let around_u = elements_at(u);
+                    if around_u.len() <= MAX_RING_VALENCE {
+                        ring.extend_from_slice(around_u);
+                    }
                 }
             }
             ring.sort_unstable();

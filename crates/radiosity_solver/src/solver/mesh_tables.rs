@@ -149,29 +149,49 @@ pub(super) fn check_patch_runs(mesh: &Mesh) -> Result<(), SolverError> {
 /// the diagonal neighbours added rays and changed neither the object means nor the render
 /// beyond their noise.
 fn element_neighbours(mesh: &Mesh) -> (Vec<u32>, Vec<u32>) {
-    // Elements around each vertex, then the union over an element's vertices.
-    let mut around = vec![Vec::new(); mesh.positions.len()];
+    // Two elements are neighbours when they share two vertices, i.e. a pair of vertices (an
+    // edge, or a quad's diagonal): every element's vertex pairs, sorted, put the elements
+    // sharing one side by side. (Looking at every element around each vertex was quadratic
+    // in a vertex's valence: the apex of a fan of 10⁵ triangles, a many-cornered light,
+    // took minutes.)
+    let mut pairs: Vec<(u32, u32, u32)> = Vec::new();
     for (e, el) in mesh.elements.iter().enumerate() {
-        for &v in el.vertex_indices() {
-            around[v as usize].push(e as u32);
-        }
-    }
-    let (mut start, mut list) = (Vec::with_capacity(mesh.elements.len() + 1), Vec::new());
-    start.push(0);
-    for (e, el) in mesh.elements.iter().enumerate() {
-        let first = list.len();
-        for &v in el.vertex_indices() {
-            for &n in &around[v as usize] {
-                let shared = mesh.elements[n as usize]
-                    .vertex_indices()
-                    .iter()
-                    .filter(|v| el.vertex_indices().contains(v))
-                    .count();
-                if n as usize != e && shared >= 2 && !list[first..].contains(&n) {
-                    list.push(n);
-                }
+        let v = el.vertex_indices();
+        for i in 0..v.len() {
+            for j in i + 1..v.len() {
+                pairs.push((v[i].min(v[j]), v[i].max(v[j]), e as u32));
             }
         }
+    }
+    pairs.sort_unstable();
+    let mut found: Vec<(u32, u32)> = Vec::new();
+    for run in pairs.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
+        for &(_, _, a) in run {
+            found.extend(run.iter().filter(|&&(_, _, b)| b != a).map(|&(_, _, b)| (a, b)));
+        }
+    }
+    drop(pairs);
+    found.sort_unstable();
+    found.dedup();
+    // Each element's neighbours in the order a walk over its vertices meets them (by the
+    // first of its vertices they share, then by number): the order the table has always had,
+    // so that what reads it (in that order) gives the same results as before.
+    let (mut start, mut list) =
+        (Vec::with_capacity(mesh.elements.len() + 1), Vec::with_capacity(found.len()));
+    start.push(0);
+    let mut next = found.as_slice();
+    for (e, el) in mesh.elements.iter().enumerate() {
+        let count = next.iter().take_while(|&&(a, _)| a as usize == e).count();
+        let (mine, rest) = next.split_at(count);
+        next = rest;
+        let own = el.vertex_indices();
+        let first_shared = |n: u32| {
+            let theirs = mesh.elements[n as usize].vertex_indices();
+            own.iter().position(|v| theirs.contains(v)).unwrap_or(own.len())
+        };
+        let mut ordered: Vec<(usize, u32)> = mine.iter().map(|&(_, n)| (first_shared(n), n)).collect();
+        ordered.sort_unstable();
+        list.extend(ordered.into_iter().map(|(_, n)| n));
         start.push(list.len() as u32);
     }
     (start, list)
