@@ -171,7 +171,7 @@ pub fn real_case(scene_arg: &str, reference_seconds: f64) -> Result<Value> {
     // Both stops are timed in one solve: down to 0.1 % whatever the scene file says (its
     // shot or time limits still apply, and then the row says where it stopped).
     prepared.params.unshot_threshold = FINE;
-    let Prepared { scene, problem, params } = &prepared;
+    let Prepared { scene, problem, params, .. } = &prepared;
     let mesh = problem.mesh();
     let triangles = mesh.occluders.len();
     let (surfaces, patches, elements) = (mesh.surfaces.len(), mesh.patches.len(), mesh.elements.len());

@@ -84,7 +84,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
     let bytes = match format {
         ExportFormat::Glb => radiosity_export::glb_bytes(mesh, &solution, mode),
         ExportFormat::Gltf => radiosity_export::gltf_text(mesh, &solution, mode).into_bytes(),
-        ExportFormat::Ply => radiosity_export::ply_bytes(mesh, &solution, tone),
+        ExportFormat::Ply => radiosity_export::ply_bytes(mesh, &solution, tone, prepared.up),
     };
     output::write_file(&a.output, a.force, &bytes)?;
     note(format_args!(
@@ -113,7 +113,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
             None => Texels::Interpolated,
         };
         let count = output::write_folder(dir, a.force, |staging| {
-            radiosity_export::write_lightmaps(staging, mesh, &solution, texels)
+            radiosity_export::write_lightmaps(staging, mesh, &solution, texels, prepared.up)
         })?;
         note(format_args!("wrote {count} lightmap files into {}", dir.display()))?;
     }

@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
-use radiosity_core::{MeshParams, Scene};
+use radiosity_core::{MeshParams, Scene, UpAxis};
 use radiosity_solver::{
     Ambient, FormFactorMethod, Overshoot, Problem, Solver, SolverParams, StepBudget, StepReport,
 };
@@ -77,6 +77,13 @@ pub struct MeshOpts {
     /// file and the scene file say [default: OBJ two-sided, glTF as its doubleSided flag].
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=2), value_name = "1|2")]
     pub sides: Option<u8>,
+    /// The model's up axis: x, y, z, -x, -y or -z (architectural and CAD models are mostly z
+    /// up). The scene is turned so that it stands upright; coordinates you give
+    /// (--camera-position, --look-at) and get back (PLY, lightmap OBJ, element centres) stay
+    /// in the file's frame, glTF output is +y up by its spec [default: the scene file's `up`,
+    /// else y].
+    #[arg(long, value_name = "AXIS", allow_hyphen_values = true)]
+    pub up: Option<String>,
     /// Cut surfaces along the outlines of solids standing on them (a block on the floor) and
     /// leave the covered part out of the solve [default: the scene's `[mesh]` contacts, else
     /// true].
@@ -208,6 +215,9 @@ pub struct Prepared {
     pub problem: Problem,
     /// Solver settings from the scene and the options.
     pub params: SolverParams,
+    /// The up axis of the file the scene came from: the scene itself is turned +y up, and
+    /// coordinates given or reported go through [`UpAxis::to_y_up`] and back.
+    pub up: UpAxis,
 }
 
 fn input(msg: String) -> anyhow::Error {
@@ -223,6 +233,8 @@ pub struct Settings {
     pub mesh_params: MeshParams,
     /// Solver settings from the scene and the options.
     pub solver_params: SolverParams,
+    /// The file's up axis ([`Prepared::up`]).
+    pub up: UpAxis,
 }
 
 /// Loads `scene_arg` (a scene file, a model file — `.obj`, `.gltf`, `.glb` — or a built-in
@@ -260,6 +272,7 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
             return Err(input(format!("{option} must be {least} to {MAX_RAYS}, got {value}")));
         }
     }
+    let up = o.mesh.up.as_deref().map(parse_up).transpose()?;
     // A model file given where a scene is expected loads as a scene of its parts; what the
     // loader dropped or defaulted (degenerate faces, a missing MTL) is said once, here.
     let options = radiosity_io::LoadOptions {
@@ -269,12 +282,25 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
         }),
         // A missing light is returned after the warnings are out, not in place of them.
         allow_no_light: true,
+        up,
     };
-    let radiosity_io::LoadedScene { mut scene, warnings, no_light } =
+    let radiosity_io::LoadedScene { mut scene, warnings, no_light, up } =
         radiosity_io::resolve_scene_with(scene_arg, &options)?;
     for w in &warnings {
         crate::output::note(format_args!("warning: {w}"))?;
     }
+    // A building model from an architectural tool is mostly z up and would lie on its side:
+    // say which flag stands it up, unless an up axis was declared.
+    if up.is_none()
+        && let Some(guess) = scene.likely_up()
+    {
+        crate::output::note(format_args!(
+            "note: the scene looks {up} up ({reason}) but is read +y up; if it lies on its side, add --up {up} (or up = \"{up}\" in a scene file)",
+            up = guess.up,
+            reason = guess.reason
+        ))?;
+    }
+    let up = up.unwrap_or_default();
     if o.mesh.sides.is_none() {
         let sealed = radiosity_core::seal_closed_objects(&mut scene);
         let names = |keep: fn(&radiosity_core::Sealed) -> bool| {
@@ -369,7 +395,16 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
         shared_visibility: o.shared_visibility,
         ..defaults
     };
-    Ok((Settings { scene, mesh_params, solver_params }, no_light))
+    Ok((Settings { scene, mesh_params, solver_params, up }, no_light))
+}
+
+/// `--up`'s axis.
+///
+/// # Errors
+/// Any other name, listing the accepted ones (exit code 2).
+fn parse_up(name: &str) -> Result<UpAxis> {
+    UpAxis::parse(name)
+        .ok_or_else(|| input(format!("--up must be one of {}, got '{name}'", UpAxis::NAMES.join(", "))))
 }
 
 /// The names of `objects` of `scene`, quoted, the first three and a count of the rest.
@@ -404,7 +439,7 @@ pub fn prepare_unlit(scene_arg: &str, o: &SolveOpts) -> Result<(Prepared, Option
 
 /// The light scale and the [`Problem`] of checked settings.
 fn mesh(settings: Settings, o: &SolveOpts) -> Result<Prepared> {
-    let Settings { mut scene, mesh_params, solver_params } = settings;
+    let Settings { mut scene, mesh_params, solver_params, up } = settings;
     if let Some(t) = o.threads {
         // One call per process: an error is the system refusing the threads.
         rayon::ThreadPoolBuilder::new()
@@ -414,7 +449,7 @@ fn mesh(settings: Settings, o: &SolveOpts) -> Result<Prepared> {
     }
     scene.scale_emission(o.light_scale);
     let problem = Problem::new(&scene, &mesh_params)?;
-    Ok(Prepared { scene, problem, params: solver_params })
+    Ok(Prepared { scene, problem, params: solver_params, up })
 }
 
 /// Refuses a light scale whose product with an emission passes [`MAX_EMISSION`], or whose
@@ -535,6 +570,7 @@ mod tests {
             element_size: None,
             crease_angle: Some(0.0),
             sides: Some(1),
+            up: None,
             contacts: None,
             shadow_outlines: None,
             corner_refinement: None,

@@ -140,10 +140,11 @@ pub struct RenderArgs {
     /// many times --shadow-rays, 1 to 64; 1: as many as any pixel.
     #[arg(long, default_value_t = RenderParams::default().penumbra_factor, value_name = "N")]
     pub penumbra_factor: u32,
-    /// Eye position `x,y,z` (default: the scene's `[camera]`, or one framing the scene).
+    /// Eye position `x,y,z`, in the file's coordinates (default: the scene's `[camera]`, or
+    /// one framing the scene).
     #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
     pub camera_position: Option<DVec3>,
-    /// Point looked at, `x,y,z`.
+    /// Point looked at, `x,y,z`, in the file's coordinates.
     #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
     pub look_at: Option<DVec3>,
     /// Vertical field of view, degrees, in (0, 180).
@@ -278,9 +279,11 @@ pub fn run(a: RenderArgs) -> Result<()> {
     }
     let prepared = prepare(&a.scene, &a.solve)?;
     let base = prepared.scene.camera_or_framing();
+    // The points given are in the file's frame; the scene has been turned +y up.
+    let turned = |p: DVec3| prepared.up.to_y_up(p);
     let camera = Camera::try_new(
-        a.camera_position.unwrap_or(base.position),
-        a.look_at.unwrap_or(base.look_at),
+        a.camera_position.map_or(base.position, turned),
+        a.look_at.map_or(base.look_at, turned),
         base.up,
         a.fov.unwrap_or(base.fov_y_deg),
     )

@@ -338,7 +338,7 @@ pub fn run(a: VerifyArgs) -> Result<()> {
     table.push('\n');
 
     // A sample of elements: local errors (shadow edges, contacts) that object means hide.
-    let element_part = match a.elements {
+    let mut element_part = match a.elements {
         Some(count) if count > 0 => Some(compare_elements(
             &reference,
             mesh,
@@ -350,8 +350,17 @@ pub fn run(a: VerifyArgs) -> Result<()> {
         )?),
         _ => None,
     };
-    if let Some(part) = &element_part {
+    if let Some(part) = &mut element_part {
         table += &part.text;
+        // Centres in the file's frame, as the user's tools show the model.
+        if let Some(elements) = part.json["elements"].as_array_mut() {
+            for e in elements {
+                if let Ok(c) = serde_json::from_value::<[f64; 3]>(e["centre"].take()) {
+                    e["centre"] =
+                        json!(prepared.up.from_y_up(radiosity_core::glam::DVec3::from_array(c)).to_array());
+                }
+            }
+        }
     }
     if a.json.as_deref() != Some("-") {
         let mut out = std::io::stdout().lock();

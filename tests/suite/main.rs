@@ -14,5 +14,6 @@ mod models;
 mod public_models;
 mod readme;
 mod rooms;
+mod up_axis;
 mod verify;
 mod viewer;
