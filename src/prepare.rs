@@ -1,13 +1,13 @@
 //! What every command that solves shares: the solve options, loading and meshing a scene,
 //! and running the solver with a progress bar.
 
-use std::io::IsTerminal;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use indicatif::{ProgressBar, ProgressStyle};
 use radiosity_core::{MeshParams, Scene, UpAxis};
+
+use crate::progress::{Progress, spinning};
 use radiosity_solver::{
     Ambient, FormFactorMethod, Overshoot, Problem, Solver, SolverParams, StepBudget, StepReport,
 };
@@ -285,7 +285,7 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
         up,
     };
     let radiosity_io::LoadedScene { mut scene, warnings, no_light, up } =
-        radiosity_io::resolve_scene_with(scene_arg, &options)?;
+        spinning(&format!("loading {scene_arg}"), || radiosity_io::resolve_scene_with(scene_arg, &options))?;
     for w in &warnings {
         crate::output::note(format_args!("warning: {w}"))?;
     }
@@ -302,7 +302,7 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
     }
     let up = up.unwrap_or_default();
     if o.mesh.sides.is_none() {
-        let sealed = radiosity_core::seal_closed_objects(&mut scene);
+        let sealed = spinning("finding closed models", || radiosity_core::seal_closed_objects(&mut scene));
         let names = |keep: fn(&radiosity_core::Sealed) -> bool| {
             let objects: Vec<usize> = sealed.iter().filter(|s| keep(s)).map(|s| s.object).collect();
             (!objects.is_empty()).then(|| name_list(&scene, &objects))
@@ -448,7 +448,7 @@ fn mesh(settings: Settings, o: &SolveOpts) -> Result<Prepared> {
             .with_context(|| format!("cannot start {t} worker threads (--threads)"))?;
     }
     scene.scale_emission(o.light_scale);
-    let problem = Problem::new(&scene, &mesh_params)?;
+    let problem = spinning("meshing", || Problem::new(&scene, &mesh_params))?;
     Ok(Prepared { scene, problem, params: solver_params, up })
 }
 
@@ -478,28 +478,13 @@ fn check_light_scale(scene: &Scene, light_scale: f64) -> Result<()> {
     Ok(())
 }
 
-/// Seconds between progress lines when stderr is not a terminal (a log file, a CI job).
-pub const LOG_INTERVAL: Duration = Duration::from_secs(5);
-
-/// Runs the solver to a stop criterion, with a progress bar on stderr when it is a terminal
-/// and a progress line every [`LOG_INTERVAL`] when it is not (a bar there would be noise).
+/// Runs the solver to a stop criterion (or a Ctrl-C that [`crate::interrupt::catch`] caught),
+/// with its progress on stderr ([`Progress`]).
 ///
 /// # Errors
 /// Solver parameter errors (exit code 2); stderr that cannot be written.
 pub fn run_solver(p: &Prepared) -> Result<(Solver, StepReport)> {
     let mut solver = p.problem.solver(p.params.clone())?;
-    let terminal = std::io::stderr().is_terminal();
-    let bar = if terminal {
-        let bar = ProgressBar::new(1000);
-        bar.set_style(
-            ProgressStyle::with_template("{spinner} solving [{bar:30}] {msg}")
-                .expect("valid template")
-                .progress_chars("=> "),
-        );
-        bar
-    } else {
-        ProgressBar::hidden()
-    };
     let threshold = p.params.unshot_threshold.max(radiosity_solver::UNSHOT_FLOOR);
     if p.params.unshot_threshold < radiosity_solver::UNSHOT_FLOOR {
         crate::output::note(format_args!(
@@ -508,32 +493,29 @@ pub fn run_solver(p: &Prepared) -> Result<(Solver, StepReport)> {
             radiosity_solver::UNSHOT_FLOOR
         ))?;
     }
-    let start = Instant::now();
-    let mut last_log = start;
+    let progress = Progress::bar("solving", 1000, "");
     let report = loop {
         let r = solver.step(StepBudget::Time(Duration::from_millis(100)));
         // Progress on a log scale: from 1 (nothing shot) down to the threshold.
         let done = (r.unshot_fraction.max(threshold).ln() / threshold.ln()).clamp(0.0, 1.0);
-        bar.set_position((done * 1000.0) as u64);
-        let secs = start.elapsed().as_secs_f64();
+        let secs = progress.elapsed().as_secs_f64();
         let eta = if done > 0.0 { secs * (1.0 - done) / done } else { f64::NAN };
-        let message = format!(
-            "{} shots, unshot {:.3} %, {:.2} M rays/s, ETA {:.1} s",
-            r.total_shots,
-            r.unshot_fraction * 100.0,
-            r.rays as f64 / secs.max(1e-9) / 1e6,
-            eta
-        );
-        if r.stop_reason.is_some() {
+        if r.stop_reason.is_some() || crate::interrupt::requested() {
             break r;
         }
-        if !terminal && last_log.elapsed() >= LOG_INTERVAL {
-            last_log = Instant::now();
-            crate::output::note(format_args!("[{secs:.0} s] solving: {message}"))?;
-        }
-        bar.set_message(message);
+        progress.set(
+            (done * 1000.0) as u64,
+            1000,
+            format!(
+                "{} shots, unshot {:.3} %, {:.2} M rays/s, ETA {:.1} s",
+                r.total_shots,
+                r.unshot_fraction * 100.0,
+                r.rays as f64 / secs.max(1e-9) / 1e6,
+                eta
+            ),
+        );
     };
-    bar.finish_and_clear();
+    drop(progress);
     // A light behind a wall or facing out of the scene: everything it emitted escaped and the
     // converged picture is black. Say why instead of leaving it to be guessed.
     let energy = solver.energy();
