@@ -61,6 +61,7 @@ enum Command {
 
 fn main() -> ExitCode {
     alloc::keep_freed_memory();
+    progress::start_clock();
     let cli = Cli::parse();
     progress::set_quiet(cli.quiet);
     if cli.progress_interval.is_finite() && cli.progress_interval > 0.0 {
