@@ -85,7 +85,7 @@ pub fn header() -> String {
 
 /// Steps `solver` one shot at a time until it stops, noting the solve time of the first
 /// report at or below each of [`COARSE`] and [`FINE`], with a progress line on stderr every
-/// [`LOG_INTERVAL`](crate::prepare::LOG_INTERVAL), as `solve` gives when not on a terminal:
+/// [`LOG_INTERVAL`](crate::progress::LOG_INTERVAL), as `solve` gives when not on a terminal:
 /// a big room takes minutes, and a silent benchmark looks hung.
 ///
 /// # Errors
@@ -107,7 +107,7 @@ fn timed_solve(solver: &mut radiosity_solver::Solver) -> Result<(StepReport, Opt
         if r.stop_reason.is_some() {
             return Ok((r, coarse, fine));
         }
-        if last_log.elapsed() >= crate::prepare::LOG_INTERVAL {
+        if last_log.elapsed() >= crate::progress::LOG_INTERVAL {
             last_log = Instant::now();
             output::note(format_args!(
                 "[{secs:.0} s] solving: {} shots, unshot {:.3} %",
@@ -171,7 +171,7 @@ pub fn real_case(scene_arg: &str, reference_seconds: f64) -> Result<Value> {
     // Both stops are timed in one solve: down to 0.1 % whatever the scene file says (its
     // shot or time limits still apply, and then the row says where it stopped).
     prepared.params.unshot_threshold = FINE;
-    let Prepared { scene, problem, params } = &prepared;
+    let Prepared { scene, problem, params, .. } = &prepared;
     let mesh = problem.mesh();
     let triangles = mesh.occluders.len();
     let (surfaces, patches, elements) = (mesh.surfaces.len(), mesh.patches.len(), mesh.elements.len());
@@ -203,11 +203,11 @@ pub fn real_case(scene_arg: &str, reference_seconds: f64) -> Result<Value> {
         time_limit: Some(Duration::from_secs_f64(reference_seconds)),
         max_reflections: u32::MAX,
     };
-    let bar = verify_cmd::reference_bar("reference");
-    let estimates = reference.estimate_objects(&ref_params, &|p| verify_cmd::report_progress(&bar, p));
-    bar.finish_and_clear();
+    let progress = verify_cmd::reference_progress("reference");
+    let estimates = reference.estimate_objects(&ref_params, &|p| verify_cmd::report_progress(&progress, p));
+    drop(progress);
     let ref_secs = estimates.elapsed.as_secs_f64();
-    let rows = verify_cmd::compare_objects(&estimates, &solved)?;
+    let rows = verify_cmd::compare_objects(&estimates, &solved, false)?;
     let judged = verify_cmd::judged(&rows);
     let large: Vec<(usize, f64, f64)> =
         judged.iter().copied().filter(|&(i, ..)| solved[i].area >= MIN_AREA_SHARE * front_area).collect();

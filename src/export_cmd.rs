@@ -10,6 +10,7 @@ use radiosity_image::{Gather, HdrImage, RenderParams, Renderer, ToneOperator, To
 
 use crate::output::{self, Targets, note};
 use crate::prepare::{InputError, SolveOpts, prepare, run_solver};
+use crate::progress::spinning;
 use crate::render_cmd::{GatherArg, ToneOpts};
 
 /// Arguments of `radiosity export`.
@@ -82,12 +83,14 @@ pub fn run(a: ExportArgs) -> Result<()> {
     let tone = ToneParams::new(ev, a.tone.tonemap.into());
     let mode =
         if a.tonemapped { VertexColours::Display(tone) } else { VertexColours::Linear { exposure_ev: ev } };
-    let bytes = match format {
-        ExportFormat::Glb => radiosity_export::glb_bytes(mesh, &solution, mode),
-        ExportFormat::Gltf => radiosity_export::gltf_text(mesh, &solution, mode).into_bytes(),
-        ExportFormat::Ply => radiosity_export::ply_bytes(mesh, &solution, tone),
-    };
-    output::write_file(&a.output, a.force, &bytes)?;
+    spinning(&format!("writing {}", a.output.display()), || {
+        let bytes = match format {
+            ExportFormat::Glb => radiosity_export::glb_bytes(mesh, &solution, mode),
+            ExportFormat::Gltf => radiosity_export::gltf_text(mesh, &solution, mode).into_bytes(),
+            ExportFormat::Ply => radiosity_export::ply_bytes(mesh, &solution, tone, prepared.up),
+        };
+        output::write_file(&a.output, a.force, &bytes)
+    })?;
     note(format_args!(
         "{}: {} patches, {} elements, {} shots, unshot {:.4} %",
         prepared.scene.name,
@@ -113,8 +116,15 @@ pub fn run(a: ExportArgs) -> Result<()> {
             Some(renderer) => Texels::Gathered { renderer, params: &params },
             None => Texels::Interpolated,
         };
-        let count = output::write_folder(dir, a.force, |staging| {
-            radiosity_export::write_lightmaps(staging, mesh, &solution, texels)
+        let what = format!(
+            "baking lightmaps ({} texels a cell, gather {})",
+            radiosity_export::LIGHTMAP_CELL_TEXELS.pow(2),
+            gather.as_str()
+        );
+        let count = spinning(&what, || {
+            output::write_folder(dir, a.force, |staging| {
+                radiosity_export::write_lightmaps(staging, mesh, &solution, texels, prepared.up)
+            })
         })?;
         note(format_args!("wrote {count} lightmap files into {}", dir.display()))?;
     }

@@ -30,6 +30,9 @@ pub fn run(a: InfoArgs) -> Result<()> {
     // One text, one write: a closed pipe or a full disk is one error, not a panic.
     let mut out = String::new();
     let (lo, hi) = mesh.bounds();
+    // In the file's frame, as the user's tools show the model.
+    let (corner, other) = (p.up.from_y_up(lo), p.up.from_y_up(hi));
+    let (lo, hi) = (corner.min(other), corner.max(other));
     let _ = writeln!(out, "scene      {}", scene.name);
     let _ = writeln!(out, "bounds     {:?} .. {:?}", lo.to_array(), hi.to_array());
     let _ = writeln!(out, "materials  {}", scene.materials.len());

@@ -6,8 +6,10 @@ mod bench_real;
 mod compare_cmd;
 mod export_cmd;
 mod info_cmd;
+mod interrupt;
 mod output;
 mod prepare;
+mod progress;
 mod render_cmd;
 mod solve_cmd;
 mod verify_cmd;
@@ -25,6 +27,12 @@ static HEAP: alloc::Counting = alloc::Counting;
 #[derive(Parser)]
 #[command(name = "radiosity", version, about, long_about = None)]
 struct Cli {
+    /// No progress on stderr (results, notes and warnings still print).
+    #[arg(long, short = 'q', global = true)]
+    quiet: bool,
+    /// Seconds between progress lines when stderr is not a terminal (tests set it short).
+    #[arg(long, global = true, hide = true, default_value_t = progress::LOG_INTERVAL.as_secs_f64())]
+    progress_interval: f64,
     #[command(subcommand)]
     command: Command,
 }
@@ -53,7 +61,12 @@ enum Command {
 
 fn main() -> ExitCode {
     alloc::keep_freed_memory();
+    progress::start_clock();
     let cli = Cli::parse();
+    progress::set_quiet(cli.quiet);
+    if cli.progress_interval.is_finite() && cli.progress_interval > 0.0 {
+        progress::set_log_interval(std::time::Duration::from_secs_f64(cli.progress_interval));
+    }
     let result = match cli.command {
         Command::Solve(a) => solve_cmd::run(a),
         Command::Info(a) => info_cmd::run(a),
@@ -69,6 +82,11 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         // A reader that stopped reading (`| head`) is not an error to report.
         Err(e) if output::is_broken_pipe(&e) => ExitCode::from(output::BROKEN_PIPE_EXIT),
+        // What the run had when Ctrl-C stopped it is out; the status says it was stopped.
+        Err(e) if e.is::<interrupt::Interrupted>() => {
+            let _ = output::note(format_args!("{e}"));
+            ExitCode::from(interrupt::INTERRUPTED_EXIT)
+        }
         Err(e) => {
             // Nowhere left to report a failure to write the report; the exit code still says it.
             let _ = output::note(format_args!("error: {}", radiosity_core::one_line(e.as_ref())));

@@ -321,6 +321,7 @@ pub fn stdout(text: &str) -> Result<()> {
 /// # Errors
 /// The write fails (a closed pipe: see [`is_broken_pipe`]).
 pub fn note(line: impl std::fmt::Display) -> Result<()> {
+    crate::progress::line_printed();
     let mut err = std::io::stderr().lock();
     writeln!(err, "{line}").and_then(|()| err.flush()).map_err(|e| stream_error(e, "stderr"))
 }

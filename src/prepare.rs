@@ -1,13 +1,13 @@
 //! What every command that solves shares: the solve options, loading and meshing a scene,
 //! and running the solver with a progress bar.
 
-use std::io::IsTerminal;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use indicatif::{ProgressBar, ProgressStyle};
-use radiosity_core::{MeshParams, Scene};
+use radiosity_core::{MeshParams, Scene, UpAxis};
+
+use crate::progress::{Progress, spinning};
 use radiosity_solver::{
     Ambient, FormFactorMethod, Overshoot, Problem, Solver, SolverParams, StepBudget, StepReport,
 };
@@ -77,6 +77,13 @@ pub struct MeshOpts {
     /// file and the scene file say [default: OBJ two-sided, glTF as its doubleSided flag].
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=2), value_name = "1|2")]
     pub sides: Option<u8>,
+    /// The model's up axis: x, y, z, -x, -y or -z (architectural and CAD models are mostly z
+    /// up). The scene is turned so that it stands upright; coordinates you give
+    /// (--camera-position, --look-at) and get back (PLY, lightmap OBJ, element centres) stay
+    /// in the file's frame, glTF output is +y up by its spec [default: the scene file's `up`,
+    /// else y].
+    #[arg(long, value_name = "AXIS", allow_hyphen_values = true)]
+    pub up: Option<String>,
     /// Cut surfaces along the outlines of solids standing on them (a block on the floor) and
     /// leave the covered part out of the solve [default: the scene's `[mesh]` contacts, else
     /// true].
@@ -208,6 +215,9 @@ pub struct Prepared {
     pub problem: Problem,
     /// Solver settings from the scene and the options.
     pub params: SolverParams,
+    /// The up axis of the file the scene came from: the scene itself is turned +y up, and
+    /// coordinates given or reported go through [`UpAxis::to_y_up`] and back.
+    pub up: UpAxis,
 }
 
 fn input(msg: String) -> anyhow::Error {
@@ -223,6 +233,8 @@ pub struct Settings {
     pub mesh_params: MeshParams,
     /// Solver settings from the scene and the options.
     pub solver_params: SolverParams,
+    /// The file's up axis ([`Prepared::up`]).
+    pub up: UpAxis,
 }
 
 /// Loads `scene_arg` (a scene file, a model file — `.obj`, `.gltf`, `.glb` — or a built-in
@@ -260,6 +272,7 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
             return Err(input(format!("{option} must be {least} to {MAX_RAYS}, got {value}")));
         }
     }
+    let up = o.mesh.up.as_deref().map(parse_up).transpose()?;
     // A model file given where a scene is expected loads as a scene of its parts; what the
     // loader dropped or defaulted (degenerate faces, a missing MTL) is said once, here.
     let options = radiosity_io::LoadOptions {
@@ -269,14 +282,27 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
         }),
         // A missing light is returned after the warnings are out, not in place of them.
         allow_no_light: true,
+        up,
     };
-    let radiosity_io::LoadedScene { mut scene, warnings, no_light } =
-        radiosity_io::resolve_scene_with(scene_arg, &options)?;
+    let radiosity_io::LoadedScene { mut scene, warnings, no_light, up } =
+        spinning(&format!("loading {scene_arg}"), || radiosity_io::resolve_scene_with(scene_arg, &options))?;
     for w in &warnings {
         crate::output::note(format_args!("warning: {w}"))?;
     }
+    // A building model from an architectural tool is mostly z up and would lie on its side:
+    // say which flag stands it up, unless an up axis was declared.
+    if up.is_none()
+        && let Some(guess) = scene.likely_up()
+    {
+        crate::output::note(format_args!(
+            "note: the scene looks {up} up ({reason}) but is read +y up; if it lies on its side, add --up {up} (or up = \"{up}\" in a scene file)",
+            up = guess.up,
+            reason = guess.reason
+        ))?;
+    }
+    let up = up.unwrap_or_default();
     if o.mesh.sides.is_none() {
-        let sealed = radiosity_core::seal_closed_objects(&mut scene);
+        let sealed = spinning("finding closed models", || radiosity_core::seal_closed_objects(&mut scene));
         let names = |keep: fn(&radiosity_core::Sealed) -> bool| {
             let objects: Vec<usize> = sealed.iter().filter(|s| keep(s)).map(|s| s.object).collect();
             (!objects.is_empty()).then(|| name_list(&scene, &objects))
@@ -369,7 +395,16 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
         shared_visibility: o.shared_visibility,
         ..defaults
     };
-    Ok((Settings { scene, mesh_params, solver_params }, no_light))
+    Ok((Settings { scene, mesh_params, solver_params, up }, no_light))
+}
+
+/// `--up`'s axis.
+///
+/// # Errors
+/// Any other name, listing the accepted ones (exit code 2).
+fn parse_up(name: &str) -> Result<UpAxis> {
+    UpAxis::parse(name)
+        .ok_or_else(|| input(format!("--up must be one of {}, got '{name}'", UpAxis::NAMES.join(", "))))
 }
 
 /// The names of `objects` of `scene`, quoted, the first three and a count of the rest.
@@ -404,7 +439,7 @@ pub fn prepare_unlit(scene_arg: &str, o: &SolveOpts) -> Result<(Prepared, Option
 
 /// The light scale and the [`Problem`] of checked settings of the scene `scene_arg` names.
 fn mesh(scene_arg: &str, settings: Settings, o: &SolveOpts) -> Result<Prepared> {
-    let Settings { mut scene, mesh_params, solver_params } = settings;
+    let Settings { mut scene, mesh_params, solver_params, up } = settings;
     if let Some(t) = o.threads {
         // One call per process: an error is the system refusing the threads.
         rayon::ThreadPoolBuilder::new()
@@ -416,8 +451,9 @@ fn mesh(scene_arg: &str, settings: Settings, o: &SolveOpts) -> Result<Prepared> 
     // The scene's loader names the line of a mesh over the element limit; one that only the
     // command's options make too large (or a model file's, which has no [mesh]) is named by
     // its file here.
-    let problem = Problem::new(&scene, &mesh_params).with_context(|| scene_arg.to_owned())?;
-    Ok(Prepared { scene, problem, params: solver_params })
+    let problem = spinning("meshing", || Problem::new(&scene, &mesh_params))
+        .with_context(|| scene_arg.to_owned())?;
+    Ok(Prepared { scene, problem, params: solver_params, up })
 }
 
 /// Refuses a light scale whose product with an emission passes [`MAX_EMISSION`], or whose
@@ -446,28 +482,13 @@ fn check_light_scale(scene: &Scene, light_scale: f64) -> Result<()> {
     Ok(())
 }
 
-/// Seconds between progress lines when stderr is not a terminal (a log file, a CI job).
-pub const LOG_INTERVAL: Duration = Duration::from_secs(5);
-
-/// Runs the solver to a stop criterion, with a progress bar on stderr when it is a terminal
-/// and a progress line every [`LOG_INTERVAL`] when it is not (a bar there would be noise).
+/// Runs the solver to a stop criterion (or a Ctrl-C that [`crate::interrupt::catch`] caught),
+/// with its progress on stderr ([`Progress`]).
 ///
 /// # Errors
 /// Solver parameter errors (exit code 2); stderr that cannot be written.
 pub fn run_solver(p: &Prepared) -> Result<(Solver, StepReport)> {
     let mut solver = p.problem.solver(p.params.clone())?;
-    let terminal = std::io::stderr().is_terminal();
-    let bar = if terminal {
-        let bar = ProgressBar::new(1000);
-        bar.set_style(
-            ProgressStyle::with_template("{spinner} solving [{bar:30}] {msg}")
-                .expect("valid template")
-                .progress_chars("=> "),
-        );
-        bar
-    } else {
-        ProgressBar::hidden()
-    };
     let threshold = p.params.unshot_threshold.max(radiosity_solver::UNSHOT_FLOOR);
     if p.params.unshot_threshold < radiosity_solver::UNSHOT_FLOOR {
         crate::output::note(format_args!(
@@ -476,32 +497,29 @@ pub fn run_solver(p: &Prepared) -> Result<(Solver, StepReport)> {
             radiosity_solver::UNSHOT_FLOOR
         ))?;
     }
-    let start = Instant::now();
-    let mut last_log = start;
+    let progress = Progress::bar("solving", 1000, "");
     let report = loop {
         let r = solver.step(StepBudget::Time(Duration::from_millis(100)));
         // Progress on a log scale: from 1 (nothing shot) down to the threshold.
         let done = (r.unshot_fraction.max(threshold).ln() / threshold.ln()).clamp(0.0, 1.0);
-        bar.set_position((done * 1000.0) as u64);
-        let secs = start.elapsed().as_secs_f64();
+        let secs = progress.elapsed().as_secs_f64();
         let eta = if done > 0.0 { secs * (1.0 - done) / done } else { f64::NAN };
-        let message = format!(
-            "{} shots, unshot {:.3} %, {:.2} M rays/s, ETA {:.1} s",
-            r.total_shots,
-            r.unshot_fraction * 100.0,
-            r.rays as f64 / secs.max(1e-9) / 1e6,
-            eta
-        );
-        if r.stop_reason.is_some() {
+        if r.stop_reason.is_some() || crate::interrupt::requested() {
             break r;
         }
-        if !terminal && last_log.elapsed() >= LOG_INTERVAL {
-            last_log = Instant::now();
-            crate::output::note(format_args!("[{secs:.0} s] solving: {message}"))?;
-        }
-        bar.set_message(message);
+        progress.set(
+            (done * 1000.0) as u64,
+            1000,
+            format!(
+                "{} shots, unshot {:.3} %, {:.2} M rays/s, ETA {:.1} s",
+                r.total_shots,
+                r.unshot_fraction * 100.0,
+                r.rays as f64 / secs.max(1e-9) / 1e6,
+                eta
+            ),
+        );
     };
-    bar.finish_and_clear();
+    drop(progress);
     // A light behind a wall or facing out of the scene: everything it emitted escaped and the
     // converged picture is black. Say why instead of leaving it to be guessed.
     let energy = solver.energy();
@@ -538,6 +556,7 @@ mod tests {
             element_size: None,
             crease_angle: Some(0.0),
             sides: Some(1),
+            up: None,
             contacts: None,
             shadow_outlines: None,
             corner_refinement: None,

@@ -1,15 +1,12 @@
 //! `radiosity render`: solve, ray cast from a camera, tone map, write PNG (and linear EXR /
 //! PFM); `radiosity tonemap`: tone map a linear picture again without solving.
 
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
 use std::time::Instant;
 
 use anyhow::Result;
 use clap::{Args, ValueEnum};
 use glam::DVec3;
-use indicatif::{ProgressBar, ProgressStyle};
 use radiosity_core::Camera;
 use radiosity_image::{
     Exposure, Gather, HdrImage, PictureFormat, RenderParams, Renderer, Shading, ToneOperator, ToneParams,
@@ -18,6 +15,7 @@ use radiosity_image::{
 
 use crate::output::{self, Targets, note};
 use crate::prepare::{InputError, SolveOpts, prepare, run_solver};
+use crate::progress::{Progress, spinning};
 
 /// Tone-mapping operator on the command line.
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -140,10 +138,11 @@ pub struct RenderArgs {
     /// many times --shadow-rays, 1 to 64; 1: as many as any pixel.
     #[arg(long, default_value_t = RenderParams::default().penumbra_factor, value_name = "N")]
     pub penumbra_factor: u32,
-    /// Eye position `x,y,z` (default: the scene's `[camera]`, or one framing the scene).
+    /// Eye position `x,y,z`, in the file's coordinates (default: the scene's `[camera]`, or
+    /// one framing the scene).
     #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
     pub camera_position: Option<DVec3>,
-    /// Point looked at, `x,y,z`.
+    /// Point looked at, `x,y,z`, in the file's coordinates.
     #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
     pub look_at: Option<DVec3>,
     /// Vertical field of view, degrees, in (0, 180).
@@ -194,46 +193,6 @@ fn input(msg: String) -> anyhow::Error {
     InputError(msg).into()
 }
 
-/// Progress of a per-row job on stderr: a bar on a terminal, otherwise a line every
-/// [`LOG_INTERVAL`](crate::prepare::LOG_INTERVAL).
-struct RowProgress {
-    bar: ProgressBar,
-    what: &'static str,
-    /// Rows done and the last log line's time, when stderr is not a terminal.
-    log: Option<Mutex<(u64, Instant)>>,
-}
-
-impl RowProgress {
-    fn new(len: u64, what: &'static str) -> Self {
-        if !std::io::stderr().is_terminal() {
-            let bar = ProgressBar::hidden();
-            bar.set_length(len);
-            return Self { bar, what, log: Some(Mutex::new((0, Instant::now()))) };
-        }
-        let bar = ProgressBar::new(len);
-        let template = format!("{{spinner}} {what} [{{bar:30}}] {{pos}}/{{len}} rows, ETA {{eta}}");
-        bar.set_style(ProgressStyle::with_template(&template).expect("valid template").progress_chars("=> "));
-        Self { bar, what, log: None }
-    }
-
-    /// One more row done (called from the render's worker threads).
-    fn inc(&self) {
-        self.bar.inc(1);
-        if let Some(log) = &self.log
-            && let Ok(mut state) = log.lock()
-        {
-            state.0 += 1;
-            if state.1.elapsed() >= crate::prepare::LOG_INTERVAL {
-                state.1 = Instant::now();
-                // Best effort from a worker thread: a stderr that cannot be written is
-                // reported by the summary line that follows the render.
-                let len = self.bar.length().unwrap_or(0);
-                let _ = note(format_args!("{}: {}/{len} rows", self.what, state.0));
-            }
-        }
-    }
-}
-
 /// Tone maps `radiance` with `tone` and writes it as the picture format `path` names; returns
 /// the exposure used (EV).
 fn write_tonemapped(path: &Path, force: bool, radiance: &HdrImage, tone: &ToneOpts) -> Result<f64> {
@@ -278,9 +237,11 @@ pub fn run(a: RenderArgs) -> Result<()> {
     }
     let prepared = prepare(&a.scene, &a.solve)?;
     let base = prepared.scene.camera_or_framing();
+    // The points given are in the file's frame; the scene has been turned +y up.
+    let turned = |p: DVec3| prepared.up.to_y_up(p);
     let camera = Camera::try_new(
-        a.camera_position.unwrap_or(base.position),
-        a.look_at.unwrap_or(base.look_at),
+        a.camera_position.map_or(base.position, turned),
+        a.look_at.map_or(base.look_at, turned),
         base.up,
         a.fov.unwrap_or(base.fov_y_deg),
     )
@@ -310,14 +271,13 @@ pub fn run(a: RenderArgs) -> Result<()> {
     // as large as the picture's inputs.
     drop(solver);
     let start = Instant::now();
-    let renderer = Renderer::new(prepared.problem.mesh().clone());
-    // The irradiance cache is gathered before the first row: say so, and keep the spinner
-    // turning meanwhile, so a long gather does not look like a hang.
+    let renderer = spinning("preparing the renderer", || Renderer::new(prepared.problem.mesh().clone()));
+    // The irradiance cache is gathered before the first row: say so, and keep the line
+    // ticking meanwhile, so a long gather does not look like a hang.
     let what = if params.gather == Gather::Full { "rendering (irradiance cache first)" } else { "rendering" };
-    let progress = RowProgress::new(u64::from(params.height), what);
-    progress.bar.enable_steady_tick(std::time::Duration::from_millis(120));
+    let progress = Progress::bar(what, u64::from(params.height), "rows");
     let rendering = renderer.render_with_progress(&solution, &camera, &params, &|| progress.inc())?;
-    progress.bar.finish_and_clear();
+    drop(progress);
     let render_secs = start.elapsed().as_secs_f64();
 
     note(format_args!(

@@ -3,22 +3,22 @@
 //! their difference in per cent and in standard errors; and the reference picture behind
 //! `render --reference`.
 
-use std::io::IsTerminal;
 use std::sync::Arc;
 use std::time::Duration;
 
 use anyhow::Result;
 use clap::Args;
-use indicatif::{ProgressBar, ProgressStyle};
 use radiosity_core::random::Rng;
 use radiosity_core::{Camera, Mesh, Rgb};
 use radiosity_image::HdrImage;
-use radiosity_reference::{Estimate, EstimateParams, PathBudget, PictureParams, Progress, Reference, Region};
+use radiosity_reference::{Estimate, EstimateParams, PathBudget, PictureParams, Reference, Region};
 use radiosity_solver::{ObjectRadiosity, Problem};
 use serde_json::{Value, json};
 
+use crate::interrupt::Interrupted;
 use crate::output::{Targets, write_report};
 use crate::prepare::{InputError, Prepared, SolveOpts, prepare, run_solver};
+use crate::progress::{Progress, spinning};
 
 /// Arguments of `radiosity verify`.
 #[derive(Args)]
@@ -26,11 +26,15 @@ pub struct VerifyArgs {
     /// The scene to load: see [`SCENE_HELP`](crate::prepare::SCENE_HELP).
     #[arg(help = crate::prepare::SCENE_HELP)]
     pub scene: String,
-    /// Paths per object for the reference (a fixed count); default: as many as it takes to
-    /// bring every channel's standard error to --stderr-target of its mean (at most 2^26).
-    /// `--time-limit S` (a solve option) also stops the reference after S seconds.
+    /// Paths per object for the reference (a fixed count, not cut short by a default time
+    /// budget); default: as many as it takes to bring every channel's standard error to
+    /// --stderr-target of its mean (at most 2^26), within --reference-time.
     #[arg(long)]
     pub paths: Option<u64>,
+    /// Most seconds for the reference, which then reports the precision it reached [default:
+    /// --time-limit when given, else 120 without --paths, else none].
+    #[arg(long, allow_negative_numbers = true, value_name = "SECONDS")]
+    pub reference_time: Option<f64>,
     /// Standard error to reach, relative to the mean, when --paths is not given.
     #[arg(long, default_value_t = 0.001, value_name = "FRACTION")]
     pub stderr_target: f64,
@@ -117,28 +121,27 @@ pub(crate) fn over_whole_area(mut objects: Vec<ObjectRadiosity>, hidden: &[f64])
     objects
 }
 
-/// A progress bar for the reference on stderr when it is a terminal.
-pub(crate) fn reference_bar(what: &str) -> ProgressBar {
-    if !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(1);
-    let template = format!("{{spinner}} {what} [{{bar:30}}] {{msg}}");
-    bar.set_style(ProgressStyle::with_template(&template).expect("valid template").progress_chars("=> "));
-    bar
+/// The reference's progress display ([`report_progress`] feeds it).
+pub(crate) fn reference_progress(what: &str) -> Progress {
+    Progress::bar(what, 0, "")
 }
 
-/// Shows the reference's paths done, its rate and time on `bar`.
-pub(crate) fn report_progress(bar: &ProgressBar, p: Progress) {
-    bar.set_length(p.paths_planned.max(1));
-    bar.set_position(p.paths_done);
+/// Shows the reference's paths done of those planned, its rate and an ETA.
+pub(crate) fn report_progress(progress: &Progress, p: radiosity_reference::Progress) {
     let secs = p.elapsed.as_secs_f64();
-    bar.set_message(format!(
-        "{:.1} M paths, {:.2} M paths/s, {:.0} s",
-        p.paths_done as f64 / 1e6,
-        p.paths_done as f64 / secs.max(1e-9) / 1e6,
-        secs
-    ));
+    let rate = p.paths_done as f64 / secs.max(1e-9);
+    // An adaptive estimate plans round by round: the ETA is to the end of this round.
+    let eta = (p.paths_planned.saturating_sub(p.paths_done)) as f64 / rate.max(1e-9);
+    progress.set(
+        p.paths_done,
+        p.paths_planned.max(1),
+        format!(
+            "{:.1} of {:.1} M paths planned, {:.2} M paths/s, ETA {eta:.0} s",
+            p.paths_done as f64 / 1e6,
+            p.paths_planned as f64 / 1e6,
+            rate / 1e6
+        ),
+    );
 }
 
 /// Says what the reference ran (paths, time, whether its time limit stopped it) and pairs
@@ -149,20 +152,43 @@ pub(crate) fn report_progress(bar: &ProgressBar, p: Progress) {
 pub(crate) fn compare_objects(
     estimates: &radiosity_reference::Estimates,
     solved: &[radiosity_solver::ObjectRadiosity],
+    interrupted: bool,
 ) -> Result<Vec<Comparison>> {
     let secs = estimates.elapsed.as_secs_f64();
+    let stopped = match (interrupted, estimates.timed_out) {
+        (true, _) => ", stopped by Ctrl-C",
+        (false, true) => ", stopped by its time budget",
+        (false, false) => "",
+    };
     crate::output::note(format_args!(
-        "reference: {:.1} M paths in {:.1} s ({:.2} M paths/s){}",
+        "reference: {:.1} M paths in {:.1} s ({:.2} M paths/s){stopped}; {}",
         estimates.paths as f64 / 1e6,
         secs,
         estimates.paths as f64 / secs.max(1e-9) / 1e6,
-        if estimates.timed_out { ", stopped by the time limit" } else { "" }
+        precision(estimates)
     ))?;
     Ok(solved
         .iter()
         .zip(&estimates.objects)
         .map(|(s, r)| Comparison { solve: s.radiosity, reference: r.estimate })
         .collect())
+}
+
+/// How precise the reference got: the largest and the median standard error of the lit
+/// objects' luminance, relative to it.
+fn precision(estimates: &radiosity_reference::Estimates) -> String {
+    let errors: Vec<(f64, &str)> = estimates
+        .objects
+        .iter()
+        .filter(|o| o.estimate.luminance > 0.0)
+        .map(|o| (o.estimate.luminance_stderr / o.estimate.luminance * 100.0, o.name.as_str()))
+        .collect();
+    let Some(&(worst, name)) = errors.iter().max_by(|a, b| a.0.total_cmp(&b.0)) else {
+        return "no object has light to estimate".into();
+    };
+    let median = median(errors.iter().map(|e| e.0).collect()).unwrap_or(worst);
+    let worst = if worst.is_finite() { format!("{worst:.2} %") } else { "unknown (too few paths)".into() };
+    format!("standard error at most {worst} ({name}), median {median:.2} %")
 }
 
 /// One solve value against its reference estimate.
@@ -250,11 +276,29 @@ pub fn run(a: VerifyArgs) -> Result<()> {
     if a.element_paths == 0 {
         return Err(input("--element-paths must be at least 1".into()));
     }
+    let reference_time = match (a.reference_time, a.solve.time_limit, a.paths) {
+        (Some(t), _, _) => {
+            if !(t > 0.0 && t <= radiosity_core::MAX_TIME_LIMIT_SECONDS) {
+                return Err(input(format!(
+                    "--reference-time must be a number of seconds in (0, {:e}], got {t}",
+                    radiosity_core::MAX_TIME_LIMIT_SECONDS
+                )));
+            }
+            Some(t)
+        }
+        // Checked with the solve options.
+        (None, Some(t), _) => Some(t),
+        (None, None, None) => Some(DEFAULT_REFERENCE_SECONDS),
+        // A fixed count asked for is kept whatever it takes: it makes the numbers repeatable.
+        (None, None, Some(_)) => None,
+    };
     if let Some(path) = &a.json
         && path != "-"
     {
         Targets::new(a.force).file(std::path::Path::new(path), "--json")?;
     }
+    // From here a first Ctrl-C stops the step that runs and the table shows what it has.
+    crate::interrupt::catch();
     let mut prepared = prepare(&a.scene, &a.solve)?;
     if let Some(k) = a.solve_reflectance_scale {
         // The same mesh and ray queries, only the reflectances the solver sees are scaled.
@@ -283,19 +327,42 @@ pub fn run(a: VerifyArgs) -> Result<()> {
         stop
     ))?;
 
-    let reference = Reference::new(scene);
+    if crate::interrupt::requested() {
+        return interrupted_solve(&a, &solved, &report);
+    }
+
+    let reference = spinning("preparing the reference", || Reference::new(scene));
     let budget = match a.paths {
         Some(paths) => PathBudget::Fixed { paths },
         None => PathBudget::Adaptive { relative_stderr: a.stderr_target, max_paths: 1 << 26 },
     };
-    let time_limit = a.solve.time_limit.map(Duration::from_secs_f64);
+    let time_limit = reference_time.map(Duration::from_secs_f64);
     let max_reflections = a.reflections.unwrap_or(u32::MAX);
     let params = EstimateParams { budget, seed: a.solve.seed, time_limit, max_reflections };
-    let bar = reference_bar("reference");
-    let estimates = reference.estimate_objects(&params, &|p| report_progress(&bar, p));
-    bar.finish_and_clear();
+    let goal = match a.paths {
+        Some(paths) => format!("{paths} paths per object"),
+        None => format!("every object to {} % standard error", a.stderr_target * 100.0),
+    };
+    let limit = match reference_time {
+        Some(t) if a.reference_time.is_none() && a.solve.time_limit.is_none() => {
+            format!(", at most {t} s (the default budget; --reference-time S for another)")
+        }
+        Some(t) => format!(", at most {t} s"),
+        None => String::new(),
+    };
+    crate::output::note(format_args!(
+        "reference: path tracing {goal}{limit}; Ctrl-C stops it and shows what it has"
+    ))?;
+    let progress = reference_progress("reference");
+    let estimates = reference.estimate_objects_until(
+        &params,
+        &|p| report_progress(&progress, p),
+        &crate::interrupt::requested,
+    );
+    drop(progress);
+    let interrupted = crate::interrupt::requested();
     let ref_secs = estimates.elapsed.as_secs_f64();
-    let rows = compare_objects(&estimates, &solved)?;
+    let rows = compare_objects(&estimates, &solved, interrupted)?;
 
     // The table: luminance for the eye, per-channel differences beside it.
     let mut table = format!(
@@ -338,8 +405,8 @@ pub fn run(a: VerifyArgs) -> Result<()> {
     table.push('\n');
 
     // A sample of elements: local errors (shadow edges, contacts) that object means hide.
-    let element_part = match a.elements {
-        Some(count) if count > 0 => Some(compare_elements(
+    let mut element_part = match a.elements {
+        Some(count) if count > 0 && !crate::interrupt::requested() => Some(compare_elements(
             &reference,
             mesh,
             &solution.element_radiosity,
@@ -350,8 +417,17 @@ pub fn run(a: VerifyArgs) -> Result<()> {
         )?),
         _ => None,
     };
-    if let Some(part) = &element_part {
+    if let Some(part) = &mut element_part {
         table += &part.text;
+        // Centres in the file's frame, as the user's tools show the model.
+        if let Some(elements) = part.json["elements"].as_array_mut() {
+            for e in elements {
+                if let Ok(c) = serde_json::from_value::<[f64; 3]>(e["centre"].take()) {
+                    e["centre"] =
+                        json!(prepared.up.from_y_up(radiosity_core::glam::DVec3::from_array(c)).to_array());
+                }
+            }
+        }
     }
     if a.json.as_deref() != Some("-") {
         let mut out = std::io::stdout().lock();
@@ -400,6 +476,8 @@ pub fn run(a: VerifyArgs) -> Result<()> {
             "timed_out": estimates.timed_out,
             "seed": a.solve.seed,
             "reflections": a.reflections,
+            "reference_time_limit": reference_time,
+            "interrupted": crate::interrupt::requested(),
             "objects": objects,
             "summary": all.json(&summary),
         });
@@ -412,7 +490,37 @@ pub fn run(a: VerifyArgs) -> Result<()> {
         }
         write_report(path, a.force, &serde_json::to_string_pretty(&doc)?)?;
     }
+    if crate::interrupt::requested() {
+        return Err(Interrupted("the reference stopped early; the table holds what it had".into()).into());
+    }
     Ok(())
+}
+
+/// Seconds the reference takes at most by default: with a solve of a few minutes, a
+/// 100 k-triangle room is verified within five, and every object of such a room gets under
+/// a few tenths of a per cent of standard error.
+pub const DEFAULT_REFERENCE_SECONDS: f64 = 120.0;
+
+/// What `verify` prints when Ctrl-C stopped the solve: the solve's means so far, no
+/// reference.
+fn interrupted_solve(
+    a: &VerifyArgs,
+    solved: &[ObjectRadiosity],
+    report: &radiosity_solver::StepReport,
+) -> Result<()> {
+    let mut table = format!("{:<20} {:>10} {:>11}\n", "object", "area", "solve Y");
+    for o in solved {
+        table += &format!("{:<20} {:>10.4e} {:>11.5e}\n", o.name, o.area, o.radiosity.luminance());
+    }
+    if a.json.as_deref() != Some("-") {
+        crate::output::stdout(&table)?;
+    }
+    Err(Interrupted(format!(
+        "the solve stopped at {} shots (unshot {:.3} %); the reference was not run",
+        report.total_shots,
+        report.unshot_fraction * 100.0
+    ))
+    .into())
 }
 
 /// `(index, difference %, difference σ)` of every row with light to compare: objects that
@@ -529,9 +637,14 @@ fn compare_elements(
         max_reflections,
         ..EstimateParams::default()
     };
-    let bar = reference_bar("elements");
-    let estimates = reference.estimate_regions(&regions, &params, &|p| report_progress(&bar, p))?;
-    bar.finish_and_clear();
+    let progress = reference_progress("elements");
+    let estimates = reference.estimate_regions_until(
+        &regions,
+        &params,
+        &|p| report_progress(&progress, p),
+        &crate::interrupt::requested,
+    )?;
+    drop(progress);
 
     let rows: Vec<(usize, Comparison)> = sample
         .iter()
@@ -616,20 +729,10 @@ pub fn reference_picture(
 ) -> Result<HdrImage> {
     let reference = Reference::new(&prepared.scene);
     let params = PictureParams { width, height, samples_per_pixel, seed };
-    let bar = if std::io::stderr().is_terminal() {
-        let bar = ProgressBar::new(u64::from(height));
-        bar.set_style(
-            ProgressStyle::with_template("{spinner} reference [{bar:30}] {pos}/{len} rows, ETA {eta}")
-                .expect("valid template")
-                .progress_chars("=> "),
-        );
-        bar
-    } else {
-        ProgressBar::hidden()
-    };
     let start = std::time::Instant::now();
-    let picture = reference.render(camera, &params, &|| bar.inc(1)).map_err(|e| input(e.to_string()))?;
-    bar.finish_and_clear();
+    let progress = Progress::bar("reference", u64::from(height), "rows");
+    let picture = reference.render(camera, &params, &|| progress.inc()).map_err(|e| input(e.to_string()))?;
+    drop(progress);
     // The noise floor of any comparison with this picture: the pixels' relative standard
     // error in luminance (bounded by the channels' own).
     let (mut sum, mut count) = (0.0, 0usize);

@@ -98,7 +98,7 @@ pub fn run(a: ViewArgs) -> Result<()> {
     let o = &a.solve;
     // The same option rules as every solving command, without meshing here: the viewer
     // meshes on its worker so the window opens at once.
-    let Settings { scene, mesh_params, solver_params } = settings(&a.scene, o)?;
+    let Settings { scene, mesh_params, solver_params, up } = settings(&a.scene, o)?;
     if let Some(path) = &a.screenshot {
         Targets::new(a.force).file(path, "--screenshot")?;
     }
@@ -106,6 +106,7 @@ pub fn run(a: ViewArgs) -> Result<()> {
         return Err(input(format!("the window must be at least 200×150, got {}×{}", a.width, a.height)));
     }
     let mut options = radiosity_viewer::ViewerOptions::new(scene, &a.scene);
+    options.up = up;
     options.light_scale = o.light_scale;
     options.mesh_params = Some(mesh_params);
     options.solver_params = solver_params;

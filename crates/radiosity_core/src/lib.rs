@@ -21,6 +21,7 @@ mod scene;
 mod sealed;
 mod shadows;
 mod srgb;
+mod up;
 
 pub use canonical::{
     cornell_box, furnace_box, furnace_sphere, two_plates, two_sided_plate, unit_cube_floor_light,
@@ -43,6 +44,7 @@ pub use scene::{
 };
 pub use sealed::{MAX_HOLE_SHARE, Sealed, seal_closed_objects};
 pub use srgb::{encode_srgb, srgb_decode, srgb_encode};
+pub use up::{UpAxis, UpGuess};
 
 /// Re-export of the vector maths used in the public API.
 pub use glam;

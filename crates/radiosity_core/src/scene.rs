@@ -335,6 +335,17 @@ impl Polygon {
     pub fn try_map(&self, f: impl Fn(DVec3) -> DVec3) -> Result<Self, SceneError> {
         Self::try_new(self.vertices.iter().map(|&v| f(v)).collect())
     }
+
+    /// The polygon with its vertices and normal mapped by `f`, a rotation that only swaps
+    /// and negates coordinates ([`crate::UpAxis::to_y_up`]): exact, so the area and the
+    /// validity need no new check (and a big model no second validation).
+    pub(crate) fn mapped_exactly(&self, f: &impl Fn(DVec3) -> DVec3) -> Self {
+        Self {
+            vertices: self.vertices.iter().map(|&v| f(v)).collect(),
+            normal: f(self.normal),
+            area: self.area,
+        }
+    }
 }
 
 /// An indexed mesh of planar convex faces (triangles or larger polygons), as read from a model
@@ -391,6 +402,15 @@ impl PolygonMesh {
             positions: self.positions.clone(),
             faces,
             polygons: self.polygons.iter().map(Polygon::flipped).collect(),
+        }
+    }
+
+    /// The mesh with its positions and faces mapped by `f` ([`Polygon::mapped_exactly`]).
+    pub(crate) fn mapped_exactly(&self, f: &impl Fn(DVec3) -> DVec3) -> Self {
+        Self {
+            positions: self.positions.iter().map(|&p| f(p)).collect(),
+            faces: self.faces.clone(),
+            polygons: self.polygons.iter().map(|p| p.mapped_exactly(f)).collect(),
         }
     }
 

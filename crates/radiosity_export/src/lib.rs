@@ -16,6 +16,11 @@
 //!   face list that mixes triangles and quads.
 //! * Lightmaps: see [`write_lightmaps`].
 //!
+//! Frames: the mesh is in the renderer's +y-up frame. glTF is +y up by its specification and
+//! is written as the mesh is; PLY and the lightmaps' OBJ have no convention, and are written
+//! back in the frame of the model file ([`UpAxis::from_y_up`]), so a lit z-up building model
+//! lies over its original in the tool it came from.
+//!
 //! Scene files come in through `radiosity_io`; lit meshes go out here, so the scene loader
 //! needs neither the solver nor the picture-file formats.
 #![warn(missing_docs)]
@@ -25,7 +30,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use radiosity_core::glam::DVec3;
-use radiosity_core::{Mesh, Rgb, encode_srgb, unique_names};
+use radiosity_core::{Mesh, Rgb, UpAxis, encode_srgb, unique_names};
 use radiosity_image::{HdrImage, RenderError, RenderParams, Renderer, ToneOperator, ToneParams, tone_map};
 use radiosity_solver::Solution;
 use rayon::prelude::*;
@@ -244,7 +249,11 @@ pub fn glb_bytes(mesh: &Mesh, solution: &Solution, mode: VertexColours) -> Vec<u
 /// A binary little-endian PLY of the element mesh: display colour as `uchar` and linear
 /// radiosity as `float` per vertex; `display` sets the tone mapping of the former. Faces are
 /// triangles only ([`Mesh::element_triangles`], the split the glTF output uses).
-pub fn ply_bytes(mesh: &Mesh, solution: &Solution, display: ToneParams) -> Vec<u8> {
+///
+/// Positions are written in the frame of a file whose up axis is `up` ([`UpAxis::from_y_up`]):
+/// PLY has no up convention, so the lit mesh lies over the model it came from in the tool the
+/// model came from.
+pub fn ply_bytes(mesh: &Mesh, solution: &Solution, display: ToneParams, up: UpAxis) -> Vec<u8> {
     let shown = vertex_colours(solution, VertexColours::Display(display));
     let mut header = String::new();
     let _ = write!(
@@ -263,7 +272,7 @@ pub fn ply_bytes(mesh: &Mesh, solution: &Solution, display: ToneParams) -> Vec<u
     );
     let mut out = header.into_bytes();
     for (v, p) in mesh.positions.iter().enumerate() {
-        for c in p.as_vec3().to_array() {
+        for c in up.from_y_up(*p).as_vec3().to_array() {
             out.extend_from_slice(&c.to_le_bytes());
         }
         out.extend_from_slice(&encode_srgb(shown[v]));
@@ -428,7 +437,8 @@ pub fn file_stem_for(name: &str) -> String {
 
 /// Writes lightmaps ([`lightmaps_with`] `texels`) into `dir` as `<object>.exr` (linear radiosity), with `lightmapped.obj`
 /// and `lightmapped.mtl` mapping them (`map_Kd`, texture coordinates per element corner) so a
-/// modelling tool shows the baked light. Returns the paths written.
+/// modelling tool shows the baked light, its positions in the frame of a file whose up axis is
+/// `up` (as [`ply_bytes`]). Returns the paths written.
 ///
 /// # Errors
 /// The folder or a file cannot be written.
@@ -437,6 +447,7 @@ pub fn write_lightmaps(
     mesh: &Mesh,
     solution: &Solution,
     texels: Texels<'_>,
+    up: UpAxis,
 ) -> Result<Vec<PathBuf>, String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: cannot create the folder: {e}", dir.display()))?;
     let maps = lightmaps_with(mesh, solution, texels).map_err(|e| e.to_string())?;
@@ -457,7 +468,7 @@ pub fn write_lightmaps(
         for (e, uvs) in &map.charts {
             let el = &mesh.elements[*e];
             for (&v, uv) in el.vertex_indices().iter().zip(uvs) {
-                let p = mesh.positions[v as usize];
+                let p = up.from_y_up(mesh.positions[v as usize]);
                 let _ = writeln!(obj, "v {} {} {}\nvt {} {}", p.x, p.y, p.z, uv[0], 1.0 - uv[1]);
             }
             let corners: Vec<String> =

@@ -121,7 +121,7 @@ fn glb_and_gltf_reload_with_the_same_vertices_and_colours() {
 fn ply_holds_display_colours_and_radiosity() {
     let (mesh, solution) = solved();
     let tone = ToneParams::new(0.0, ToneOperator::Linear);
-    let bytes = ply_bytes(&mesh, &solution, tone);
+    let bytes = ply_bytes(&mesh, &solution, tone, radiosity_core::UpAxis::Y);
     let end = bytes.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
     let header = std::str::from_utf8(&bytes[..end]).unwrap();
     assert!(header.starts_with("ply\nformat binary_little_endian 1.0\n"));
@@ -175,7 +175,9 @@ fn lightmaps_hold_vertex_radiosity_at_chart_corners() {
         }
     }
     let dir = tempfile::tempdir().unwrap();
-    let written = write_lightmaps(dir.path(), &mesh, &solution, Texels::Interpolated).unwrap();
+    let written =
+        write_lightmaps(dir.path(), &mesh, &solution, Texels::Interpolated, radiosity_core::UpAxis::Y)
+            .unwrap();
     assert_eq!(written.len(), mesh.object_names.len() + 2);
     let floor = radiosity_image::read_exr(&dir.path().join("floor.exr")).unwrap();
     assert_eq!(floor.width(), maps[0].image.width());

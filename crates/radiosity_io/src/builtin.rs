@@ -4,7 +4,9 @@
 
 use std::path::Path;
 
-use crate::{LoadError, LoadOptions, LoadedScene, ModelFormat, Scene, load_scene_with, parse_scene};
+use crate::{
+    LoadError, LoadOptions, LoadedScene, ModelFormat, Scene, load_scene_with, parse_scene, parse_scene_with,
+};
 
 /// Built-in scene names with the origin shown in messages and the embedded text.
 const FILES: &[(&str, &str, &str)] = &[
@@ -52,8 +54,13 @@ pub fn resolve_scene_with(arg: &str, opts: &LoadOptions) -> Result<LoadedScene, 
     if present || arg.ends_with(".toml") || ModelFormat::from_path(path).is_some() {
         return load_scene_with(path, opts);
     }
-    builtin_scene(arg)
-        .map(|scene| LoadedScene { scene, warnings: Vec::new(), no_light: None })
+    // Parsed with the options, so that an up axis given for a built-in scene turns it too.
+    FILES
+        .iter()
+        .find(|(n, _, _)| *n == arg)
+        .map(|(_, origin, text)| {
+            parse_scene_with(text, origin, opts).expect("built-in scenes are valid (tested)")
+        })
         .ok_or_else(|| LoadError::UnknownScene { name: arg.to_owned(), known: BUILTIN_SCENES.join(", ") })
 }
 

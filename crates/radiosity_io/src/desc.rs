@@ -66,6 +66,9 @@ fn faces_opt<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Spanned<Vec<Face>
 pub(crate) struct SceneDesc {
     /// Display name; defaults to the file stem.
     pub(crate) name: Option<String>,
+    /// The file's up axis: `"x"`, `"y"` (default), `"z"`, `"-x"`, `"-y"` or `"-z"`; every
+    /// coordinate of the file is in that frame.
+    pub(crate) up: Option<Spanned<String>>,
     /// `[camera]`; without it the renderer frames the scene.
     pub(crate) camera: Option<Spanned<CameraDesc>>,
     /// `[[material]]` entries.
@@ -90,7 +93,7 @@ pub(crate) struct CameraDesc {
     /// Point looked at.
     #[serde(deserialize_with = "point")]
     pub(crate) look_at: Point,
-    /// Up direction; default `[0, 1, 0]`.
+    /// Up direction; default the file's up axis (`[0, 1, 0]` without one).
     #[serde(default, deserialize_with = "point_opt")]
     pub(crate) up: Option<Point>,
     /// Vertical field of view in degrees, in (0, 180); default 45.

@@ -13,7 +13,7 @@ use std::path::Path;
 use radiosity_core::glam::DVec3;
 use radiosity_core::{
     Camera, Facing, Material, MeshParams, Object, Polygon, Rgb, Scene, SceneError, Shape, Sides,
-    SolverSettings, Sphere, box_faces,
+    SolverSettings, Sphere, UpAxis, box_faces,
 };
 use toml::Spanned;
 
@@ -24,8 +24,6 @@ use crate::desc::{
 use crate::locate::Locator;
 use crate::model::{ModelFormat, Transform, load_model, model_error};
 
-/// Camera `up` when the file gives none.
-const DEFAULT_UP: [f64; 3] = [0.0, 1.0, 0.0];
 /// Camera vertical field of view in degrees when the file gives none.
 const DEFAULT_FOV_Y_DEG: f64 = 45.0;
 
@@ -55,6 +53,12 @@ pub struct LoadedScene {
     /// strict load gives, for a caller that describes the scene to report, or one that
     /// solves it to return once the warnings (which may explain it) are out.
     pub no_light: Option<LoadError>,
+    /// The up axis the scene was declared with ([`LoadOptions::up`], else a scene file's
+    /// `up` key), already applied: the scene is in the renderer's +y-up frame, and
+    /// [`UpAxis::from_y_up`] takes its coordinates back to the file's. `None` when nothing
+    /// declared one and the file was taken as +y up (OBJ has no convention; glTF's is +y),
+    /// which is when [`Scene::likely_up`] is worth asking.
+    pub up: Option<UpAxis>,
 }
 
 /// How a scene is loaded. The default is what a solve needs: every rule, and the sides that
@@ -69,6 +73,9 @@ pub struct LoadOptions {
     /// Accept a scene in which nothing emits (a solve of it would be black), setting
     /// [`LoadedScene::no_light`] instead of failing; every other rule still applies.
     pub allow_no_light: bool,
+    /// The up axis of the file, over a scene file's `up` key; `None`: the key, else +y. The
+    /// loaded scene is turned so that this axis is +y ([`Scene::rotate_to_y_up`]).
+    pub up: Option<UpAxis>,
 }
 
 /// Whether the back face of `sides` emits.
@@ -147,17 +154,19 @@ fn scene_from_model(path: &Path, opts: &LoadOptions) -> Result<LoadedScene, Load
     let lit = objects.iter().any(|o| model.materials.get(o.material).is_some_and(Material::is_emitter));
     if opts.allow_no_light {
         // The caller shows the warnings before it reports or returns the missing light.
-        let scene =
+        let mut scene =
             Scene::try_new_unlit(&name, model.camera, model.materials, objects).map_err(|e| error(e, ""))?;
+        scene.rotate_to_y_up(opts.up.unwrap_or_default());
         let no_light = (!lit).then(|| error(SceneError::NoEmitter, ""));
-        return Ok(LoadedScene { scene, warnings: model.warnings, no_light });
+        return Ok(LoadedScene { scene, warnings: model.warnings, no_light, up: opts.up });
     }
     // What the loader noticed (a missing MTL, an unknown material) often explains the error,
     // and would otherwise be lost with the scene.
     let notes: String = model.warnings.iter().map(|w| format!(" (warning: {w})")).collect();
-    let scene =
+    let mut scene =
         Scene::try_new(&name, model.camera, model.materials, objects).map_err(|e| error(e, &notes))?;
-    Ok(LoadedScene { scene, warnings: model.warnings, no_light: None })
+    scene.rotate_to_y_up(opts.up.unwrap_or_default());
+    Ok(LoadedScene { scene, warnings: model.warnings, no_light: None, up: opts.up })
 }
 
 /// Parses and validates the text of a scene file, with the loader's warnings (from the model
@@ -212,7 +221,11 @@ pub fn parse_scene_with(text: &str, origin: &str, opts: &LoadOptions) -> Result<
         }
         origins.resize(objects.len(), i);
     }
-    let camera = desc.camera.as_ref().map(|c| camera(&loc, c)).transpose()?;
+    let up = match opts.up {
+        Some(up) => Some(up),
+        None => desc.up.as_ref().map(|u| up_axis(&loc, u)).transpose()?,
+    };
+    let camera = desc.camera.as_ref().map(|c| camera(&loc, c, up.unwrap_or_default())).transpose()?;
     let mesh = desc.mesh.as_ref().map(|m| mesh_params(&loc, m)).transpose()?;
     let solver = desc.solver.as_ref().map(|s| solver_settings(&loc, s)).transpose()?.unwrap_or_default();
     let name = desc.name.clone().unwrap_or_else(|| {
@@ -256,8 +269,10 @@ pub fn parse_scene_with(text: &str, origin: &str, opts: &LoadOptions) -> Result<
     scene.mesh = mesh;
     scene.solver = solver;
     check_element_count(&loc, &desc, &scene, &origins)?;
+    // Last, once every error has pointed at the file's own coordinates.
+    scene.rotate_to_y_up(up.unwrap_or_default());
     let no_light = (!lit).then(|| scene_error(SceneError::NoEmitter));
-    Ok(LoadedScene { scene, warnings, no_light })
+    Ok(LoadedScene { scene, warnings, no_light, up })
 }
 
 /// The `[[material]]` entries of a file with the sides each one gives (`None`: it says
@@ -371,11 +386,20 @@ fn materials(
     Ok((materials, sides))
 }
 
-fn camera(loc: &Locator, c: &Spanned<CameraDesc>) -> Result<Camera, LoadError> {
+/// The file's `up` key, or an error at its value listing the accepted names.
+fn up_axis(loc: &Locator, u: &Spanned<String>) -> Result<UpAxis, LoadError> {
+    UpAxis::parse(u.get_ref()).ok_or_else(|| {
+        let names: Vec<String> = UpAxis::NAMES.iter().map(|n| format!("\"{n}\"")).collect();
+        loc.at(u.span(), "up", format!("expected one of {}, got {:?}", names.join(", "), u.get_ref()))
+    })
+}
+
+/// The `[camera]` of a file whose up axis is `file_up` (the default of its `up`).
+fn camera(loc: &Locator, c: &Spanned<CameraDesc>, file_up: UpAxis) -> Result<Camera, LoadError> {
     let d = c.get_ref();
     let position = *d.position.get_ref();
     let look_at = *d.look_at.get_ref();
-    let up = d.up.as_ref().map_or(DEFAULT_UP, |u| *u.get_ref());
+    let up = d.up.as_ref().map_or(file_up.direction().to_array(), |u| *u.get_ref());
     let fov = d.fov_y_deg.as_ref().map_or(DEFAULT_FOV_Y_DEG, |f| *f.get_ref());
     Camera::try_new(v3(position), v3(look_at), v3(up), fov).map_err(|e| {
         // The core says what is wrong; name the field it is about, checking in the core's
@@ -392,13 +416,14 @@ fn camera(loc: &Locator, c: &Spanned<CameraDesc>) -> Result<Camera, LoadError> {
         } else {
             "fov_y_deg"
         };
+        let default_up = format!(
+            "; `up` defaults to {:?} (the file's up axis): give another when looking straight up or down",
+            file_up.direction().to_array().map(|c| c as i32)
+        );
         let (span, note) = match field {
             "position" => (d.position.span(), ""),
             "look_at" => (d.look_at.span(), ""),
-            "up" => d.up.as_ref().map_or_else(
-                || (c.span(), "; `up` defaults to [0, 1, 0]: give another when looking straight up or down"),
-                |u| (u.span(), ""),
-            ),
+            "up" => d.up.as_ref().map_or_else(|| (c.span(), default_up.as_str()), |u| (u.span(), "")),
             _ => d.fov_y_deg.as_ref().map_or_else(|| (c.span(), ""), |f| (f.span(), "")),
         };
         loc.at(span, format!("camera.{field}"), format!("{e}{note}"))

@@ -170,12 +170,15 @@ fn batch(g: &Geometry, target: &Target, seed: u64, task: u64, index: u64, max_re
 }
 
 /// Estimates every target: rounds of batches run in parallel; per target the batches are
-/// merged in index order, so the numbers do not depend on the thread count.
+/// merged in index order, so the numbers do not depend on the thread count. The time limit
+/// and `stop` (asked before each batch) end it early, with what the batches done so far
+/// give; the flag returned says so.
 pub(crate) fn estimate_targets(
     g: &Geometry,
     targets: &[(Target, u64)],
     params: &EstimateParams,
     progress: &(dyn Fn(Progress) + Sync),
+    stop: &(dyn Fn() -> bool + Sync),
 ) -> (Vec<Moments>, bool) {
     let start = Instant::now();
     let deadline = params.time_limit.map(|t| start + t);
@@ -228,7 +231,7 @@ pub(crate) fn estimate_targets(
         let results: Vec<Option<Moments>> = work
             .par_iter()
             .map(|&(i, b)| {
-                if deadline.is_some_and(|d| Instant::now() >= d) {
+                if deadline.is_some_and(|d| Instant::now() >= d) || stop() {
                     return None;
                 }
                 let (target, task) = &targets[i];

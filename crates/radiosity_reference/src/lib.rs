@@ -227,11 +227,23 @@ impl Reference {
         params: &EstimateParams,
         progress: &(dyn Fn(Progress) + Sync),
     ) -> Estimates {
+        self.estimate_objects_until(params, progress, &|| false)
+    }
+
+    /// [`Reference::estimate_objects`], ended early once `stop` says so (asked before each
+    /// batch of paths, from any worker thread: a user's Ctrl-C), with what the batches done
+    /// by then give; [`Estimates::timed_out`] is then set, as by the time limit.
+    pub fn estimate_objects_until(
+        &self,
+        params: &EstimateParams,
+        progress: &(dyn Fn(Progress) + Sync),
+        stop: &(dyn Fn() -> bool + Sync),
+    ) -> Estimates {
         let start = Instant::now();
         let targets: Vec<(Target, u64)> = (0..self.geometry.objects.len() as u32)
             .map(|o| (Target::Object(o), OBJECT_TASK | u64::from(o)))
             .collect();
-        let (moments, timed_out) = estimate_targets(&self.geometry, &targets, params, progress);
+        let (moments, timed_out) = estimate_targets(&self.geometry, &targets, params, progress, stop);
         let objects = self
             .geometry
             .objects
@@ -252,6 +264,21 @@ impl Reference {
         params: &EstimateParams,
         progress: &(dyn Fn(Progress) + Sync),
     ) -> Result<Vec<Estimate>, ReferenceError> {
+        self.estimate_regions_until(regions, params, progress, &|| false)
+    }
+
+    /// [`Reference::estimate_regions`], ended early once `stop` says so (as
+    /// [`Reference::estimate_objects_until`]); a region no batch reached has no paths.
+    ///
+    /// # Errors
+    /// As [`Reference::estimate_regions`].
+    pub fn estimate_regions_until(
+        &self,
+        regions: &[Region],
+        params: &EstimateParams,
+        progress: &(dyn Fn(Progress) + Sync),
+        stop: &(dyn Fn() -> bool + Sync),
+    ) -> Result<Vec<Estimate>, ReferenceError> {
         let prepared = regions
             .iter()
             .enumerate()
@@ -261,7 +288,7 @@ impl Reference {
             .collect::<Result<Vec<_>, _>>()?;
         let targets: Vec<(Target, u64)> =
             prepared.iter().enumerate().map(|(i, r)| (Target::Region(r), REGION_TASK | i as u64)).collect();
-        let (moments, _) = estimate_targets(&self.geometry, &targets, params, progress);
+        let (moments, _) = estimate_targets(&self.geometry, &targets, params, progress, stop);
         Ok(moments.iter().map(|m| m.estimate()).collect())
     }
 

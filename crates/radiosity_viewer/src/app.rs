@@ -14,7 +14,7 @@ use std::time::{Duration, Instant};
 use eframe::egui::{self, Color32, Key, Pos2, Rect, Sense, Vec2};
 use eframe::{egui_wgpu, wgpu};
 use radiosity_core::Camera;
-use radiosity_core::{MeshParams, Scene};
+use radiosity_core::{MeshParams, Scene, UpAxis};
 use radiosity_image::{Exposure, Gather, SrgbImage, ToneOperator, ToneParams, tone_map_image};
 
 use crate::ViewerOptions;
@@ -129,6 +129,9 @@ pub struct ViewerApp {
     /// The automatic exposure as it adapts, stops.
     auto_ev: Option<f64>,
     subdivision: Subdivision,
+    /// The up axis of the file the scene came from, as the scene is now turned (the panel
+    /// changes it: the scene turns and the solve restarts).
+    up: UpAxis,
     open_text: String,
     loading: Option<(String, Receiver<Result<Scene, String>>)>,
     load_error: Option<String>,
@@ -191,6 +194,7 @@ impl ViewerApp {
         // is made for egui's target format and sample count.
         let renderer = SceneRenderer::new(&render_state.device, render_state.target_format, options.samples);
         render_state.renderer.write().callback_resources.insert(renderer);
+        let up = options.up;
         let scene = Arc::new(options.scene);
         let mesh_params = options.mesh_params.unwrap_or_else(|| scene.mesh_params());
         let job = SolveJob {
@@ -233,6 +237,7 @@ impl ViewerApp {
                 element_size: job.mesh_params.element_size,
                 adaptive_levels: job.mesh_params.adaptive_levels,
             },
+            up,
             open_text: String::new(),
             job,
             shown: None,
@@ -287,6 +292,21 @@ impl ViewerApp {
         }
     }
 
+    /// Turns the scene as read from a file whose up axis is `up` instead of the current one,
+    /// and solves it again: a z-up building model read +y up lies on its side until then.
+    fn set_up(&mut self, up: UpAxis) {
+        if up == self.up {
+            return;
+        }
+        let mut scene = Scene::clone(&self.job.scene);
+        scene.rotate_from_y_up(self.up);
+        scene.rotate_to_y_up(up);
+        self.up = up;
+        // A new scene: the camera frames it afresh once its first snapshot arrives.
+        let job = SolveJob { scene: Arc::new(scene), ..self.job.clone() };
+        self.restart_with(job);
+    }
+
     /// Loads a scene file (or built-in name) on a helper thread; the old scene stays until it
     /// has loaded and meshed.
     fn open(&mut self, ctx: &egui::Context, arg: String) {
@@ -328,6 +348,8 @@ impl ViewerApp {
                     solver_params.unshot_threshold = t;
                 }
                 let job = SolveJob { label: arg, scene, light_scale: 1.0, mesh_params, solver_params };
+                // Files opened here are read +y up; the panel turns them.
+                self.up = UpAxis::Y;
                 self.restart_with(job);
                 // A scene just opened is there to be seen lit, whatever the old one was doing.
                 self.worker.resume();
@@ -815,6 +837,17 @@ impl ViewerApp {
         if apply {
             self.apply_subdivision();
         }
+        let mut up = self.up;
+        ui.horizontal(|ui| {
+            egui::ComboBox::from_label("up axis of the file").selected_text(up.as_str()).show_ui(ui, |ui| {
+                for a in UpAxis::ALL {
+                    ui.selectable_value(&mut up, a, a.as_str());
+                }
+            });
+        })
+        .response
+        .on_hover_text("the axis that points up in the model file (z for most building models): the scene turns upright and the solve restarts");
+        self.set_up(up);
         ui.separator();
 
         ui.horizontal(|ui| {

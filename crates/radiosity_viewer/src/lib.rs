@@ -19,7 +19,7 @@ pub mod worker;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
-use radiosity_core::{MeshParams, Scene};
+use radiosity_core::{MeshParams, Scene, UpAxis};
 use radiosity_solver::SolverParams;
 
 pub use app::{KEY_HINT, ViewState};
@@ -33,8 +33,11 @@ pub use worker::{Progress, Snapshot, SolveJob, SolveWorker, Status, WorkerOption
 /// What `radiosity view` opens, and how.
 #[derive(Clone, Debug)]
 pub struct ViewerOptions {
-    /// The scene, before the light scale.
+    /// The scene, before the light scale, turned +y up.
     pub scene: Scene,
+    /// The up axis of the file `scene` was read from (it has been turned by it, see
+    /// [`Scene::rotate_to_y_up`]); the panel's up setting starts here and turns the scene live.
+    pub up: UpAxis,
     /// What the user typed to open it (path or built-in name), shown in the panel.
     pub scene_label: String,
     /// Factor on every emission, > 0.
@@ -79,6 +82,7 @@ impl ViewerOptions {
     pub fn new(scene: Scene, scene_label: &str) -> Self {
         Self {
             scene,
+            up: UpAxis::Y,
             scene_label: scene_label.to_owned(),
             light_scale: 1.0,
             mesh_params: None,
