@@ -451,8 +451,8 @@ fn mesh(scene_arg: &str, settings: Settings, o: &SolveOpts) -> Result<Prepared> 
     // The scene's loader names the line of a mesh over the element limit; one that only the
     // command's options make too large (or a model file's, which has no [mesh]) is named by
     // its file here.
-    let problem = spinning("meshing", || Problem::new(&scene, &mesh_params))
-        .with_context(|| scene_arg.to_owned())?;
+    let problem =
+        spinning("meshing", || Problem::new(&scene, &mesh_params)).with_context(|| scene_arg.to_owned())?;
     Ok(Prepared { scene, problem, params: solver_params, up })
 }
 
