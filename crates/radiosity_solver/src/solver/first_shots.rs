@@ -22,7 +22,7 @@ use super::uneven::NONUNIFORM;
 /// the Cornell box's dark block faces, which see floor and wall patches whose shadowed part
 /// is near them, came out 1.5–1.9 % dark (means over four seeds), every object within 0.86 %
 /// with the spread fixed again past 0.2 (0.3: 1.2 %), for 1.3 times the rays.
-const DRIFT: f64 = 0.2;
+pub(super) const DRIFT: f64 = 0.2;
 
 /// A bright shooter carrying at least this share of the power the solve started with (the
 /// emitted power) takes all of `SolverParams::penumbra_rays`; one carrying less, a part in

@@ -59,6 +59,13 @@ impl Solver {
         {
             previous = self.rows.take_out(key);
         }
+        if let Shooter::Group(g) = shooter
+            && self.params.overshoot == Overshoot::Off
+            && self.clusters.refresh_if_drifted(g, &self.mesh, &self.tally.unshot)
+        {
+            // A group's row holds nothing its next spread could reuse.
+            self.rows.take_out(key);
+        }
         let kept = self.rows.take(key);
         let was_kept = kept.is_some();
         let row = kept.unwrap_or_else(|| self.compute_any_row(key, previous));
