@@ -19,6 +19,18 @@ const MAX_BOXES: usize = 64;
 
 /// The occluder triangles of `mesh` that can block a ray between two points of its surfaces.
 pub(crate) fn blocking_triangles(mesh: &Mesh) -> Vec<[DVec3; 3]> {
+    split_triangles(mesh).0
+}
+
+/// The occluder triangles that [`blocking_triangles`] leaves out: those with every surface
+/// point in front of them (a box room's walls). No ray between two surface points crosses
+/// them, but a ray leaving the scene from inside a closed room meets them.
+pub(crate) fn hull_triangles(mesh: &Mesh) -> Vec<[Vec3; 3]> {
+    split_triangles(mesh).1.iter().map(|t| t.map(|p| p.as_vec3())).collect()
+}
+
+/// The occluder triangles that can block a ray between two surface points, and the rest.
+fn split_triangles(mesh: &Mesh) -> (Vec<[DVec3; 3]>, Vec<[DVec3; 3]>) {
     let (lo, hi) = mesh.bounds();
     let tolerance = 1e-7 * (hi - lo).length().max(f64::MIN_POSITIVE);
     let corners: Vec<DVec3> = (0..8)
@@ -26,22 +38,18 @@ pub(crate) fn blocking_triangles(mesh: &Mesh) -> Vec<[DVec3; 3]> {
         .collect();
     let points: Vec<DVec3> = mesh.occluders.iter().flatten().copied().collect();
     let scan = mesh.occluders.len().saturating_mul(points.len()) <= SCAN_BUDGET;
-    mesh.occluders
-        .iter()
-        .filter(|t| {
-            let n = (t[1] - t[0]).cross(t[2] - t[0]);
-            if n.length_squared() == 0.0 {
-                return true;
-            }
-            let n = n.normalize();
-            let in_front = |p: &DVec3| n.dot(*p - t[0]) >= -tolerance;
-            // Bounding-box corners in front settle axis-aligned walls at once; otherwise scan
-            // every occluder vertex when that is affordable.
-            let hull = corners.iter().all(in_front) || (scan && points.iter().all(in_front));
-            !hull
-        })
-        .copied()
-        .collect()
+    mesh.occluders.iter().partition(|t| {
+        let n = (t[1] - t[0]).cross(t[2] - t[0]);
+        if n.length_squared() == 0.0 {
+            return true;
+        }
+        let n = n.normalize();
+        let in_front = |p: &DVec3| n.dot(*p - t[0]) >= -tolerance;
+        // Bounding-box corners in front settle axis-aligned walls at once; otherwise scan
+        // every occluder vertex when that is affordable.
+        let hull = corners.iter().all(in_front) || (scan && points.iter().all(in_front));
+        !hull
+    })
 }
 
 /// The blocking occluder triangles of a mesh in single precision, ready for a

@@ -314,6 +314,26 @@ impl Clusters {
         self.groups.len()
     }
 
+    /// The reach of group `g`'s near field from its centre: the receivers within it take
+    /// its points' kernel (see [`FAR`]).
+    pub(super) fn near_reach(&self, g: usize) -> f64 {
+        FAR * self.groups[g].radius
+    }
+
+    /// Group `g`'s near-field points with their normals, as its last shot fixed them (none
+    /// before its first shot): where its probe rays start (see `enclosure`).
+    pub(super) fn probe_points(&self, g: usize) -> Vec<(DVec3, DVec3)> {
+        let Some(frozen) = &self.groups[g].frozen else { return Vec::new() };
+        let near = &frozen.near;
+        (0..POINTS)
+            .filter(|&i| near.patch[i] != NONE)
+            .map(|i| {
+                let at = |v: &[[f32; POINTS]; 3]| glam::Vec3::new(v[0][i], v[1][i], v[2][i]).as_dvec3();
+                (near.origin + at(&near.x), at(&near.n).normalize_or_zero())
+            })
+            .collect()
+    }
+
     /// Group `g`.
     pub(super) fn group(&self, g: usize) -> &Group {
         &self.groups[g]

@@ -36,6 +36,7 @@ use radiosity_accel::RayQuery;
 use radiosity_core::{Mesh, Rgb};
 
 mod clusters;
+mod enclosure;
 mod error;
 mod first_shots;
 mod mesh_tables;
@@ -89,6 +90,12 @@ pub struct Solver {
     tally: Tally,
     /// Shots, rays, time, stop.
     progress: Progress,
+    /// Per shooter (patches, then groups): whether it is enclosed (see [`enclosure`]),
+    /// once probed.
+    enclosed: Vec<Option<bool>>,
+    /// The occluder triangles left out of `accel` (a room's walls, see
+    /// `occluders::hull_triangles`), built at the first probe.
+    hull: Option<radiosity_accel::Bvh>,
 }
 
 /// How many groups of small model facets would shoot as one in a solve of `mesh` with
@@ -109,6 +116,7 @@ impl Solver {
         let tally = Tally::new(&mesh)?;
         let mut clusters = Clusters::new(&mesh, params.clustering);
         clusters.sum(&tally.patch_abs);
+        let shooters = mesh.patches.len() + clusters.len();
         Ok(Self {
             tables: MeshTables::new(&mesh),
             first_shots: FirstShots::new(&mesh, &tally),
@@ -120,6 +128,8 @@ impl Solver {
             scratch: ShotScratch::new(&mesh),
             tally,
             progress: Progress::new(mesh.patches.len()),
+            enclosed: vec![None; shooters],
+            hull: None,
             mesh,
             accel,
             params,

@@ -72,13 +72,18 @@ impl Solver {
         // 3. Shoot ω ΔB_i through it (ω = 1 unless over-relaxing).
         let omega = self.params.overshoot.omega();
         let patch = key as u32;
+        let enclosed = self.encloses(shooter, key);
         let by = match shooter {
-            Shooter::Patch(p) => {
-                Shooters { patches: std::slice::from_ref(&patch), area: self.mesh.patches[p].area }
-            }
+            Shooter::Patch(p) => Shooters {
+                patches: std::slice::from_ref(&patch),
+                area: self.mesh.patches[p].area,
+                near_reach: None,
+                enclosed,
+            },
             Shooter::Group(g) => {
                 let group = self.clusters.group(g);
-                Shooters { patches: &group.patches, area: group.area }
+                let near_reach = Some((group.centre, self.clusters.near_reach(g)));
+                Shooters { patches: &group.patches, area: group.area, near_reach, enclosed }
             }
         };
         self.tally.shoot(&self.mesh, &self.tables, by, &row, omega, self.clusters.members());
@@ -114,5 +119,33 @@ impl Solver {
         let (row, rays) = self.clusters.row(g, mesh, tables, &*self.accel, params, &mut self.scratch);
         self.progress.rays += rays;
         row
+    }
+}
+
+impl Solver {
+    /// Whether every probe ray from `shooter` (shooter index `key`) meets a surface (see
+    /// [`super::enclosure`]); probed once per shooter, the first time it shoots.
+    fn encloses(&mut self, shooter: Shooter, key: usize) -> bool {
+        if let Some(known) = self.enclosed[key] {
+            return known;
+        }
+        let mesh = &*self.mesh;
+        let hull = self
+            .hull
+            .get_or_insert_with(|| radiosity_accel::Bvh::new(&crate::occluders::hull_triangles(mesh)));
+        let points: Vec<(glam::DVec3, glam::DVec3)> = match shooter {
+            Shooter::Patch(p) => {
+                let patch = &mesh.patches[p];
+                let inner = patch.corners().iter().map(|c| (patch.centre + *c) * 0.5);
+                std::iter::once(patch.centre).chain(inner).map(|x| (x, patch.normal)).collect()
+            }
+            Shooter::Group(g) => self.clusters.probe_points(g),
+        };
+        let (lo, hi) = mesh.bounds();
+        let reach = 2.0 * (hi - lo).length();
+        let known =
+            super::enclosure::encloses(&*self.accel, hull, &points, reach, self.params.seed, key as u64);
+        self.enclosed[key] = Some(known);
+        known
     }
 }

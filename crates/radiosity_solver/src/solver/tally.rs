@@ -9,6 +9,16 @@ use super::mesh_tables::MeshTables;
 use super::parallel::Carve;
 use super::row::{CLUSTER_TERM, NearField, Row};
 
+/// The most an enclosed shooter's shot is scaled up by to deliver all of its power (see
+/// [`super::enclosure`]): three times for a group's near receivers (its points' kernel gives a
+/// receiver at one point-disc radius 69 % of its share, and crevices are nearer), which also
+/// bounds what a shooter wrongly judged enclosed can create.
+const MAX_REFUND: f64 = 3.0;
+
+/// The most an enclosed patch's shot is scaled up by: its rows fall short by a fraction of a
+/// per cent (the ceiling of a closed room with a sofa: 0.4 %).
+const MAX_PATCH_REFUND: f64 = 1.25;
+
 /// Power bookkeeping per channel: emitted + created = absorbed + unshot + escaped, to
 /// round-off.
 ///
@@ -48,6 +58,12 @@ pub(super) struct Shooters<'a> {
     pub(super) patches: &'a [u32],
     /// Their total area.
     pub(super) area: f64,
+    /// A group's centre and the reach of its near field (see `clusters::FAR`): the
+    /// receivers within it are those its shot's shortfall is given back to.
+    pub(super) near_reach: Option<(glam::DVec3, f64)>,
+    /// Every probe ray from the shooter met a surface (see [`super::enclosure`]): its shot
+    /// delivers all of its power.
+    pub(super) enclosed: bool,
 }
 
 /// Radiosity, unshot radiosity and power tallies.
@@ -217,7 +233,7 @@ impl Tally {
         omega: f64,
         grouped: &[bool],
     ) {
-        let Shooters { patches: shooters, area } = by;
+        let Shooters { patches: shooters, area, .. } = by;
         let power: Rgb = shooters.iter().map(|&q| self.patch_unshot_power[q as usize]).sum();
         let mut shot_b = power * (omega / area);
         self.changed.clear();
@@ -274,9 +290,31 @@ impl Tally {
         }
         let mean_b = shot_b;
         shot_b = shot_b * near_scale;
+        // An enclosed shooter's shortfall given back (see `enclosure`): `near_gain` scales
+        // what the receivers within a group's near field take, `gain` what all take.
+        let (mut near_gain, mut gain) = (Rgb::ONE, Rgb::ONE);
+        if by.enclosed && omega == 1.0 {
+            let (far, near_part) = self.delivered(mesh, tables, by, row, &near_b, shot_b, mean_b, grouped);
+            let sent = mean_b * area;
+            let ratio =
+                |lo: f64, hi: f64| move |a: f64, b: f64| if b > 0.0 { (a / b).clamp(lo, hi) } else { 1.0 };
+            if near_part.max_channel() > 0.0 {
+                near_gain = (sent - far).zip_map(near_part, ratio(1.0 / MAX_REFUND, MAX_REFUND));
+            } else {
+                gain = sent.zip_map(far, ratio(1.0 / MAX_PATCH_REFUND, MAX_PATCH_REFUND));
+            }
+        }
+        shot_b = shot_b * gain;
+        let mean_b_rx = mean_b * gain;
+        let near_b: Vec<Rgb> = near_b.into_iter().map(|b| b * gain).collect();
+        let reach = by.near_reach.filter(|_| near_gain != Rgb::ONE);
+        let gain_of = |e: usize| match reach {
+            Some((c, r)) if mesh.elements[e].centre.distance_squared(c) <= r * r => near_gain,
+            _ => Rgb::ONE,
+        };
         // A model's grouped facets take the mean: a scan beside a room patch sees it whole,
         // and scaled with the rest the bunnies of a furnished room came out 3–3.6 % bright.
-        let b_of = |patch: usize| if grouped[patch] { mean_b } else { shot_b };
+        let b_of = |patch: usize| if grouped[patch] { mean_b_rx } else { shot_b };
         // The shooters keep (1 − ω) of their unshot radiosity before the receivers gain:
         // a group's facets also receive from each other.
         for &q in shooters {
@@ -325,13 +363,14 @@ impl Tally {
                 let per_factor = tables.patch_reflectance[patch] * b_of(patch);
                 let area = &tables.element_area[elements.clone()];
                 let local = elements.start - base;
-                let mut seen = 0.0;
+                let mut seen = Rgb::ZERO;
                 for k in 0..elements.len() {
                     let f = f64::from(factors[offset + k]);
-                    let reflected = per_factor * f; // ρ × irradiance from this shot, W/unit²
+                    let m = gain_of(elements.start + k);
+                    let reflected = per_factor * m * f; // ρ × irradiance from this shot, W/unit²
                     radiosity[local + k] += reflected;
                     unshot[local + k] += reflected;
-                    seen += f * area[k];
+                    seen += m * (f * area[k]);
                 }
                 offset += elements.len();
                 let gained = tables.patch_reflectance[patch] * b_of(patch) * seen;
@@ -379,7 +418,49 @@ impl Tally {
         let left = mean_b * area - received;
         self.escaped += left.map(|x| x.max(0.0));
         self.created += left.map(|x| (-x).max(0.0));
-        self.tally_direct(tables, by, row, omega, near_scale, grouped);
+        self.tally_direct(tables, by, row, omega, near_scale * gain, grouped);
+    }
+
+    /// What a shot's row would deliver (irradiance × area, before any refund): to the
+    /// receivers outside the group's near field (with the near receivers' own shares), and
+    /// to those within it (see [`Shooters::near_reach`]; nothing for a patch's shot).
+    #[allow(clippy::too_many_arguments)]
+    fn delivered(
+        &self,
+        mesh: &Mesh,
+        tables: &MeshTables,
+        by: Shooters,
+        row: &Row,
+        near_b: &[Rgb],
+        shot_b: Rgb,
+        mean_b: Rgb,
+        grouped: &[bool],
+    ) -> (Rgb, Rgb) {
+        let b_of = |patch: usize| if grouped[patch] { mean_b } else { shot_b };
+        let is_near = |e: usize| match by.near_reach {
+            Some((c, r)) => mesh.elements[e].centre.distance_squared(c) <= r * r,
+            None => false,
+        };
+        let (mut far, mut near) = (Rgb::ZERO, Rgb::ZERO);
+        let mut offset = 0;
+        for_each_patch(tables, &row.spans, |patch, elements| {
+            let (mut seen_far, mut seen_near) = (0.0, 0.0);
+            for (k, e) in elements.clone().enumerate() {
+                let x = f64::from(row.factors[offset + k]) * tables.element_area[e];
+                if is_near(e) {
+                    seen_near += x;
+                } else {
+                    seen_far += x;
+                }
+            }
+            offset += elements.len();
+            far += b_of(patch) * seen_far;
+            near += b_of(patch) * seen_near;
+        });
+        for (&(e, f, _, _), b) in row.near.receivers.iter().zip(near_b) {
+            far += (*b - shot_b) * f64::from(f) * tables.element_area[e as usize];
+        }
+        (far, near)
     }
 
     /// Adds to each receiver the part of this shot that is the shooter's own emission (its
@@ -395,7 +476,7 @@ impl Tally {
         scale: Rgb,
         grouped: &[bool],
     ) {
-        let Shooters { patches: shooters, area } = by;
+        let Shooters { patches: shooters, area, .. } = by;
         let emission: Rgb = shooters.iter().map(|&q| self.patch_unshot_emission[q as usize]).sum();
         if emission.max_channel() <= 0.0 {
             return;
