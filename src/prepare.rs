@@ -23,7 +23,7 @@ pub fn exit_code(e: &anyhow::Error) -> u8 {
         c.is::<InputError>()
             || c.is::<radiosity_io::LoadError>()
             || c.is::<radiosity_core::SceneError>()
-            || c.is::<radiosity_core::MeshError>()
+            || c.is::<radiosity_mesh::MeshError>()
             || c.is::<radiosity_solver::SolverError>()
             || c.is::<radiosity_image::RenderError>()
     });
@@ -302,8 +302,8 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
     }
     let up = up.unwrap_or_default();
     if o.mesh.sides.is_none() {
-        let sealed = spinning("finding closed models", || radiosity_core::seal_closed_objects(&mut scene));
-        let names = |keep: fn(&radiosity_core::Sealed) -> bool| {
+        let sealed = spinning("finding closed models", || radiosity_mesh::seal_closed_objects(&mut scene));
+        let names = |keep: fn(&radiosity_mesh::Sealed) -> bool| {
             let objects: Vec<usize> = sealed.iter().filter(|s| keep(s)).map(|s| s.object).collect();
             (!objects.is_empty()).then(|| name_list(&scene, &objects))
         };

@@ -236,7 +236,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         PictureFormat::of(path).map_err(|e| input(format!("-o: {e}")))?;
     }
     let prepared = prepare(&a.scene, &a.solve)?;
-    let base = prepared.scene.camera_or_framing();
+    let base = radiosity_image::camera_or_framing(&prepared.scene);
     // The points given are in the file's frame; the scene has been turned +y up.
     let turned = |p: DVec3| prepared.up.to_y_up(p);
     let camera = Camera::try_new(
@@ -246,7 +246,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         a.fov.unwrap_or(base.fov_y_deg),
     )
     .map_err(|e| input(format!("camera options (--camera-position, --look-at, --fov): {e}")))?;
-    let lit = prepared.scene.lit_share_seen_by(&camera);
+    let lit = radiosity_image::lit_share_seen_by(&prepared.scene, &camera);
     if lit < 0.05 {
         note(format_args!(
             "warning: the camera sees almost no lit face ({:.0} % of a coarse probe): it looks at nothing or at the backs of one-sided surfaces, so the picture will be nearly black; move it (--camera-position, --look-at), or make the surfaces two-sided (--sides 2 for model files, sides = 2 in a scene file)",

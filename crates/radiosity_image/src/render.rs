@@ -22,7 +22,8 @@ use std::sync::Arc;
 use glam::{DVec2, DVec3, Vec3};
 use radiosity_accel::{Bvh, Hit, RayQuery};
 use radiosity_core::random::Rng;
-use radiosity_core::{Camera, CameraRays, Mesh, Rgb};
+use radiosity_core::{Camera, CameraRays, Rgb};
+use radiosity_mesh::Mesh;
 use radiosity_solver::Solution;
 use rayon::prelude::*;
 use thiserror::Error;
@@ -1030,7 +1031,7 @@ fn shuffled(n: u32, rng: &mut Rng) -> Vec<u32> {
 
 /// Whether every vertex normal of `el` is its own normal, within round-off of a normal
 /// computed from other corners of the same plane (3e-5 rad): there is nothing to interpolate.
-fn is_flat(el: &radiosity_core::Element, normals: &[DVec3]) -> bool {
+fn is_flat(el: &radiosity_mesh::Element, normals: &[DVec3]) -> bool {
     el.vertex_indices().iter().all(|&v| normals[v as usize].dot(el.normal) > 1.0 - 5e-10)
 }
 

@@ -22,7 +22,7 @@
 //! the same quads in a scene file), fan-split when convex but not planar, ear-clipped when
 //! concave. Positions equal to the bit after the transform are welded, so faces that an
 //! exporter split at texture seams still share edges (and so surfaces, see
-//! `radiosity_core::Mesh::build`). Degenerate faces are dropped with a warning count; an
+//! `radiosity_mesh::Mesh::build`). Degenerate faces are dropped with a warning count; an
 //! object left with no face is an error.
 
 use rustc_hash::FxHashMap as HashMap;

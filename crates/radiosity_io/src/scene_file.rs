@@ -321,7 +321,7 @@ fn material_sides(loc: &Locator, key: &str, m: &MaterialDesc) -> Result<Option<S
     }))
 }
 
-/// Refuses, with a line, a scene whose mesh would pass [`radiosity_core::MAX_ELEMENTS`]: at
+/// Refuses, with a line, a scene whose mesh would pass [`radiosity_mesh::MAX_ELEMENTS`]: at
 /// `[mesh] element_size` when the file sets it, else at the object that passes the limit
 /// (a huge sphere, say, against the default sizes).
 fn check_element_count(
@@ -331,11 +331,11 @@ fn check_element_count(
     origins: &[usize],
 ) -> Result<(), LoadError> {
     let params = scene.mesh_params();
-    let Some(i) = radiosity_core::first_object_over_limit(scene, &params) else { return Ok(()) };
+    let Some(i) = radiosity_mesh::first_object_over_limit(scene, &params) else { return Ok(()) };
     let object = &desc.object[origins[i]];
-    let e = radiosity_core::MeshError::TooManyElements {
+    let e = radiosity_mesh::MeshError::TooManyElements {
         object: scene.objects[i].name.chars().take(80).collect(),
-        limit: radiosity_core::MAX_ELEMENTS,
+        limit: radiosity_mesh::MAX_ELEMENTS,
         patch_size: params.patch_size,
         element_size: params.element_size,
     };

@@ -216,7 +216,7 @@ impl ViewerApp {
         );
         let (lo, hi) = scene.bounds();
         let extent = SceneExtent::new(lo, hi);
-        let camera = FlyCamera::from_scene_camera(&scene.camera_or_framing(), &extent);
+        let camera = FlyCamera::from_scene_camera(&radiosity_image::camera_or_framing(&scene), &extent);
         Ok(Self {
             view: ViewState {
                 camera,
@@ -389,8 +389,10 @@ impl ViewerApp {
         if self.camera_scene.as_ref().is_none_or(|s| !Arc::ptr_eq(s, &snap.job.scene)) {
             let (lo, hi) = snap.mesh.bounds();
             self.extent = SceneExtent::new(lo, hi);
-            self.view.camera =
-                FlyCamera::from_scene_camera(&snap.job.scene.camera_or_framing(), &self.extent);
+            self.view.camera = FlyCamera::from_scene_camera(
+                &radiosity_image::camera_or_framing(&snap.job.scene),
+                &self.extent,
+            );
             self.camera_scene = Some(snap.job.scene.clone());
         }
         self.shown = Some(snap);
@@ -499,7 +501,8 @@ impl ViewerApp {
             moving = true;
         }
         if reset && let Some(scene) = &self.camera_scene {
-            self.view.camera = FlyCamera::from_scene_camera(&scene.camera_or_framing(), &self.extent);
+            self.view.camera =
+                FlyCamera::from_scene_camera(&radiosity_image::camera_or_framing(&scene), &self.extent);
         }
         if frame_all {
             self.view.camera.frame(&self.extent, aspect);

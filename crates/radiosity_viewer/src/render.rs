@@ -19,8 +19,9 @@ use std::sync::Arc;
 
 use eframe::wgpu;
 use glam::{DMat4, DVec3};
-use radiosity_core::{Mesh, Rgb};
+use radiosity_core::Rgb;
 use radiosity_image::ToneOperator;
+use radiosity_mesh::Mesh;
 use radiosity_solver::Solution;
 
 use crate::coarse::{COARSE_TRIANGLES, CoarseTriangle};

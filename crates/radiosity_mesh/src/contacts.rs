@@ -24,7 +24,7 @@ use crate::planar::{
     area, area_signed, bounds, clean, contains_within, distance_to_polygon, key, lexicographic, plane, split,
     tolerance,
 };
-use crate::scene::{Polygon, Scene, Shape};
+use radiosity_core::{Polygon, Scene, Shape};
 
 /// A polygon of a scene: the object and the polygon's index within it (a face index for a
 /// model mesh).
@@ -627,8 +627,8 @@ fn convex_loop(lp: Vec<DVec3>, n: DVec3) -> Option<Vec<DVec3>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::{Facing, box_faces};
-    use crate::{Material, Object, Rgb};
+    use radiosity_core::{Facing, box_faces};
+    use radiosity_core::{Material, Object, Rgb};
 
     fn quad(y: f64, size: f64) -> Polygon {
         Polygon::try_new(vec![
