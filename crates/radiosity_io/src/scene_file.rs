@@ -21,8 +21,9 @@ use crate::LoadError;
 use crate::desc::{
     CameraDesc, Face, MaterialDesc, MeshDesc, ObjectDesc, Scale, SceneDesc, SolverDesc, TransformDesc,
 };
+use crate::load_model::load_model;
 use crate::locate::Locator;
-use crate::model::{ModelFormat, Transform, load_model, model_error};
+use crate::model::{ModelFormat, Transform, model_error};
 
 /// Camera vertical field of view in degrees when the file gives none.
 const DEFAULT_FOV_Y_DEG: f64 = 45.0;

@@ -20,7 +20,8 @@
 //! Files, bottom-up: `union_find`, `planar` (convex polygons on a plane) and `builder` (one
 //! surface's vertices and elements) are used by the rest; `lattice` and `model_faces` cut a
 //! surface; `contacts`, `shadows` and `grading` cut and grade it further; `refinement` names
-//! elements to quarter; `smoothing` pools vertices across surfaces; `build` puts it all
+//! elements to quarter; `smoothing` is the table of vertices pooled across surfaces and
+//! `pooling` builds it; `build` puts it all
 //! together into a [`Mesh`] (`mesh`), within the `limits`; `sealed` makes closed models
 //! one-sided before meshing.
 //!
@@ -37,6 +38,7 @@ mod limits;
 mod mesh;
 mod model_faces;
 mod planar;
+mod pooling;
 mod refinement;
 mod sealed;
 mod shadows;
