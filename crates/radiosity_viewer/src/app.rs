@@ -1151,7 +1151,7 @@ fn unique_path(dir: &std::path::Path, name: &str) -> PathBuf {
 /// The window driven by egui_kittest: real egui frames, real wgpu (lavapipe on CI), input
 /// injected as events. Rendering goes through the P screenshot path (an offscreen target),
 /// since the harness's own pass has no depth buffer for the paint callback.
-#[cfg(all(test, feature = "gui-tests"))]
+#[cfg(test)]
 mod tests {
     use super::*;
     use egui_kittest::Harness;
