@@ -4,10 +4,10 @@
 
 use super::*;
 use eframe::egui::Key;
-use radiosity_core::MeshParams;
-use radiosity_image::Gather;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
+use radiosity_core::MeshParams;
+use radiosity_image::Gather;
 use radiosity_solver::SolverParams;
 
 const LONG: Duration = Duration::from_secs(60);
