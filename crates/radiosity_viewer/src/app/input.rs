@@ -66,7 +66,7 @@ impl ViewerApp {
         }
         if reset && let Some(scene) = &self.camera_scene {
             self.view.camera =
-                FlyCamera::from_scene_camera(&radiosity_image::camera_or_framing(&scene), &self.extent);
+                FlyCamera::from_scene_camera(&radiosity_image::camera_or_framing(scene), &self.extent);
         }
         if frame_all {
             self.view.camera.frame(&self.extent, aspect);
