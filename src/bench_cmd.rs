@@ -24,7 +24,8 @@ use clap::Args;
 use glam::{DVec3, Vec3};
 use radiosity_accel::{Bvh, RayQuery};
 use radiosity_core::random::XorShift64;
-use radiosity_core::{Mesh, MeshParams, Scene, Shape};
+use radiosity_core::{MeshParams, Scene, Shape};
+use radiosity_mesh::Mesh;
 use radiosity_solver::{Problem, SolverParams};
 use rayon::prelude::*;
 use serde_json::json;
@@ -244,7 +245,7 @@ fn big_case(scene_arg: &str, clustering: bool) -> Result<serde_json::Value> {
     let start = Instant::now();
     let mut scene = radiosity_io::resolve_scene(scene_arg)?.scene;
     // As `solve` does without `--sides`: closed models lit from one side are one-sided.
-    radiosity_core::seal_closed_objects(&mut scene);
+    radiosity_mesh::seal_closed_objects(&mut scene);
     let loaded = start.elapsed().as_secs_f64();
     let problem = Problem::new(&scene, &scene.mesh_params())?;
     let meshed = start.elapsed().as_secs_f64() - loaded;

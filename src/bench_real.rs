@@ -18,9 +18,11 @@ use radiosity_solver::{StepBudget, StepReport};
 use serde_json::{Value, json};
 
 use crate::alloc;
+use crate::comparison::{Comparison, Summary};
+use crate::errors::InputError;
 use crate::output;
-use crate::prepare::{InputError, Prepared, SolveOpts, prepare};
-use crate::verify_cmd::{self, Comparison, Summary};
+use crate::prepare::{Prepared, prepare};
+use crate::solve_opts::SolveOpts;
 
 /// The first unshot fraction whose crossing is timed: "good enough to look at" (`bench
 /// --big` solves to it).
@@ -136,8 +138,8 @@ fn compared_objects(
                     "area": solved[i].area,
                     "radiosity_luminance": rows[i].solve.luminance(),
                     "reference_luminance": rows[i].reference.luminance,
-                    "difference_percent": verify_cmd::num(p),
-                    "difference_sigma": verify_cmd::num(z),
+                    "difference_percent": crate::comparison::num(p),
+                    "difference_sigma": crate::comparison::num(z),
                     "paths": rows[i].reference.paths,
                 })
             })
@@ -192,10 +194,10 @@ pub fn real_case(scene_arg: &str, reference_seconds: f64) -> Result<Value> {
 
     // `verify`'s comparison: the same per-object means (spread over the whole input area,
     // back faces as objects of their own) against the reference's.
-    let fronts = verify_cmd::over_whole_area(objects, &mesh.hidden_area);
+    let fronts = crate::comparison::over_whole_area(objects, &mesh.hidden_area);
     let front_count = fronts.len();
     let front_area: f64 = fronts.iter().map(|o| o.area).sum();
-    let solved = verify_cmd::with_back_faces(fronts);
+    let solved = crate::comparison::with_back_faces(fronts);
     let reference = Reference::new(scene);
     let ref_params = EstimateParams {
         budget: PathBudget::Adaptive { relative_stderr: 0.001, max_paths: 1 << 26 },
@@ -203,12 +205,13 @@ pub fn real_case(scene_arg: &str, reference_seconds: f64) -> Result<Value> {
         time_limit: Some(Duration::from_secs_f64(reference_seconds)),
         max_reflections: u32::MAX,
     };
-    let progress = verify_cmd::reference_progress("reference");
-    let estimates = reference.estimate_objects(&ref_params, &|p| verify_cmd::report_progress(&progress, p));
+    let progress = crate::reference_run::reference_progress("reference");
+    let estimates =
+        reference.estimate_objects(&ref_params, &|p| crate::reference_run::report_progress(&progress, p));
     drop(progress);
     let ref_secs = estimates.elapsed.as_secs_f64();
-    let rows = verify_cmd::compare_objects(&estimates, &solved, false)?;
-    let judged = verify_cmd::judged(&rows);
+    let rows = crate::comparison::compare_objects(&estimates, &solved, false)?;
+    let judged = crate::comparison::judged(&rows);
     let large: Vec<(usize, f64, f64)> =
         judged.iter().copied().filter(|&(i, ..)| solved[i].area >= MIN_AREA_SHARE * front_area).collect();
     let (front, back): (Vec<_>, Vec<_>) = large.iter().partition(|j| j.0 < front_count);
@@ -256,8 +259,8 @@ pub fn real_case(scene_arg: &str, reference_seconds: f64) -> Result<Value> {
         "patches": patches,
         "elements": elements,
         "load_mesh_seconds": mesh_secs,
-        "seconds_to_1_percent": coarse.map_or(Value::Null, verify_cmd::num),
-        "seconds_to_0_1_percent": fine.map_or(Value::Null, verify_cmd::num),
+        "seconds_to_1_percent": coarse.map_or(Value::Null, crate::comparison::num),
+        "seconds_to_0_1_percent": fine.map_or(Value::Null, crate::comparison::num),
         "solve_seconds": report.elapsed.as_secs_f64(),
         "shots": report.total_shots,
         "rays": report.rays,

@@ -9,8 +9,8 @@ use radiosity_core::Rgb;
 use radiosity_image::{HdrImage, SrgbImage, encode_png, read_hdr};
 use serde_json::json;
 
+use crate::errors::InputError;
 use crate::output::{self, Targets, write_report};
-use crate::prepare::InputError;
 
 /// Arguments of `radiosity compare`.
 #[derive(Args)]

@@ -8,16 +8,18 @@ use clap::Args;
 use radiosity_export::{ExportFormat, Texels, VertexColours};
 use radiosity_image::{Gather, HdrImage, RenderParams, Renderer, ToneOperator, ToneParams};
 
+use crate::errors::InputError;
 use crate::output::{self, Targets, note};
-use crate::prepare::{InputError, SolveOpts, prepare, run_solver};
+use crate::picture_opts::{GatherArg, ToneOpts};
+use crate::prepare::{prepare, run_solver};
 use crate::progress::spinning;
-use crate::render_cmd::{GatherArg, ToneOpts};
+use crate::solve_opts::SolveOpts;
 
 /// Arguments of `radiosity export`.
 #[derive(Args)]
 pub struct ExportArgs {
-    /// The scene to load: see [`SCENE_HELP`](crate::prepare::SCENE_HELP).
-    #[arg(help = crate::prepare::SCENE_HELP)]
+    /// The scene to load: see [`SCENE_HELP`](crate::solve_opts::SCENE_HELP).
+    #[arg(help = crate::solve_opts::SCENE_HELP)]
     pub scene: String,
     /// Lit mesh to write: .glb, .gltf (buffer embedded) or .ply (binary little endian).
     #[arg(short = 'o', long = "output")]

@@ -6,13 +6,14 @@ use anyhow::Result;
 use clap::Args;
 use radiosity_core::Rgb;
 
-use crate::prepare::{MeshOpts, SolveOpts, prepare_unlit};
+use crate::prepare::prepare_unlit;
+use crate::solve_opts::{MeshOpts, SolveOpts};
 
 /// Arguments of `radiosity info`.
 #[derive(Args)]
 pub struct InfoArgs {
-    /// The scene to load: see [`SCENE_HELP`](crate::prepare::SCENE_HELP).
-    #[arg(help = crate::prepare::SCENE_HELP)]
+    /// The scene to load: see [`SCENE_HELP`](crate::solve_opts::SCENE_HELP).
+    #[arg(help = crate::solve_opts::SCENE_HELP)]
     pub scene: String,
     #[command(flatten)]
     pub mesh: MeshOpts,

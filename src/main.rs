@@ -4,14 +4,21 @@ mod alloc;
 mod bench_cmd;
 mod bench_real;
 mod compare_cmd;
+mod comparison;
+mod errors;
 mod export_cmd;
 mod info_cmd;
 mod interrupt;
+mod load_scene;
 mod output;
+mod picture_opts;
 mod prepare;
 mod progress;
+mod reference_run;
 mod render_cmd;
 mod solve_cmd;
+mod solve_opts;
+mod tonemap_cmd;
 mod verify_cmd;
 mod view_cmd;
 
@@ -48,7 +55,7 @@ enum Command {
     /// Solve a scene and ray cast it to a tone-mapped PNG (and linear EXR / PFM).
     Render(render_cmd::RenderArgs),
     /// Tone map a linear picture (.exr or .pfm) to PNG again, without solving.
-    Tonemap(render_cmd::TonemapArgs),
+    Tonemap(tonemap_cmd::TonemapArgs),
     /// Open a window that solves the scene live while you fly through it.
     View(view_cmd::ViewArgs),
     /// Solve a scene and write the lit mesh (glTF, GLB, PLY) with baked colours, and lightmaps.
@@ -61,7 +68,7 @@ enum Command {
 
 fn main() -> ExitCode {
     alloc::keep_freed_memory();
-    progress::start_clock();
+    output::start_clock();
     let cli = Cli::parse();
     progress::set_quiet(cli.quiet);
     if cli.progress_interval.is_finite() && cli.progress_interval > 0.0 {
@@ -72,7 +79,7 @@ fn main() -> ExitCode {
         Command::Info(a) => info_cmd::run(a),
         Command::Bench(a) => bench_cmd::run(a),
         Command::Render(a) => render_cmd::run(a),
-        Command::Tonemap(a) => render_cmd::run_tonemap(a),
+        Command::Tonemap(a) => tonemap_cmd::run(a),
         Command::View(a) => view_cmd::run(a),
         Command::Export(a) => export_cmd::run(a),
         Command::Verify(a) => verify_cmd::run(a),
@@ -90,7 +97,7 @@ fn main() -> ExitCode {
         Err(e) => {
             // Nowhere left to report a failure to write the report; the exit code still says it.
             let _ = output::note(format_args!("error: {}", radiosity_core::one_line(e.as_ref())));
-            ExitCode::from(prepare::exit_code(&e))
+            ExitCode::from(errors::exit_code(&e))
         }
     }
 }

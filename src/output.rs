@@ -20,10 +20,13 @@ use std::ffi::OsString;
 use std::fs::File;
 use std::io::{BufWriter, ErrorKind, Write};
 use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, anyhow};
 
-use crate::prepare::InputError;
+use crate::errors::InputError;
 
 /// Exit status for a closed output pipe: 128 + SIGPIPE (13), what a shell reports for a
 /// process the signal ended, and what `head`-style pipelines expect.
@@ -307,6 +310,33 @@ pub fn energy_json(e: &radiosity_solver::EnergyBalance) -> serde_json::Value {
     })
 }
 
+/// When the last line went to stderr, milliseconds after [`epoch`]: a step's timer waits a
+/// whole interval after it, whoever printed it, so a chain of short steps (loading, meshing,
+/// then the first seconds of a solve) is never silent for longer than one interval.
+static LAST_LINE_MS: AtomicU64 = AtomicU64::new(0);
+
+/// The process's clock origin for [`LAST_LINE_MS`].
+fn epoch() -> Instant {
+    static EPOCH: OnceLock<Instant> = OnceLock::new();
+    *EPOCH.get_or_init(Instant::now)
+}
+
+/// Starts the clock that silences are measured on: the start of the process counts as the
+/// last line until one is printed.
+pub fn start_clock() {
+    epoch();
+}
+
+/// Notes that a line went to stderr now ([`note`] calls it).
+pub fn line_printed() {
+    LAST_LINE_MS.store(epoch().elapsed().as_millis() as u64, Ordering::Relaxed);
+}
+
+/// Time since the last line went to stderr (since the start, before any).
+pub fn since_last_line() -> Duration {
+    epoch().elapsed().saturating_sub(Duration::from_millis(LAST_LINE_MS.load(Ordering::Relaxed)))
+}
+
 /// Writes `text` to stdout and flushes it.
 ///
 /// # Errors
@@ -321,7 +351,7 @@ pub fn stdout(text: &str) -> Result<()> {
 /// # Errors
 /// The write fails (a closed pipe: see [`is_broken_pipe`]).
 pub fn note(line: impl std::fmt::Display) -> Result<()> {
-    crate::progress::line_printed();
+    line_printed();
     let mut err = std::io::stderr().lock();
     writeln!(err, "{line}").and_then(|()| err.flush()).map_err(|e| stream_error(e, "stderr"))
 }

@@ -11,7 +11,7 @@
 
 use std::io::IsTerminal;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::{Arc, Condvar, Mutex, OnceLock};
+use std::sync::{Arc, Condvar, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
@@ -35,33 +35,6 @@ const TICK: Duration = Duration::from_millis(120);
 
 /// Set by `--quiet`: no progress at all (results, notes and warnings still print).
 static QUIET: AtomicBool = AtomicBool::new(false);
-
-/// When the last line went to stderr, milliseconds after [`epoch`]: a step's timer waits a
-/// whole interval after it, whoever printed it, so a chain of short steps (loading, meshing,
-/// then the first seconds of a solve) is never silent for longer than one interval.
-static LAST_LINE_MS: AtomicU64 = AtomicU64::new(0);
-
-/// The process's clock origin for [`LAST_LINE_MS`].
-fn epoch() -> Instant {
-    static EPOCH: OnceLock<Instant> = OnceLock::new();
-    *EPOCH.get_or_init(Instant::now)
-}
-
-/// Starts the clock that silences are measured on: the start of the process counts as the
-/// last line until one is printed.
-pub fn start_clock() {
-    epoch();
-}
-
-/// Notes that a line went to stderr now ([`crate::output::note`] calls it).
-pub fn line_printed() {
-    LAST_LINE_MS.store(epoch().elapsed().as_millis() as u64, Ordering::Relaxed);
-}
-
-/// Time since the last line went to stderr (since the start, before any).
-fn since_last_line() -> Duration {
-    epoch().elapsed().saturating_sub(Duration::from_millis(LAST_LINE_MS.load(Ordering::Relaxed)))
-}
 
 /// Silences (or restores) every progress display of this process.
 pub fn set_quiet(quiet: bool) {
@@ -167,7 +140,7 @@ impl Progress {
             // Checked before every wait: the step may have ended before this thread ran, and
             // a wake-up sent then is not kept.
             while !*ended {
-                let wait = interval.saturating_sub(since_last_line());
+                let wait = interval.saturating_sub(crate::output::since_last_line());
                 if wait.is_zero() {
                     // Best effort: a stderr that cannot be written is reported by the
                     // step's own summary line, on the main thread. The note marks the time.

@@ -1,95 +1,29 @@
 //! `radiosity render`: solve, ray cast from a camera, tone map, write PNG (and linear EXR /
-//! PFM); `radiosity tonemap`: tone map a linear picture again without solving.
+//! PFM).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Result;
-use clap::{Args, ValueEnum};
+use clap::Args;
 use glam::DVec3;
 use radiosity_core::Camera;
 use radiosity_image::{
-    Exposure, Gather, HdrImage, PictureFormat, RenderParams, Renderer, Shading, ToneOperator, ToneParams,
-    encode_exr, encode_pfm, encode_picture, read_hdr, tone_map_image,
+    Gather, HdrImage, PictureFormat, RenderParams, Renderer, Shading, ToneOperator, encode_exr, encode_pfm,
 };
 
+use crate::errors::InputError;
 use crate::output::{self, Targets, note};
-use crate::prepare::{InputError, SolveOpts, prepare, run_solver};
+use crate::picture_opts::{GatherArg, ShadingArg, ToneOpts, write_tonemapped};
+use crate::prepare::{prepare, run_solver};
 use crate::progress::{Progress, spinning};
-
-/// Tone-mapping operator on the command line.
-#[derive(Clone, Copy, Debug, ValueEnum)]
-pub enum TonemapArg {
-    /// Exposure, then clamp to [0, 1].
-    Linear,
-    /// Reinhard et al. 2002, L / (1 + L) on luminance.
-    Reinhard,
-    /// ACES filmic curve (Narkowicz 2015 fit).
-    Aces,
-}
-
-impl From<TonemapArg> for ToneOperator {
-    fn from(a: TonemapArg) -> Self {
-        match a {
-            TonemapArg::Linear => ToneOperator::Linear,
-            TonemapArg::Reinhard => ToneOperator::Reinhard,
-            TonemapArg::Aces => ToneOperator::Aces,
-        }
-    }
-}
-
-/// Shading on the command line.
-#[derive(Clone, Copy, Debug, ValueEnum)]
-pub enum ShadingArg {
-    /// Radiosity interpolated from the vertices (within each surface only).
-    Smooth,
-    /// Each element's own radiosity: shows the mesh.
-    Flat,
-}
-
-/// Final gather on the command line.
-#[derive(Clone, Copy, Debug, ValueEnum)]
-pub enum GatherArg {
-    /// The radiosity solution only, interpolated over the mesh.
-    None,
-    /// Direct light by shadow rays per pixel; indirect light from the solution.
-    Direct,
-    /// Direct light by shadow rays; indirect by one bounce of gathering rays at the records
-    /// of an irradiance cache, interpolated between them.
-    Full,
-}
-
-impl From<GatherArg> for Gather {
-    fn from(a: GatherArg) -> Self {
-        match a {
-            GatherArg::None => Gather::None,
-            GatherArg::Direct => Gather::Direct,
-            GatherArg::Full => Gather::Full,
-        }
-    }
-}
-
-/// Exposure and operator, shared by `render` and `tonemap`.
-#[derive(Args, Clone, Debug)]
-pub struct ToneOpts {
-    /// Exposure: `auto` maps the log-average luminance of the picture's lit pixels (near-black
-    /// pixels and the brightest 2 %, where lamps are, left out) to middle grey, held down so
-    /// the brightest lit surfaces stay under display white; `auto+1` or
-    /// `auto-0.5` is that many stops brighter or darker than auto; a plain number is a fixed
-    /// exposure in stops (EV, radiance × 2^EV: `1` is brighter than `0`, not than auto).
-    /// One exposure for the whole picture.
-    #[arg(long, default_value = "auto", allow_hyphen_values = true)]
-    pub exposure: Exposure,
-    /// Tone-mapping operator.
-    #[arg(long, value_enum, default_value_t = TonemapArg::Aces)]
-    pub tonemap: TonemapArg,
-}
+use crate::solve_opts::SolveOpts;
 
 /// Arguments of `radiosity render`.
 #[derive(Args)]
 pub struct RenderArgs {
-    /// The scene to load: see [`SCENE_HELP`](crate::prepare::SCENE_HELP).
-    #[arg(help = crate::prepare::SCENE_HELP)]
+    /// The scene to load: see [`SCENE_HELP`](crate::solve_opts::SCENE_HELP).
+    #[arg(help = crate::solve_opts::SCENE_HELP)]
     pub scene: String,
     /// Tone-mapped 8-bit sRGB picture to write: PNG (.png) or JPEG (.jpg, .jpeg).
     #[arg(short = 'o', long = "output")]
@@ -164,21 +98,6 @@ pub struct RenderArgs {
     pub solve: SolveOpts,
 }
 
-/// Arguments of `radiosity tonemap`.
-#[derive(Args)]
-pub struct TonemapArgs {
-    /// Linear picture to read (.exr or .pfm), e.g. from `render --exr`.
-    pub input: PathBuf,
-    /// Tone-mapped 8-bit sRGB picture to write: PNG (.png) or JPEG (.jpg, .jpeg).
-    #[arg(short = 'o', long = "output")]
-    pub output: PathBuf,
-    #[command(flatten)]
-    pub tone: ToneOpts,
-    /// Overwrite an existing output file.
-    #[arg(long)]
-    pub force: bool,
-}
-
 fn parse_point(s: &str) -> Result<DVec3, String> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
     let numbers: Vec<f64> =
@@ -191,15 +110,6 @@ fn parse_point(s: &str) -> Result<DVec3, String> {
 
 fn input(msg: String) -> anyhow::Error {
     InputError(msg).into()
-}
-
-/// Tone maps `radiance` with `tone` and writes it as the picture format `path` names; returns
-/// the exposure used (EV).
-fn write_tonemapped(path: &Path, force: bool, radiance: &HdrImage, tone: &ToneOpts) -> Result<f64> {
-    let ev = tone.exposure.ev_for(radiance);
-    let png = tone_map_image(radiance, &ToneParams::new(ev, tone.tonemap.into()));
-    output::write_file(path, force, &encode_picture(&png, path)?)?;
-    Ok(ev)
 }
 
 /// Runs `render`.
@@ -236,7 +146,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         PictureFormat::of(path).map_err(|e| input(format!("-o: {e}")))?;
     }
     let prepared = prepare(&a.scene, &a.solve)?;
-    let base = prepared.scene.camera_or_framing();
+    let base = radiosity_image::camera_or_framing(&prepared.scene);
     // The points given are in the file's frame; the scene has been turned +y up.
     let turned = |p: DVec3| prepared.up.to_y_up(p);
     let camera = Camera::try_new(
@@ -246,7 +156,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         a.fov.unwrap_or(base.fov_y_deg),
     )
     .map_err(|e| input(format!("camera options (--camera-position, --look-at, --fov): {e}")))?;
-    let lit = prepared.scene.lit_share_seen_by(&camera);
+    let lit = radiosity_image::lit_share_seen_by(&prepared.scene, &camera);
     if lit < 0.05 {
         note(format_args!(
             "warning: the camera sees almost no lit face ({:.0} % of a coarse probe): it looks at nothing or at the backs of one-sided surfaces, so the picture will be nearly black; move it (--camera-position, --look-at), or make the surfaces two-sided (--sides 2 for model files, sides = 2 in a scene file)",
@@ -254,7 +164,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         ))?;
     }
     if a.reference {
-        let radiance = crate::verify_cmd::reference_picture(
+        let radiance = crate::reference_run::reference_picture(
             &prepared,
             &camera,
             a.width,
@@ -316,18 +226,4 @@ fn write_pictures(a: &RenderArgs, radiance: &HdrImage) -> Result<()> {
         note(format_args!("wrote {} (linear radiance)", path.display()))?;
     }
     Ok(())
-}
-
-/// Runs `tonemap`.
-pub fn run_tonemap(a: TonemapArgs) -> Result<()> {
-    Targets::new(a.force).file(&a.output, "-o")?;
-    PictureFormat::of(&a.output).map_err(|e| input(format!("-o: {e}")))?;
-    // A missing or malformed input is the user's to fix: exit code 2.
-    let radiance = read_hdr(&a.input).map_err(|e| input(e.to_string()))?;
-    let ev = write_tonemapped(&a.output, a.force, &radiance, &a.tone)?;
-    note(format_args!(
-        "wrote {} (exposure {ev:+.2} EV, {})",
-        a.output.display(),
-        ToneOperator::from(a.tone.tonemap)
-    ))
 }

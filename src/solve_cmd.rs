@@ -5,13 +5,14 @@ use clap::Args;
 use serde_json::json;
 
 use crate::output::{self, Targets};
-use crate::prepare::{Prepared, SolveOpts, prepare, run_solver};
+use crate::prepare::{Prepared, prepare, run_solver};
+use crate::solve_opts::SolveOpts;
 
 /// Arguments of `radiosity solve`.
 #[derive(Args)]
 pub struct SolveArgs {
-    /// The scene to load: see [`SCENE_HELP`](crate::prepare::SCENE_HELP).
-    #[arg(help = crate::prepare::SCENE_HELP)]
+    /// The scene to load: see [`SCENE_HELP`](crate::solve_opts::SCENE_HELP).
+    #[arg(help = crate::solve_opts::SCENE_HELP)]
     pub scene: String,
     /// Write the JSON report here (`-` for stdout).
     #[arg(long)]

@@ -1,30 +1,34 @@
 //! `radiosity verify`: solve a scene as `solve` would, estimate the same quantities with the
 //! independent Monte Carlo reference (`radiosity_reference`), and print both side by side with
-//! their difference in per cent and in standard errors; and the reference picture behind
-//! `render --reference`.
+//! their difference in per cent and in standard errors (the comparison itself is
+//! [`crate::comparison`], the reference runs are [`crate::reference_run`]).
 
 use std::sync::Arc;
 use std::time::Duration;
 
 use anyhow::Result;
 use clap::Args;
-use radiosity_core::random::Rng;
-use radiosity_core::{Camera, Mesh, Rgb};
-use radiosity_image::HdrImage;
-use radiosity_reference::{Estimate, EstimateParams, PathBudget, PictureParams, Reference, Region};
+use radiosity_mesh::Mesh;
+use radiosity_reference::{EstimateParams, PathBudget, Reference};
 use radiosity_solver::{ObjectRadiosity, Problem};
 use serde_json::{Value, json};
 
+use crate::comparison::{
+    Summary, compare_objects, fmt_pct, fmt_sigma, judged, num, over_whole_area, with_back_faces,
+};
+use crate::errors::InputError;
 use crate::interrupt::Interrupted;
 use crate::output::{Targets, write_report};
-use crate::prepare::{InputError, Prepared, SolveOpts, prepare, run_solver};
-use crate::progress::{Progress, spinning};
+use crate::prepare::{Prepared, prepare, run_solver};
+use crate::progress::spinning;
+use crate::reference_run::{compare_elements, reference_progress, report_progress};
+use crate::solve_opts::SolveOpts;
 
 /// Arguments of `radiosity verify`.
 #[derive(Args)]
 pub struct VerifyArgs {
-    /// The scene to load: see [`SCENE_HELP`](crate::prepare::SCENE_HELP).
-    #[arg(help = crate::prepare::SCENE_HELP)]
+    /// The scene to load: see [`SCENE_HELP`](crate::solve_opts::SCENE_HELP).
+    #[arg(help = crate::solve_opts::SCENE_HELP)]
     pub scene: String,
     /// Paths per object for the reference (a fixed count, not cut short by a default time
     /// budget); default: as many as it takes to bring every channel's standard error to
@@ -85,184 +89,6 @@ pub fn scale_solver_reflectance(mesh: &mut Mesh, factor: f64) -> Result<()> {
         m.reflectance *= factor;
     }
     Ok(())
-}
-
-/// `objects`, then the back face of every two-sided one as an object of its own named
-/// `NAME (back)`: the order of [`Reference::objects`].
-pub(crate) fn with_back_faces(objects: Vec<ObjectRadiosity>) -> Vec<ObjectRadiosity> {
-    let backs: Vec<ObjectRadiosity> = objects
-        .iter()
-        .filter_map(|o| {
-            Some(ObjectRadiosity {
-                name: format!("{} (back)", o.name),
-                area: o.area,
-                emitted_power: Rgb::ZERO,
-                radiosity: o.radiosity_back?,
-                radiosity_back: None,
-            })
-        })
-        .collect();
-    objects.into_iter().chain(backs).collect()
-}
-
-/// Each object's means spread over its whole input area: the mesh leaves out what solids
-/// standing on a surface cover (`Mesh::hidden_area`), while the reference samples the whole
-/// input polygon, whose covered part no light reaches (it sees only the inside of the solid).
-pub(crate) fn over_whole_area(mut objects: Vec<ObjectRadiosity>, hidden: &[f64]) -> Vec<ObjectRadiosity> {
-    for (o, &hidden) in objects.iter_mut().zip(hidden) {
-        let whole = o.area + hidden;
-        if hidden > 0.0 && whole > 0.0 {
-            let f = o.area / whole;
-            o.radiosity *= f;
-            o.radiosity_back = o.radiosity_back.map(|b| b * f);
-            o.area = whole;
-        }
-    }
-    objects
-}
-
-/// The reference's progress display ([`report_progress`] feeds it).
-pub(crate) fn reference_progress(what: &str) -> Progress {
-    Progress::bar(what, 0, "")
-}
-
-/// Shows the reference's paths done of those planned, its rate and an ETA.
-pub(crate) fn report_progress(progress: &Progress, p: radiosity_reference::Progress) {
-    let secs = p.elapsed.as_secs_f64();
-    let rate = p.paths_done as f64 / secs.max(1e-9);
-    // An adaptive estimate plans round by round: the ETA is to the end of this round.
-    let eta = (p.paths_planned.saturating_sub(p.paths_done)) as f64 / rate.max(1e-9);
-    progress.set(
-        p.paths_done,
-        p.paths_planned.max(1),
-        format!(
-            "{:.1} of {:.1} M paths planned, {:.2} M paths/s, ETA {eta:.0} s",
-            p.paths_done as f64 / 1e6,
-            p.paths_planned as f64 / 1e6,
-            rate / 1e6
-        ),
-    );
-}
-
-/// Says what the reference ran (paths, time, whether its time limit stopped it) and pairs
-/// each solved object with its reference estimate.
-///
-/// # Errors
-/// The note cannot be written (a closed stderr).
-pub(crate) fn compare_objects(
-    estimates: &radiosity_reference::Estimates,
-    solved: &[radiosity_solver::ObjectRadiosity],
-    interrupted: bool,
-) -> Result<Vec<Comparison>> {
-    let secs = estimates.elapsed.as_secs_f64();
-    let stopped = match (interrupted, estimates.timed_out) {
-        (true, _) => ", stopped by Ctrl-C",
-        (false, true) => ", stopped by its time budget",
-        (false, false) => "",
-    };
-    crate::output::note(format_args!(
-        "reference: {:.1} M paths in {:.1} s ({:.2} M paths/s){stopped}; {}",
-        estimates.paths as f64 / 1e6,
-        secs,
-        estimates.paths as f64 / secs.max(1e-9) / 1e6,
-        precision(estimates)
-    ))?;
-    Ok(solved
-        .iter()
-        .zip(&estimates.objects)
-        .map(|(s, r)| Comparison { solve: s.radiosity, reference: r.estimate })
-        .collect())
-}
-
-/// How precise the reference got: the largest and the median standard error of the lit
-/// objects' luminance, relative to it.
-fn precision(estimates: &radiosity_reference::Estimates) -> String {
-    let errors: Vec<(f64, &str)> = estimates
-        .objects
-        .iter()
-        .filter(|o| o.estimate.luminance > 0.0)
-        .map(|o| (o.estimate.luminance_stderr / o.estimate.luminance * 100.0, o.name.as_str()))
-        .collect();
-    let Some(&(worst, name)) = errors.iter().max_by(|a, b| a.0.total_cmp(&b.0)) else {
-        return "no object has light to estimate".into();
-    };
-    let median = median(errors.iter().map(|e| e.0).collect()).unwrap_or(worst);
-    let worst = if worst.is_finite() { format!("{worst:.2} %") } else { "unknown (too few paths)".into() };
-    format!("standard error at most {worst} ({name}), median {median:.2} %")
-}
-
-/// One solve value against its reference estimate.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Comparison {
-    /// The solver's value.
-    pub(crate) solve: Rgb,
-    /// The reference's estimate of it.
-    pub(crate) reference: Estimate,
-}
-
-impl Comparison {
-    /// (solve − reference) / reference per channel, in per cent (`None` where the reference
-    /// is 0).
-    fn percent(&self) -> [Option<f64>; 3] {
-        let (s, r) = (self.solve.to_array(), self.reference.mean.to_array());
-        [0, 1, 2].map(|i| (r[i] != 0.0).then(|| (s[i] - r[i]) / r[i] * 100.0))
-    }
-
-    /// (solve − reference) / standard error per channel.
-    fn sigma(&self) -> [f64; 3] {
-        let (s, r, e) =
-            (self.solve.to_array(), self.reference.mean.to_array(), self.reference.stderr.to_array());
-        [0, 1, 2].map(|i| z_score(s[i] - r[i], e[i], r[i]))
-    }
-
-    /// (solve − reference) / reference in luminance, in per cent (`None` where the
-    /// reference is 0).
-    pub(crate) fn luminance_percent(&self) -> Option<f64> {
-        let r = self.reference.luminance;
-        (r != 0.0).then(|| (self.solve.luminance() - r) / r * 100.0)
-    }
-
-    /// (solve − reference) / standard error in luminance.
-    pub(crate) fn luminance_sigma(&self) -> f64 {
-        let r = self.reference.luminance;
-        z_score(self.solve.luminance() - r, self.reference.luminance_stderr, r)
-    }
-}
-
-/// A difference in standard errors. An exact reference (a light that only emits: every path
-/// gives its emission) has a standard error of round-off only; below 1e-9 of the value it
-/// counts as 1e-9 of the value, so round-off never reads as a significant difference.
-fn z_score(diff: f64, stderr: f64, reference: f64) -> f64 {
-    let floor = 1e-9 * reference.abs();
-    if stderr.max(floor) > 0.0 {
-        diff / stderr.max(floor)
-    } else if diff == 0.0 {
-        0.0
-    } else {
-        diff.signum() * f64::INFINITY
-    }
-}
-
-/// A number for JSON: non-finite values become null.
-pub(crate) fn num(x: f64) -> Value {
-    if x.is_finite() { json!(x) } else { Value::Null }
-}
-
-fn fmt_pct(p: Option<f64>) -> String {
-    p.map_or_else(|| "—".into(), |p| format!("{p:+.2}"))
-}
-
-fn fmt_sigma(z: f64) -> String {
-    if z.is_finite() { format!("{z:+.1}") } else { format!("{}∞", if z > 0.0 { "+" } else { "−" }) }
-}
-
-fn median(mut v: Vec<f64>) -> Option<f64> {
-    if v.is_empty() {
-        return None;
-    }
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    Some(if n % 2 == 1 { v[n / 2] } else { 0.5 * (v[n / 2 - 1] + v[n / 2]) })
 }
 
 /// Runs `verify`.
@@ -521,236 +347,4 @@ fn interrupted_solve(
         report.unshot_fraction * 100.0
     ))
     .into())
-}
-
-/// `(index, difference %, difference σ)` of every row with light to compare: objects that
-/// are dark in both (nothing to compare) are left out of the summary.
-pub(crate) fn judged(rows: &[Comparison]) -> Vec<(usize, f64, f64)> {
-    rows.iter()
-        .enumerate()
-        .filter_map(|(i, c)| c.luminance_percent().map(|p| (i, p, c.luminance_sigma())))
-        .collect()
-}
-
-/// The verdict over some of the compared objects: how many differ by more than 3 σ, the
-/// worst, the median |difference| and the area-weighted mean difference.
-pub(crate) struct Summary {
-    /// Objects judged.
-    pub(crate) objects: usize,
-    /// Of them, those more than 3 σ off.
-    pub(crate) over: usize,
-    /// `(name, difference %, difference σ)`.
-    pub(crate) worst: Option<(String, f64, f64)>,
-    /// Median |difference|, per cent.
-    pub(crate) median_abs: Option<f64>,
-    /// Area-weighted mean difference, per cent.
-    pub(crate) area_weighted: Option<f64>,
-    /// The one-line verdict.
-    pub(crate) text: String,
-}
-
-impl Summary {
-    /// The verdict over `judged` (`(index into solved, difference %, difference σ)`).
-    pub(crate) fn of(judged: &[(usize, f64, f64)], solved: &[ObjectRadiosity]) -> Self {
-        let over = judged.iter().filter(|(_, _, z)| z.abs() > 3.0).count();
-        let worst = judged
-            .iter()
-            .max_by(|x, y| x.1.abs().total_cmp(&y.1.abs()))
-            .map(|&(i, p, z)| (solved[i].name.clone(), p, z));
-        let median_abs = median(judged.iter().map(|j| j.1.abs()).collect());
-        let area_weighted = {
-            let (mut sum, mut area) = (0.0, 0.0);
-            for &(i, p, _) in judged {
-                sum += p * solved[i].area;
-                area += solved[i].area;
-            }
-            (area > 0.0).then(|| sum / area)
-        };
-        let text = match &worst {
-            Some((name, p, z)) => format!(
-                "{over} of {} objects differ by more than 3 σ; worst {name} {p:+.2} % ({} σ), median |difference| {:.2} %, area-weighted mean {:+.2} %",
-                judged.len(),
-                fmt_sigma(*z),
-                median_abs.unwrap_or(0.0),
-                area_weighted.unwrap_or(0.0)
-            ),
-            None => "no object has light to compare".into(),
-        };
-        Self { objects: judged.len(), over, worst, median_abs, area_weighted, text }
-    }
-
-    /// The report's form of it, with `text` as its text.
-    pub(crate) fn json(&self, text: &str) -> Value {
-        json!({
-            "text": text,
-            "objects": self.objects,
-            "over_3_sigma": self.over,
-            "worst": self.worst.as_ref().map(|(name, p, z)| json!({"name": name, "difference_percent": num(*p), "difference_sigma": num(*z)})),
-            "median_abs_difference_percent": self.median_abs,
-            "area_weighted_difference_percent": self.area_weighted,
-        })
-    }
-}
-
-/// What the element sample adds to the table and to the report.
-struct ElementPart {
-    text: String,
-    json: Value,
-}
-
-/// Compares `count` elements drawn at random (seeded) with reference estimates over each.
-fn compare_elements(
-    reference: &Reference,
-    mesh: &Mesh,
-    element_radiosity: &[Rgb],
-    count: usize,
-    paths: u64,
-    seed: u64,
-    max_reflections: u32,
-) -> Result<ElementPart> {
-    // A partial Fisher–Yates shuffle: `count` distinct elements, the same for a seed.
-    let n = mesh.elements.len();
-    let mut order: Vec<usize> = (0..n).collect();
-    let mut rng = Rng::for_task(seed, 0x656c_656d, 0); // "elem"
-    let k = count.min(n);
-    for i in 0..k {
-        let j = i + (rng.next_u64() % (n - i) as u64) as usize;
-        order.swap(i, j);
-    }
-    let mut sample = order[..k].to_vec();
-    sample.sort_unstable();
-    let regions: Vec<Region> = sample
-        .iter()
-        .map(|&e| {
-            let object = mesh.element_object(e);
-            let object = if mesh.element_is_back(e) {
-                reference.back_object(object).unwrap_or(object)
-            } else {
-                object
-            };
-            Region { object, corners: mesh.element_corners(e).collect() }
-        })
-        .collect();
-    let params = EstimateParams {
-        budget: PathBudget::Fixed { paths },
-        seed,
-        max_reflections,
-        ..EstimateParams::default()
-    };
-    let progress = reference_progress("elements");
-    let estimates = reference.estimate_regions_until(
-        &regions,
-        &params,
-        &|p| report_progress(&progress, p),
-        &crate::interrupt::requested,
-    )?;
-    drop(progress);
-
-    let rows: Vec<(usize, Comparison)> = sample
-        .iter()
-        .zip(&estimates)
-        .map(|(&e, r)| (e, Comparison { solve: element_radiosity[e], reference: *r }))
-        .collect();
-    // Relative differences in luminance, over the elements the reference sees lit; the
-    // noise part is what the reference's own standard errors alone would give.
-    let lit: Vec<&(usize, Comparison)> = rows.iter().filter(|(_, c)| c.reference.luminance > 0.0).collect();
-    let m = lit.len().max(1) as f64;
-    let rms =
-        (lit.iter().map(|(_, c)| (c.luminance_percent().unwrap_or(0.0)).powi(2)).sum::<f64>() / m).sqrt();
-    let noise = (lit
-        .iter()
-        .map(|(_, c)| (c.reference.luminance_stderr / c.reference.luminance * 100.0).powi(2))
-        .sum::<f64>()
-        / m)
-        .sqrt();
-    let beyond = (rms * rms - noise * noise).max(0.0).sqrt();
-    let mean = lit.iter().map(|(_, c)| c.luminance_percent().unwrap_or(0.0)).sum::<f64>() / m;
-
-    let mut text = format!(
-        "\n{} elements sampled, {} paths each: RMS difference {:.2} % (reference noise alone {:.2} %, beyond noise {:.2} %), mean {:+.2} %\n",
-        rows.len(),
-        paths,
-        rms,
-        noise,
-        beyond,
-        mean
-    );
-    let mut worst: Vec<&(usize, Comparison)> = lit.clone();
-    worst.sort_by(|x, y| y.1.luminance_sigma().abs().total_cmp(&x.1.luminance_sigma().abs()));
-    let shown = worst.len().min(20);
-    text += &format!(
-        "the {shown} largest in σ:\n{:>9} {:<20} {:>11} {:>11} {:>9} {:>8} {:>8}\n",
-        "element", "object", "solve Y", "reference Y", "± σ %", "diff %", "diff σ"
-    );
-    for (e, c) in &worst[..shown] {
-        text += &format!(
-            "{:>9} {:<20} {:>11.5e} {:>11.5e} {:>9.3} {:>8} {:>8}\n",
-            e,
-            mesh.object_names[mesh.element_object(*e)],
-            c.solve.luminance(),
-            c.reference.luminance,
-            c.reference.luminance_stderr / c.reference.luminance * 100.0,
-            fmt_pct(c.luminance_percent()),
-            fmt_sigma(c.luminance_sigma())
-        );
-    }
-    let json = json!({
-        "count": rows.len(),
-        "paths_per_element": paths,
-        "rms_difference_percent": rms,
-        "rms_noise_percent": noise,
-        "rms_beyond_noise_percent": beyond,
-        "mean_difference_percent": mean,
-        "elements": rows.iter().map(|(e, c)| json!({
-            "element": e,
-            "object": mesh.object_names[mesh.element_object(*e)],
-            "area": mesh.elements[*e].area,
-            "centre": mesh.elements[*e].centre.to_array(),
-            "radiosity": c.solve.to_array(),
-            "reference": c.reference.mean.to_array(),
-            "stderr": c.reference.stderr.to_array(),
-        })).collect::<Vec<_>>(),
-    });
-    Ok(ElementPart { text, json })
-}
-
-/// Renders `camera`'s view of the prepared scene with the reference estimator, printing how
-/// long it took and how noisy it is: the picture behind `render --reference`.
-///
-/// # Errors
-/// Picture settings out of range (exit code 2).
-pub fn reference_picture(
-    prepared: &Prepared,
-    camera: &Camera,
-    width: u32,
-    height: u32,
-    samples_per_pixel: u32,
-    seed: u64,
-) -> Result<HdrImage> {
-    let reference = Reference::new(&prepared.scene);
-    let params = PictureParams { width, height, samples_per_pixel, seed };
-    let start = std::time::Instant::now();
-    let progress = Progress::bar("reference", u64::from(height), "rows");
-    let picture = reference.render(camera, &params, &|| progress.inc()).map_err(|e| input(e.to_string()))?;
-    drop(progress);
-    // The noise floor of any comparison with this picture: the pixels' relative standard
-    // error in luminance (bounded by the channels' own).
-    let (mut sum, mut count) = (0.0, 0usize);
-    for (l, s) in picture.radiance.iter().zip(&picture.stderr) {
-        let y = l.luminance();
-        if y > 0.0 && s.is_finite() {
-            sum += s.luminance() / y;
-            count += 1;
-        }
-    }
-    crate::output::note(format_args!(
-        "{}: reference picture {}×{} at {} paths per pixel in {:.1} s; mean relative standard error per pixel {}",
-        prepared.scene.name,
-        width,
-        height,
-        samples_per_pixel,
-        start.elapsed().as_secs_f64(),
-        if count > 0 { format!("{:.2} %", sum / count as f64 * 100.0) } else { "—".into() }
-    ))?;
-    Ok(HdrImage::from_pixels(width, height, picture.radiance))
 }

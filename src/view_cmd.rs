@@ -7,9 +7,11 @@ use clap::{Args, ValueEnum};
 use radiosity_image::Exposure;
 use radiosity_viewer::{Detail, DisplayMode, Wireframe};
 
+use crate::errors::InputError;
+use crate::load_scene::{Settings, settings};
 use crate::output::Targets;
-use crate::prepare::{InputError, Settings, SolveOpts, settings};
-use crate::render_cmd::ToneOpts;
+use crate::picture_opts::ToneOpts;
+use crate::solve_opts::SolveOpts;
 
 /// What the surfaces show, on the command line.
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -50,8 +52,8 @@ pub enum DetailArg {
 /// Arguments of `radiosity view`.
 #[derive(Args)]
 pub struct ViewArgs {
-    /// The scene to load: see [`SCENE_HELP`](crate::prepare::SCENE_HELP).
-    #[arg(help = crate::prepare::SCENE_HELP, default_value = "cornell")]
+    /// The scene to load: see [`SCENE_HELP`](crate::solve_opts::SCENE_HELP).
+    #[arg(help = crate::solve_opts::SCENE_HELP, default_value = "cornell")]
     pub scene: String,
     /// Write the window's content to this PNG once the solve has done --after-shots shots (or
     /// has stopped, without it), then exit. Runs headless under scripts/xvfb-run.sh.
@@ -135,7 +137,7 @@ pub fn run(a: ViewArgs) -> Result<()> {
         Exposure::Ev(ev) => Some(ev),
         Exposure::Auto => None,
         Exposure::AutoPlus(_) => {
-            return Err(crate::prepare::InputError(
+            return Err(crate::errors::InputError(
                 "--exposure auto±EV is for pictures; in the viewer, start from auto and use its exposure slider".into(),
             )
             .into());

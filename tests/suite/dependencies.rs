@@ -1,7 +1,7 @@
 //! The crate graph keeps its shape: the solver never depends, directly or through another
 //! crate, on a window, picture, command-line or file-format crate (it returns data and never
-//! draws, reads files or parses arguments), and the scene loader needs neither the solver nor
-//! the picture files.
+//! draws, reads files or parses arguments), the scene loader needs neither the solver nor
+//! the picture files, and the scene vocabulary and the mesher need neither rays nor threads.
 //!
 //! Asked of `cargo tree` over the lock file (`--offline`, `--locked`: no network, no change
 //! to `Cargo.lock`), for the host platform (other platforms' crates need not be downloaded)
@@ -73,6 +73,26 @@ fn the_scene_loader_needs_no_solver_or_picture_files() {
         "radiosity_io",
         &["radiosity_solver", "radiosity_accel", "radiosity_image", "exr", "rayon"],
     );
+}
+
+#[test]
+fn the_scene_vocabulary_and_the_mesher_stand_alone() {
+    let workspace = [
+        "radiosity_accel",
+        "radiosity_solver",
+        "radiosity_image",
+        "radiosity_io",
+        "radiosity_export",
+        "radiosity_viewer",
+        "radiosity_reference",
+    ];
+    // Every crate depends on the vocabulary: a meshing change must not rebuild it.
+    let mut core_forbidden = workspace.to_vec();
+    core_forbidden.extend(["radiosity_mesh", "rayon", "obvhs"]);
+    assert_free_of("radiosity_core", &core_forbidden);
+    let mut mesh_forbidden = workspace.to_vec();
+    mesh_forbidden.extend(["rayon", "obvhs", "serde_json", "toml"]);
+    assert_free_of("radiosity_mesh", &mesh_forbidden);
 }
 
 /// The check itself can fail: the viewer does depend on the window crates.

@@ -5,10 +5,11 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use radiosity_core::{Mesh, MeshParams, Rgb, Scene, Sides};
+use radiosity_core::{MeshParams, Rgb, Scene, Sides};
 use radiosity_io::{
     LoadError, LoadOptions, ModelFormat, Transform, load_scene, load_scene_with, parse_model, resolve_scene,
 };
+use radiosity_mesh::Mesh;
 use radiosity_solver::{Problem, SolverParams};
 
 fn scenes() -> PathBuf {

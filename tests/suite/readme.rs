@@ -10,8 +10,16 @@ use std::process::{Command, Output, Stdio};
 /// The commands whose first argument is a SCENE; their help must name every form it takes.
 const SCENE_COMMANDS: [&str; 6] = ["solve", "info", "render", "view", "export", "verify"];
 
-/// The READMEs whose `sh` blocks are run.
-const READMES: [&str; 2] = ["README.md", "crates/radiosity_viewer/README.md"];
+/// The READMEs and reference pages whose `sh` blocks are run.
+const READMES: [&str; 7] = [
+    "README.md",
+    "crates/radiosity_viewer/README.md",
+    "docs/CLI.md",
+    "docs/FORMAT.md",
+    "docs/ACCURACY.md",
+    "docs/PERFORMANCE.md",
+    "docs/ARCHITECTURE.md",
+];
 
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -170,21 +178,37 @@ fn other_command(command: &str) -> Result<(), String> {
     match words.as_slice() {
         ["./setup.sh"] => exists("setup.sh"),
         ["cargo", "test", "--workspace"] => Ok(()),
-        ["cargo", "test", "-p", "radiosity_viewer", "--features", feature] => {
-            let manifest =
-                std::fs::read_to_string(root().join("crates/radiosity_viewer/Cargo.toml")).unwrap();
-            let declared = manifest.lines().any(|l| l.starts_with(&format!("{feature} =")));
-            if declared { Ok(()) } else { Err(format!("radiosity_viewer has no feature {feature}")) }
-        }
         ["cargo", "bench", "-p", crate_name]
         | ["cargo", "bench", "-p", crate_name, "--features", "bench"] => {
             exists(&format!("crates/{crate_name}/benches"))
         }
         ["cargo", "install", "--locked", "--path", "."] => exists("Cargo.toml"),
+        ["cargo", "run", "--release", "-p", crate_name, "--example", example, "--", ..] => {
+            exists(&format!("crates/{crate_name}/examples/{example}.rs"))
+        }
         ["pip", "install", ..] => Ok(()),
         ["python3", script, ..] => exists(script),
         _ => Err("not a command this test knows; add it to `other_command`".into()),
     }
+}
+
+/// The README's test command is one command, and CI runs exactly it: what a contributor runs
+/// is what decides a merge, and nothing is built twice with other features.
+#[test]
+fn ci_runs_the_readme_test_command() {
+    let tests: Vec<String> = readme_commands()
+        .into_iter()
+        .filter(|(readme, _, c)| readme == "README.md" && c.starts_with("cargo test"))
+        .map(|(_, _, c)| c)
+        .collect();
+    assert_eq!(tests, ["cargo test --workspace"], "the README's test commands");
+    let ci = std::fs::read_to_string(root().join(".ci/run")).unwrap();
+    let ci_tests: Vec<&str> = ci
+        .lines()
+        .map(|l| l.split(" #").next().unwrap_or("").trim())
+        .filter(|l| l.contains("cargo test"))
+        .collect();
+    assert_eq!(ci_tests, [tests[0].as_str()], ".ci/run's test commands");
 }
 
 /// Runs every README command line: `radiosity …`, `cargo run --release -- …` and

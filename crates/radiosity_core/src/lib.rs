@@ -1,25 +1,21 @@
 //! Vocabulary of the `radiosity` renderer: linear colour ([`Rgb`]), validated scenes
-//! ([`Scene`], [`Material`], [`Object`]), and meshing into shooting patches and receiving
-//! elements ([`Mesh`], [`MeshParams`]).
+//! ([`Scene`], [`Material`], [`Object`]), how finely to mesh them ([`MeshParams`]; the mesher
+//! is the `radiosity_mesh` crate), camera rays, seeded random streams and the canonical scenes.
 //!
 //! Units: positions in scene units (any length unit, used consistently), radiosity and
 //! emission in W per unit², power in W.
 #![warn(missing_docs)]
 #![forbid(unsafe_code)]
 
-mod auto_camera;
 mod canonical;
 mod color;
-mod contacts;
 mod film;
-mod grading;
-mod mesh;
+mod limits;
+mod mesh_params;
 mod one_line;
-mod planar;
 pub mod random;
 mod scene;
-mod sealed;
-mod shadows;
+mod scene_error;
 mod srgb;
 mod up;
 
@@ -29,20 +25,18 @@ pub use canonical::{
 };
 pub use color::Rgb;
 pub use film::CameraRays;
-pub use mesh::{
+pub use limits::{MAX_COORDINATE, MAX_POLYGON_VERTICES, MAX_TIME_LIMIT_SECONDS};
+pub use mesh_params::{
     DEFAULT_ADAPTIVE_LEVELS, DEFAULT_CORNER_REFINEMENT, DEFAULT_CREASE_ANGLE_DEG,
-    DEFAULT_PROXIMITY_REFINEMENT, Element, MAX_ADAPTIVE_LEVELS, MAX_CORNER_REFINEMENT, MAX_ELEMENTS,
-    MAX_PROXIMITY_REFINEMENT, Mesh, MeshError, MeshParams, Patch, Refinement, Smoothing, Surface,
-    estimate_elements, first_object_over_limit,
+    DEFAULT_PROXIMITY_REFINEMENT, MAX_ADAPTIVE_LEVELS, MAX_CORNER_REFINEMENT, MAX_PROXIMITY_REFINEMENT,
+    MeshParams,
 };
 pub use one_line::{MAX_PART_CHARS, escape_controls, one_line};
-pub use planar::distance_to_polygon;
 pub use scene::{
-    Camera, Facing, MAX_COORDINATE, MAX_POLYGON_VERTICES, MAX_TIME_LIMIT_SECONDS, Material, Object, Polygon,
-    PolygonMesh, Scene, SceneError, Shape, Sides, SolverSettings, Sphere, box_faces, check_coordinate,
-    coordinate_in_range, unique_names,
+    Camera, Facing, Material, Object, Polygon, PolygonMesh, Scene, Shape, Sides, SolverSettings, Sphere,
+    box_faces, check_coordinate, coordinate_in_range, unique_names,
 };
-pub use sealed::{MAX_HOLE_SHARE, Sealed, seal_closed_objects};
+pub use scene_error::SceneError;
 pub use srgb::{encode_srgb, srgb_decode, srgb_encode};
 pub use up::{UpAxis, UpGuess};
 

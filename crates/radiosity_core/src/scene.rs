@@ -4,184 +4,9 @@
 //! `Sphere::try_new`, `Scene::try_new`) so that a file loader can attach a file/line location
 //! to each error it gets back.
 
+use crate::limits::{MAX_COORDINATE, MAX_POLYGON_VERTICES};
+use crate::{MeshParams, Rgb, SceneError};
 use glam::DVec3;
-use thiserror::Error;
-
-use crate::Rgb;
-
-/// Why a material, a piece of geometry or a whole scene is not acceptable.
-#[derive(Clone, Debug, Error, PartialEq)]
-pub enum SceneError {
-    /// A reflectance channel is outside [0, 1) or not finite.
-    #[error(
-        "reflectance of material '{material}' must be in [0, 1) in every channel, got {value:?} (ρ ≥ 1 never converges: energy is never lost)"
-    )]
-    ReflectanceOutOfRange {
-        /// Material name.
-        material: String,
-        /// The offending `[r, g, b]`.
-        value: [f64; 3],
-    },
-    /// An emission channel is negative or not finite.
-    #[error("emission of material '{material}' must be finite and ≥ 0 in every channel, got {value:?}")]
-    EmissionOutOfRange {
-        /// Material name.
-        material: String,
-        /// The offending `[r, g, b]`.
-        value: [f64; 3],
-    },
-    /// A coordinate is NaN or infinite.
-    #[error("coordinates must be finite numbers, got {value:?}")]
-    NonFiniteCoordinate {
-        /// The offending point.
-        value: [f64; 3],
-    },
-    /// A coordinate lies farther from the origin than [`MAX_COORDINATE`] on some axis.
-    #[error(
-        "coordinates must be within ±{limit:e} scene units of the origin, got {value:?}; move the scene nearer the origin or use larger units"
-    )]
-    CoordinateOutOfRange {
-        /// The offending point.
-        value: [f64; 3],
-        /// [`MAX_COORDINATE`].
-        limit: f64,
-    },
-    /// A polygon has fewer than three vertices.
-    #[error("a polygon needs at least 3 vertices, got {count}")]
-    TooFewVertices {
-        /// Number of vertices given.
-        count: usize,
-    },
-    /// A polygon has more vertices than [`MAX_POLYGON_VERTICES`].
-    #[error(
-        "polygon has {count} vertices, more than the {limit} accepted; give the curve fewer corners or as a model's triangles"
-    )]
-    TooManyVertices {
-        /// Number of vertices given.
-        count: usize,
-        /// [`MAX_POLYGON_VERTICES`].
-        limit: usize,
-    },
-    /// A polygon's area is zero (collinear or repeated vertices).
-    #[error("polygon is degenerate: its area is {area:e}, its vertices are collinear or repeated")]
-    DegeneratePolygon {
-        /// Area found.
-        area: f64,
-    },
-    /// A polygon's vertices do not lie in one plane.
-    #[error(
-        "polygon is not planar: a vertex is {distance:e} off the polygon's plane (tolerance {tolerance:e}); split it into triangles"
-    )]
-    NonPlanarPolygon {
-        /// Largest distance of a vertex from the best-fit plane.
-        distance: f64,
-        /// Tolerance used.
-        tolerance: f64,
-    },
-    /// A polygon is not convex.
-    #[error("polygon is not convex at vertex {vertex}; split it into convex polygons")]
-    NonConvexPolygon {
-        /// Index of the offending vertex.
-        vertex: usize,
-    },
-    /// A sphere radius is not a positive finite number, or is over [`MAX_COORDINATE`].
-    #[error(
-        "sphere radius must be a finite number > 0, got {radius}; the largest accepted is {MAX_COORDINATE:e}"
-    )]
-    BadRadius {
-        /// Radius given.
-        radius: f64,
-    },
-    /// A box has min ≥ max on some axis.
-    #[error("box min must be below max on every axis, got min {min:?} max {max:?}")]
-    EmptyBox {
-        /// Minimum corner.
-        min: [f64; 3],
-        /// Maximum corner.
-        max: [f64; 3],
-    },
-    /// An object names a material that does not exist.
-    #[error("object '{object}' uses material '{material}', which is not defined (defined: {known})")]
-    UnknownMaterial {
-        /// Object name.
-        object: String,
-        /// Material name asked for.
-        material: String,
-        /// Comma-separated list of the defined materials.
-        known: String,
-    },
-    /// Two materials share a name.
-    #[error("material '{name}' is defined twice")]
-    DuplicateMaterial {
-        /// The repeated name.
-        name: String,
-    },
-    /// Nothing in the scene emits light.
-    #[error("the scene has no light: no object uses a material with emission > 0")]
-    NoEmitter,
-    /// The scene has no objects at all.
-    #[error("the scene has no objects")]
-    NoObjects,
-    /// A mesh size parameter is not a positive finite number.
-    #[error("{key} must be a finite number > 0, got {value}")]
-    BadMeshSize {
-        /// `patch_size` or `element_size`.
-        key: &'static str,
-        /// Value given.
-        value: f64,
-    },
-    /// A crease angle outside [0, 180) degrees.
-    #[error("crease_angle must be a number of degrees in [0, 180), got {value}")]
-    BadCreaseAngle {
-        /// Value given.
-        value: f64,
-    },
-    /// A corner refinement beyond the largest allowed.
-    #[error("corner_refinement must be a whole number in [0, 6], got {value}")]
-    BadCornerRefinement {
-        /// Value given.
-        value: u32,
-    },
-    /// A proximity refinement beyond the largest allowed.
-    #[error("proximity_refinement must be a whole number in [0, 4], got {value}")]
-    BadProximityRefinement {
-        /// Value given.
-        value: u32,
-    },
-    /// Adaptive subdivision levels beyond the largest allowed.
-    #[error("adaptive_levels must be a whole number in [0, 4], got {value}")]
-    BadAdaptiveLevels {
-        /// Value given.
-        value: u32,
-    },
-    /// A camera is degenerate.
-    #[error("camera is degenerate: {reason}")]
-    BadCamera {
-        /// What is wrong.
-        reason: String,
-    },
-    /// A face of a polygon mesh refers to a vertex that does not exist.
-    #[error("face {face}: vertex index {index} out of range (the mesh has {count} vertices)")]
-    VertexIndexOutOfRange {
-        /// 0-based face number.
-        face: usize,
-        /// The offending 0-based vertex index.
-        index: usize,
-        /// Number of vertices in the mesh.
-        count: usize,
-    },
-    /// A face of a polygon mesh is not a valid polygon.
-    #[error("face {face}: {source}")]
-    BadMeshFace {
-        /// 0-based face number.
-        face: usize,
-        /// Why the face's polygon was rejected.
-        source: Box<SceneError>,
-    },
-    /// A polygon mesh has no faces.
-    #[error("the mesh has no faces")]
-    EmptyMesh,
-}
 
 /// A diffuse (Lambertian) material.
 #[derive(Clone, Debug, PartialEq)]
@@ -670,29 +495,6 @@ impl Camera {
     }
 }
 
-/// Most vertices of one polygon (or one model face): 1024. Validation is linear in the
-/// corners, but the mesher cuts a polygon into a fan of triangles, each meshed on its own
-/// lattice as long as the polygon is wide, and a concave model face is ear-clipped into such
-/// slivers: a 4096-corner light made half a million elements and solved in 37 s, a
-/// 10⁵-corner one never finished (every patch shoots, each shot visiting every patch). A
-/// 1024-gon solves in about 4 s at the default sizes. A face with more corners is a
-/// tessellated curve, better given as fewer corners or as a model's triangles.
-pub const MAX_POLYGON_VERTICES: usize = 1024;
-
-/// Largest coordinate magnitude accepted on any axis, in scene units: 10¹². Every point of a
-/// scene (polygon and mesh corners, box corners, a sphere's bounds, the camera) lies within
-/// ±10¹² of the origin. Why a bound: the mesher, the ray tracer and the form factors work with
-/// squares and fourth powers of distances and with grids over the scene's bounds, which
-/// overflow or collapse for points near `f64::MAX` (a sphere centred at 10³⁰⁸ asked for a
-/// 25 GB table and then crashed the ray tracer's build); and there, a point's spacing from the
-/// next representable one (10⁻⁴ of a unit at 10¹², a whole unit by 10¹⁶) already exceeds the
-/// details of any model. In metres that is beyond the Sun; in millimetres, 10⁶ km.
-pub const MAX_COORDINATE: f64 = 1e12;
-
-/// Longest solve time limit accepted, in seconds (about 31.7 years): any longer limit is no
-/// limit, and a larger number does not fit a `Duration`'s arithmetic in every caller.
-pub const MAX_TIME_LIMIT_SECONDS: f64 = 1e9;
-
 /// Stop settings a scene file may carry for the solver (all optional; the solver has defaults).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SolverSettings {
@@ -717,7 +519,7 @@ pub struct Scene {
     /// Objects.
     pub objects: Vec<Object>,
     /// Subdivision given by the scene, if any (`None`: derived from the scene size).
-    pub mesh: Option<crate::MeshParams>,
+    pub mesh: Option<MeshParams>,
     /// Stop settings given by the scene.
     pub solver: SolverSettings,
 }
@@ -802,25 +604,11 @@ impl Scene {
             })
     }
 
-    /// The scene's camera or, without one, a view that sees its lit faces: from outside on
-    /// the side that shows the most front faces (the open side of an open box), or from inside
-    /// a closed room (probed with a few dozen rays per candidate view).
-    pub fn camera_or_framing(&self) -> Camera {
-        self.camera.unwrap_or_else(|| crate::auto_camera::choose(self))
-    }
-
-    /// The share of a coarse grid of rays through `camera` (48 of them) that first meet a lit
-    /// face: near 0 when the view looks at the backs of one-sided surfaces (a closed room
-    /// from outside) or at nothing, so that a black picture can be explained before it is made.
-    pub fn lit_share_seen_by(&self, camera: &Camera) -> f64 {
-        crate::auto_camera::lit_share(self, camera)
-    }
-
-    /// Mesh parameters of the scene, or [`crate::MeshParams::for_extent`] of its bounds.
-    pub fn mesh_params(&self) -> crate::MeshParams {
+    /// Mesh parameters of the scene, or [`MeshParams::for_extent`] of its bounds.
+    pub fn mesh_params(&self) -> MeshParams {
         self.mesh.unwrap_or_else(|| {
             let (lo, hi) = self.bounds();
-            crate::MeshParams::for_extent((hi - lo).length())
+            MeshParams::for_extent((hi - lo).length())
         })
     }
 

@@ -30,8 +30,9 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use radiosity_core::glam::DVec3;
-use radiosity_core::{Mesh, Rgb, UpAxis, encode_srgb, unique_names};
+use radiosity_core::{Rgb, UpAxis, encode_srgb, unique_names};
 use radiosity_image::{HdrImage, RenderError, RenderParams, Renderer, ToneOperator, ToneParams, tone_map};
+use radiosity_mesh::Mesh;
 use radiosity_solver::Solution;
 use rayon::prelude::*;
 use serde_json::{Value, json};

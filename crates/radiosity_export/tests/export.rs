@@ -4,12 +4,13 @@
 
 use std::sync::Arc;
 
-use radiosity_core::{Mesh, Rgb, cornell_box};
+use radiosity_core::{Rgb, cornell_box};
 use radiosity_export::{
     LIGHTMAP_CELL_TEXELS, Texels, VertexColours, glb_bytes, gltf_text, lightmaps, ply_bytes, vertex_colours,
     write_lightmaps,
 };
 use radiosity_image::{ToneOperator, ToneParams};
+use radiosity_mesh::Mesh;
 use radiosity_solver::{Problem, Solution, SolverParams};
 
 /// The Cornell box after 150 shots: enough light everywhere for the values to be distinct.

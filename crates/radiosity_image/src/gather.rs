@@ -39,8 +39,9 @@ use std::f64::consts::PI;
 
 use glam::DVec3;
 use radiosity_accel::RayQuery;
+use radiosity_core::Rgb;
 use radiosity_core::random::Rng;
-use radiosity_core::{Mesh, Rgb};
+use radiosity_mesh::Mesh;
 
 /// How a picture's pixels get their light.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]

@@ -24,6 +24,7 @@
 
 mod cache;
 mod files;
+mod framing;
 mod gather;
 mod hdr;
 mod metrics;
@@ -35,6 +36,7 @@ pub use files::{
     encode_picture, encode_png, read_exr, read_hdr, read_pfm, read_png, write_exr, write_file_atomic,
     write_hdr, write_pfm, write_png,
 };
+pub use framing::{camera_or_framing, lit_share_seen_by};
 pub use gather::Gather;
 pub use hdr::HdrImage;
 pub use metrics::{ObjectPixels, difference_image, object_mean_radiance};

@@ -30,6 +30,7 @@ mod builtin;
 mod desc;
 mod error;
 mod gltf_in;
+mod load_model;
 mod locate;
 mod model;
 mod obj;
@@ -37,9 +38,8 @@ mod scene_file;
 
 pub use builtin::{BUILTIN_SCENES, builtin_scene, resolve_scene, resolve_scene_with};
 pub use error::LoadError;
-pub use model::{
-    CLAMPED_REFLECTANCE, DEFAULT_GREY, Model, ModelFormat, ModelPart, Transform, load_model, parse_model,
-};
+pub use load_model::{load_model, parse_model};
+pub use model::{CLAMPED_REFLECTANCE, DEFAULT_GREY, Model, ModelFormat, ModelPart, Transform};
 pub use scene_file::{LoadOptions, LoadedScene, load_scene, load_scene_with, parse_scene, parse_scene_with};
 
 use radiosity_core::Scene;

@@ -21,8 +21,9 @@ use crate::LoadError;
 use crate::desc::{
     CameraDesc, Face, MaterialDesc, MeshDesc, ObjectDesc, Scale, SceneDesc, SolverDesc, TransformDesc,
 };
+use crate::load_model::load_model;
 use crate::locate::Locator;
-use crate::model::{ModelFormat, Transform, load_model, model_error};
+use crate::model::{ModelFormat, Transform, model_error};
 
 /// Camera vertical field of view in degrees when the file gives none.
 const DEFAULT_FOV_Y_DEG: f64 = 45.0;
@@ -321,7 +322,7 @@ fn material_sides(loc: &Locator, key: &str, m: &MaterialDesc) -> Result<Option<S
     }))
 }
 
-/// Refuses, with a line, a scene whose mesh would pass [`radiosity_core::MAX_ELEMENTS`]: at
+/// Refuses, with a line, a scene whose mesh would pass [`radiosity_mesh::MAX_ELEMENTS`]: at
 /// `[mesh] element_size` when the file sets it, else at the object that passes the limit
 /// (a huge sphere, say, against the default sizes).
 fn check_element_count(
@@ -331,11 +332,11 @@ fn check_element_count(
     origins: &[usize],
 ) -> Result<(), LoadError> {
     let params = scene.mesh_params();
-    let Some(i) = radiosity_core::first_object_over_limit(scene, &params) else { return Ok(()) };
+    let Some(i) = radiosity_mesh::first_object_over_limit(scene, &params) else { return Ok(()) };
     let object = &desc.object[origins[i]];
-    let e = radiosity_core::MeshError::TooManyElements {
+    let e = radiosity_mesh::MeshError::TooManyElements {
         object: scene.objects[i].name.chars().take(80).collect(),
-        limit: radiosity_core::MAX_ELEMENTS,
+        limit: radiosity_mesh::MAX_ELEMENTS,
         patch_size: params.patch_size,
         element_size: params.element_size,
     };

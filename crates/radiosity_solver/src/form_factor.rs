@@ -13,7 +13,7 @@
 //!   away; kept for comparison.
 
 use glam::DVec3;
-pub use radiosity_core::distance_to_polygon;
+pub use radiosity_mesh::distance_to_polygon;
 use std::f64::consts::PI;
 
 /// Clips a convex polygon to the half-space `n · (x − p) ≥ 0`; at most 5 vertices come out of

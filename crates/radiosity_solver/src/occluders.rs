@@ -8,7 +8,7 @@
 //! else (furnace, two plates) needs no rays at all.
 
 use glam::{DVec3, Vec3};
-use radiosity_core::Mesh;
+use radiosity_mesh::Mesh;
 
 /// Above this many (triangle × vertex) pairs the exact half-space scan is skipped for
 /// triangles that the bounding-box test does not settle; they are kept (always correct).

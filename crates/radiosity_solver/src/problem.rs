@@ -8,7 +8,8 @@
 use std::sync::Arc;
 
 use radiosity_accel::{Bvh, RayQuery};
-use radiosity_core::{MAX_ELEMENTS, Mesh, MeshError, MeshParams, Refinement, Rgb, Scene};
+use radiosity_core::{MeshParams, Rgb, Scene};
+use radiosity_mesh::{MAX_ELEMENTS, Mesh, MeshError, Refinement};
 
 use crate::solution::VertexElements;
 use crate::{Solver, SolverError, SolverParams, occluder_triangles};

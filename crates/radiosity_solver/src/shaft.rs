@@ -12,7 +12,7 @@
 
 use glam::{DVec3, Vec3};
 use radiosity_accel::{CandidateTriangles, Segments4};
-use radiosity_core::Mesh;
+use radiosity_mesh::Mesh;
 
 /// Above this many blocking triangles the per-patch scan costs more than it saves; every
 /// pair then goes to the caller's ray structure.

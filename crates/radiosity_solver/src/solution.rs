@@ -1,7 +1,8 @@
 //! What a solve produces: radiosity per element and per vertex, and summaries per object.
 
 use glam::{DMat3, DVec3};
-use radiosity_core::{Mesh, Rgb};
+use radiosity_core::Rgb;
+use radiosity_mesh::Mesh;
 
 /// A snapshot of the solution, linear radiosity in W/unit².
 #[derive(Clone, Debug, Default)]

@@ -3,9 +3,10 @@
 use std::sync::Arc;
 
 use radiosity_core::{
-    Mesh, MeshParams, Rgb, Scene, Sides, furnace_box, furnace_sphere, two_plates, two_sided_plate,
+    MeshParams, Rgb, Scene, Sides, furnace_box, furnace_sphere, two_plates, two_sided_plate,
     unit_cube_floor_light,
 };
+use radiosity_mesh::Mesh;
 use radiosity_solver::{
     Overshoot, Problem, Solver, SolverParams, StepBudget, StopReason, occluder_triangles,
 };

@@ -18,7 +18,7 @@
 //! a cell share a cell, and the lit side must not take the colour of the dark one.
 
 use glam::{DMat3, DVec3};
-use radiosity_core::Mesh;
+use radiosity_mesh::Mesh;
 use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
 
 /// One drawn triangle of a [`CoarseMesh`].

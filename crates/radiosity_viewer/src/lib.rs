@@ -202,11 +202,11 @@ pub fn default_samples() -> u32 {
 
 /// Loads a scene file or built-in name, the error on one line as the command prints it
 /// ([`radiosity_core::one_line`]), with closed models lit from one side made one-sided as the
-/// command does ([`radiosity_core::seal_closed_objects`]). The loader's warnings are
+/// command does ([`radiosity_mesh::seal_closed_objects`]). The loader's warnings are
 /// dropped: the window has no place for them yet.
 fn load_scene(arg: &str) -> Result<Scene, String> {
     let mut scene = radiosity_io::resolve_scene(arg).map_err(|e| radiosity_core::one_line(&e))?.scene;
-    radiosity_core::seal_closed_objects(&mut scene);
+    radiosity_mesh::seal_closed_objects(&mut scene);
     Ok(scene)
 }
 

@@ -10,8 +10,9 @@ use std::sync::Arc;
 use std::sync::mpsc::{Receiver, TryRecvError, channel};
 use std::time::Instant;
 
-use radiosity_core::{Camera, Mesh};
+use radiosity_core::Camera;
 use radiosity_image::{Gather, HdrImage, RenderParams, Renderer};
+use radiosity_mesh::Mesh;
 use radiosity_solver::Solution;
 
 /// Longest side of a still, pixels: the view's size, capped so a large window renders in

@@ -13,7 +13,8 @@ use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use radiosity_core::{Mesh, MeshParams, Scene};
+use radiosity_core::{MeshParams, Scene};
+use radiosity_mesh::Mesh;
 use radiosity_solver::{Problem, Solution, Solver, SolverParams, StepBudget, StopReason};
 
 /// How long the worker shoots between two publications: 20 updates a second, well above the

@@ -63,7 +63,7 @@ fn direct_gather_needs_the_direct_part() {
 fn gathered_cornell_box_agrees_with_the_mesh_per_object() {
     let scene = radiosity_core::cornell_box();
     let (mesh, solution) = common::solve(&scene, SolverParams::default());
-    let camera = scene.camera_or_framing();
+    let camera = radiosity_image::camera_or_framing(&scene);
     let renderer = Renderer::new(mesh.clone());
     let params = |gather| RenderParams {
         width: 96,
@@ -182,7 +182,7 @@ fn a_record_on_a_corner_edge_is_not_dark() {
     let scene = radiosity_core::cornell_box();
     let (mesh, solution) = common::solve(&scene, SolverParams::default());
     let renderer = Renderer::new(mesh);
-    let eye = scene.camera_or_framing().position;
+    let eye = radiosity_image::camera_or_framing(&scene).position;
     let camera = Camera::try_new(eye, DVec3::new(278.0, 548.8, 559.2), DVec3::Y, 10.0).unwrap();
     let params = |gather| RenderParams { width: 41, height: 41, gather, ..RenderParams::default() };
     let picture = |gather| renderer.render(&solution, &camera, &params(gather)).unwrap().radiance;

@@ -74,8 +74,9 @@ fn render_small_cornell(solver_seed: u64) -> (Vec<String>, Rendering) {
         common::solve(&scene, SolverParams { seed: solver_seed, ..SolverParams::default() });
     let params =
         RenderParams { width: WIDTH, height: HEIGHT, samples_per_pixel: SAMPLES, ..RenderParams::default() };
-    let rendering =
-        Renderer::new(mesh.clone()).render(&solution, &scene.camera_or_framing(), &params).unwrap();
+    let rendering = Renderer::new(mesh.clone())
+        .render(&solution, &radiosity_image::camera_or_framing(&scene), &params)
+        .unwrap();
     (mesh.object_names.clone(), rendering)
 }
 

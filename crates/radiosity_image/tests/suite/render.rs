@@ -335,7 +335,7 @@ fn solved_cornell() -> (Renderer, radiosity_solver::Solution, radiosity_core::Ca
     let scene = radiosity_core::cornell_box();
     let (mesh, solution) = crate::common::solve(&scene, radiosity_solver::SolverParams::default());
     let lamp = mesh.object_names.iter().position(|n| n == "light").expect("the lamp") as u32;
-    (Renderer::new(mesh), solution, scene.camera_or_framing(), lamp)
+    (Renderer::new(mesh), solution, radiosity_image::camera_or_framing(&scene), lamp)
 }
 
 /// Pixels on an outline take `edge_factor` times the samples, decided by rays apart from the

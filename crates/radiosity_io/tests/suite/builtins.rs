@@ -4,8 +4,9 @@
 use std::path::Path;
 
 use radiosity_core::glam::DVec3;
-use radiosity_core::{Facing, Mesh, Shape};
+use radiosity_core::{Facing, Shape};
 use radiosity_io::{BUILTIN_SCENES, LoadError, builtin_scene, load_scene, resolve_scene};
+use radiosity_mesh::Mesh;
 
 #[test]
 fn every_builtin_parses() {

@@ -33,7 +33,8 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::{DVec3, Vec3, Vec4};
 use radiosity_accel::RayQuery;
-use radiosity_core::{Mesh, Rgb};
+use radiosity_core::Rgb;
+use radiosity_mesh::Mesh;
 
 use super::SolverParams;
 use super::first_shots::DRIFT;

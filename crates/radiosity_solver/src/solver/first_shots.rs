@@ -8,7 +8,7 @@
 //! too far from it ([`FirstShots::refresh_if_drifted`]): then it is fixed again and the row
 //! computed again. Its brightness stays that of its first shot.
 
-use radiosity_core::Mesh;
+use radiosity_mesh::Mesh;
 
 use super::tally::Tally;
 use super::uneven::NONUNIFORM;
@@ -203,7 +203,8 @@ fn near_square(n: u32) -> u32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use radiosity_core::{Mesh, Rgb, two_plates};
+    use radiosity_core::{Rgb, two_plates};
+    use radiosity_mesh::Mesh;
 
     /// Penumbra rays follow the shooter's share of the emitted power: all of them from half
     /// of it up, a part in proportion below, never under the least (nor over the most), and

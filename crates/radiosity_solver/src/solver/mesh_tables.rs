@@ -2,7 +2,8 @@
 //! element neighbours, and the ray-skipping structures over the blocking triangles.
 
 use glam::{DVec3, Vec3A};
-use radiosity_core::{Mesh, Patch, Rgb};
+use radiosity_core::Rgb;
+use radiosity_mesh::{Mesh, Patch};
 
 use super::SolverError;
 use crate::occluders::{OccluderBoxes, blocking_triangles};

@@ -33,7 +33,8 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use radiosity_accel::RayQuery;
-use radiosity_core::{Mesh, Rgb};
+use radiosity_core::Rgb;
+use radiosity_mesh::Mesh;
 
 mod clusters;
 mod enclosure;

@@ -5,7 +5,7 @@
 //! its elements may use one midpoint.
 
 use glam::DVec3;
-use radiosity_core::Mesh;
+use radiosity_mesh::Mesh;
 
 use super::mesh_tables::{MeshTables, patch_radius};
 use super::parallel::for_each_maybe_parallel;

@@ -3,7 +3,7 @@
 //! VRAD, Wallace et al. 1989, turned into a cell count).
 
 use glam::DVec3;
-use radiosity_core::Patch;
+use radiosity_mesh::Patch;
 
 use crate::form_factor::{Rule, distance_to_polygon};
 
@@ -55,7 +55,8 @@ pub(super) fn element_quadrature(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use radiosity_core::{Mesh, furnace_box};
+    use radiosity_core::furnace_box;
+    use radiosity_mesh::Mesh;
 
     /// Far: one midpoint; near: Gauss cells of radius below a quarter of the gap, capped at
     /// `max`; the count never falls as the gap shrinks.

@@ -4,7 +4,7 @@
 
 use glam::DVec3;
 use radiosity_accel::Segments4;
-use radiosity_core::{Mesh, Patch};
+use radiosity_mesh::{Mesh, Patch};
 
 use super::FormFactorMethod;
 use super::plans::PatchPlan;

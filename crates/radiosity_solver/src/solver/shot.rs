@@ -3,7 +3,7 @@
 
 use glam::{DVec3, Vec3, Vec3A};
 use radiosity_accel::RayQuery;
-use radiosity_core::{Mesh, Patch};
+use radiosity_mesh::{Mesh, Patch};
 
 use super::SolverParams;
 use super::clusters::Clusters;

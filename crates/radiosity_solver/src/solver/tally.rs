@@ -1,7 +1,8 @@
 //! The physics state of a solve: radiosity B and unshot radiosity ΔB per element, unshot
 //! power per patch, and the power bookkeeping (emitted = absorbed + unshot + escaped).
 
-use radiosity_core::{Mesh, Rgb};
+use radiosity_core::Rgb;
+use radiosity_mesh::Mesh;
 use rayon::prelude::*;
 
 use super::SolverError;

@@ -3,7 +3,8 @@
 
 use std::sync::Arc;
 
-use radiosity_core::{Mesh, Scene};
+use radiosity_core::Scene;
+use radiosity_mesh::Mesh;
 use radiosity_solver::{Problem, Solution, SolverParams};
 
 /// Meshes `scene` with its own parameters and solves it to a stop criterion.

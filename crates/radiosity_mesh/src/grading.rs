@@ -23,7 +23,7 @@ use rustc_hash::FxHashMap as HashMap;
 
 use glam::DVec3;
 
-use crate::mesh::SurfaceBuilder;
+use crate::builder::SurfaceBuilder;
 
 /// Whether point `p` lies on segment `(a, b)` within `tol`.
 fn on_segment(p: DVec3, (a, b): (DVec3, DVec3), tol: f64) -> bool {

@@ -27,9 +27,9 @@ use rustc_hash::FxHashMap as HashMap;
 
 use glam::{DVec2, DVec3};
 
-use crate::mesh::UnionFind;
 use crate::planar::{area, bounds, clean, clip, key, lexicographic, plane, split, tolerance};
-use crate::scene::{Polygon, Scene, Shape};
+use crate::union_find::UnionFind;
+use radiosity_core::{Polygon, Scene, Shape};
 
 /// Least share of the scene's emitted power an emitter needs to cast outlines: the dim ones'
 /// shadows are faint, and every outline costs elements.
@@ -335,9 +335,10 @@ fn intersect(a: &[DVec3], b: &[DVec3], n: DVec3) -> Vec<DVec3> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Mesh;
     use crate::planar::contains_within;
-    use crate::scene::{Facing, box_faces};
-    use crate::{Material, Mesh, Object, Rgb};
+    use radiosity_core::{Facing, box_faces};
+    use radiosity_core::{Material, Object, Rgb};
 
     /// A 4 × 4 floor, a unit box turned 30° about the vertical standing on it, and a unit
     /// lamp 3 above the floor facing down.
@@ -446,7 +447,7 @@ mod tests {
     /// one side of each), while the floor meshed without outlines has elements across them.
     #[test]
     fn no_cornell_floor_element_lies_across_a_shadow_outline() {
-        let scene = crate::cornell_box();
+        let scene = radiosity_core::cornell_box();
         let params = scene.mesh_params();
         let Shape::Polygons(floor) = &scene.objects[0].shape else { unreachable!() };
         let outlines = ShadowOutlines::new(&scene).outlines(&floor[0]);

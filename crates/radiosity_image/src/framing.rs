@@ -14,8 +14,7 @@
 
 use glam::DVec3;
 
-use crate::scene::{Camera, Facing, Shape, Sides};
-use crate::{CameraRays, Polygon, Scene};
+use radiosity_core::{Camera, CameraRays, Facing, Polygon, Scene, Shape, Sides};
 
 /// Probe rays per candidate view, across and down (a 4:3 picture).
 const PROBE: (usize, usize) = (8, 6);
@@ -23,8 +22,22 @@ const PROBE: (usize, usize) = (8, 6);
 /// Field of view of a camera placed inside the scene, degrees: wide, as a room is seen.
 const INSIDE_FOV_DEG: f64 = 75.0;
 
-/// The camera [`Scene::camera_or_framing`] gives a scene without one.
-pub(crate) fn choose(scene: &Scene) -> Camera {
+/// The scene's camera or, without one, a view that sees its lit faces: from outside on the
+/// side that shows the most front faces (the open side of an open box), or from inside a
+/// closed room (probed with a few dozen rays per candidate view).
+pub fn camera_or_framing(scene: &Scene) -> Camera {
+    scene.camera.unwrap_or_else(|| choose(scene))
+}
+
+/// The share of a coarse grid of rays through `camera` (48 of them) that first meet a lit
+/// face: near 0 when the view looks at the backs of one-sided surfaces (a closed room from
+/// outside) or at nothing, so that a black picture can be explained before it is made.
+pub fn lit_share_seen_by(scene: &Scene, camera: &Camera) -> f64 {
+    lit_share(scene, camera)
+}
+
+/// The camera [`camera_or_framing`] gives a scene without one.
+fn choose(scene: &Scene) -> Camera {
     let (lo, hi) = scene.bounds();
     let framing = Camera::framing(lo, hi);
     let centre = (lo + hi) * 0.5;
@@ -134,7 +147,7 @@ fn best_of(scene: &Scene, candidates: Vec<Camera>, by_objects: bool) -> (Camera,
 
 /// The share of the probe rays through `camera` that first meet a lit side: a front face, or
 /// either face of a two-sided object.
-pub(crate) fn lit_share(scene: &Scene, camera: &Camera) -> f64 {
+fn lit_share(scene: &Scene, camera: &Camera) -> f64 {
     probe(scene, camera).into_iter().filter(|&s| s != Seen::Back).count() as f64 / (PROBE.0 * PROBE.1) as f64
 }
 
@@ -227,7 +240,7 @@ fn hit_polygon(p: &Polygon, origin: DVec3, dir: DVec3) -> Option<(f64, bool)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{cornell_box, furnace_box, two_plates};
+    use radiosity_core::{cornell_box, furnace_box, two_plates};
 
     /// A closed box lit from inside is seen from inside: every probe ray meets a lit face
     /// (the framing view from outside would see only the backs of its walls).
@@ -239,7 +252,7 @@ mod tests {
             Camera::framing(lo, hi)
         };
         assert_eq!(front_faces_seen(&scene, &framing), 0, "the old default saw only back faces");
-        let camera = scene.camera_or_framing();
+        let camera = camera_or_framing(&scene);
         assert_eq!(front_faces_seen(&scene, &camera), PROBE.0 * PROBE.1);
     }
 
@@ -249,7 +262,7 @@ mod tests {
     fn an_open_box_is_seen_through_its_open_side() {
         let mut scene = cornell_box();
         scene.camera = None;
-        let camera = scene.camera_or_framing();
+        let camera = camera_or_framing(&scene);
         assert!(camera.position.z < 0.0 && camera.look_at.z > camera.position.z, "{camera:?}");
         assert!(front_faces_seen(&scene, &camera) >= PROBE.0 * PROBE.1 / 4);
     }
@@ -264,7 +277,7 @@ mod tests {
         for o in &mut scene.objects {
             o.sides = Sides::Two { emits_back: false };
         }
-        let camera = scene.camera_or_framing();
+        let camera = camera_or_framing(&scene);
         assert!(camera.position.z < 0.0 && camera.look_at.z > camera.position.z, "{camera:?}");
         let seen = probe(&scene, &camera);
         assert!(seen.iter().filter(|&&s| s == Seen::Front).count() >= PROBE.0 * PROBE.1 / 4, "{seen:?}");
@@ -278,7 +291,7 @@ mod tests {
                 *p = Polygon::try_new(turned).unwrap();
             }
         }
-        let camera = scene.camera_or_framing();
+        let camera = camera_or_framing(&scene);
         assert!(camera.position.z > 559.2 && camera.look_at.z < camera.position.z, "{camera:?}");
     }
 
@@ -289,7 +302,7 @@ mod tests {
         for o in &mut scene.objects {
             o.sides = Sides::Two { emits_back: false };
         }
-        let camera = scene.camera_or_framing();
+        let camera = camera_or_framing(&scene);
         let (lo, hi) = scene.bounds();
         assert!(camera.position.cmpgt(lo).all() && camera.position.cmplt(hi).all(), "{camera:?}");
     }
@@ -298,20 +311,20 @@ mod tests {
     /// block (it shows two objects, the other views one), from behind the room's middle.
     #[test]
     fn inside_a_room_the_view_shows_the_most_objects() {
-        use crate::box_faces;
+        use radiosity_core::box_faces;
         for (side, min, max) in [
             (DVec3::X, DVec3::new(0.7, 0.2, 0.3), DVec3::new(0.95, 0.7, 0.7)),
             (-DVec3::Z, DVec3::new(0.3, 0.2, 0.05), DVec3::new(0.7, 0.7, 0.3)),
         ] {
             let mut scene = furnace_box(0.5, 1.0);
             let block = box_faces(min, max, Facing::Outward, 0.0).unwrap();
-            scene.objects.push(crate::Object {
+            scene.objects.push(radiosity_core::Object {
                 name: "block".into(),
                 material: 0,
                 shape: Shape::Polygons(block),
                 sides: Sides::One,
             });
-            let camera = scene.camera_or_framing();
+            let camera = camera_or_framing(&scene);
             let (lo, hi) = scene.bounds();
             assert!(camera.position.cmpgt(lo).all() && camera.position.cmplt(hi).all(), "{camera:?}");
             let view = (camera.look_at - camera.position).normalize();
@@ -324,7 +337,7 @@ mod tests {
     /// view from inside aims down at it.
     #[test]
     fn inside_a_room_the_view_aims_at_what_stands_in_it() {
-        use crate::box_faces;
+        use radiosity_core::box_faces;
         let mut scene = furnace_box(0.5, 1.0);
         for o in &mut scene.objects {
             let Shape::Polygons(ps) = &mut o.shape else { continue };
@@ -333,12 +346,17 @@ mod tests {
                 *p = Polygon::try_new(room).unwrap();
             }
         }
-        let grey = crate::Material::try_new("grey", crate::Rgb::splat(0.5), crate::Rgb::ZERO).unwrap();
+        let grey = radiosity_core::Material::try_new(
+            "grey",
+            radiosity_core::Rgb::splat(0.5),
+            radiosity_core::Rgb::ZERO,
+        )
+        .unwrap();
         scene.materials.push(grey);
         let (min, max) = (DVec3::new(1.7, 0.0, 1.7), DVec3::new(2.3, 0.3, 2.3));
         let block = box_faces(min, max, Facing::Outward, 0.0).unwrap();
-        scene.objects.push(crate::Object::new("block", 1, Shape::Polygons(block)));
-        let camera = scene.camera_or_framing();
+        scene.objects.push(radiosity_core::Object::new("block", 1, Shape::Polygons(block)));
+        let camera = camera_or_framing(&scene);
         let view = (camera.look_at - camera.position).normalize();
         let to_block = ((min + max) * 0.5 - camera.position).normalize();
         assert!(view.dot(to_block) > 0.999, "aims at the block: {camera:?}");
@@ -349,7 +367,7 @@ mod tests {
     #[test]
     fn facing_plates_show_a_lit_side() {
         let scene = two_plates(1.0, 1.0, 0.5, 1.0);
-        let camera = scene.camera_or_framing();
+        let camera = camera_or_framing(&scene);
         assert!(front_faces_seen(&scene, &camera) > 0, "{camera:?}");
     }
 

@@ -27,7 +27,7 @@ use rustc_hash::FxHashMap as HashMap;
 use glam::DVec3;
 
 use crate::planar::{bounds, key};
-use crate::scene::{Polygon, Scene, Shape, Sides};
+use radiosity_core::{Polygon, Scene, Shape, Sides};
 
 /// Emitting polygon sides tested against each closed object, spread over the emitters.
 const MAX_EMITTER_SIDES: usize = 32;
@@ -200,7 +200,7 @@ fn emitter_points(scene: &Scene) -> Vec<Vec<DVec3>> {
         match &o.shape {
             Shape::Sphere(s) => {
                 // Light leaves the outside of a ball and the inside of a dome.
-                let out = if s.facing == crate::scene::Facing::Outward { 1.0 + 1e-6 } else { 0.0 };
+                let out = if s.facing == radiosity_core::Facing::Outward { 1.0 + 1e-6 } else { 0.0 };
                 sides.push(vec![s.center + DVec3::Y * (s.radius * out)]);
             }
             Shape::Polygons(ps) => push_fronts(&mut sides, ps, both, step),
@@ -311,8 +311,8 @@ fn ray_triangle(p: DVec3, d: DVec3, t: &[DVec3; 3]) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::{Facing, Material, Object, PolygonMesh, Sphere};
-    use crate::{Rgb, box_faces};
+    use radiosity_core::{Facing, Material, Object, PolygonMesh, Sphere};
+    use radiosity_core::{Rgb, box_faces};
 
     fn lamp(at: DVec3, down: bool) -> Object {
         let mut v: Vec<DVec3> = [(-0.1, -0.1), (0.1, -0.1), (0.1, 0.1), (-0.1, 0.1)]

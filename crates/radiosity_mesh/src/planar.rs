@@ -4,7 +4,7 @@
 
 use glam::DVec3;
 
-use crate::scene::Polygon;
+use radiosity_core::Polygon;
 
 /// A point's exact position as a hashable key: faces of one solid share corners bit for bit.
 /// Adding 0 makes −0 and +0 (a pole of a model's sphere written as `-0` and `0`) one key.

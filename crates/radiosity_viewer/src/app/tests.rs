@@ -1,0 +1,258 @@
+//! The window driven by egui_kittest: real egui frames, real wgpu (lavapipe on CI), input
+//! injected as events. Rendering goes through the P screenshot path (an offscreen target),
+//! since the harness's own pass has no depth buffer for the paint callback.
+
+use super::*;
+use eframe::egui::Key;
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use radiosity_core::MeshParams;
+use radiosity_image::Gather;
+use radiosity_solver::SolverParams;
+
+const LONG: Duration = Duration::from_secs(60);
+
+fn harness(scene: &str, shots: Option<u64>, dir: &std::path::Path) -> Harness<'static, ViewerApp> {
+    let mut options = ViewerOptions::new(radiosity_io::resolve_scene(scene).unwrap().scene, scene);
+    options.samples = 1;
+    options.threads = Some(1);
+    options.screenshot_dir = dir.to_owned();
+    options.solver_params = SolverParams { max_shots: shots, ..SolverParams::preview() };
+    Harness::builder()
+        .with_size(Vec2::new(1000.0, 640.0))
+        .wgpu()
+        .build_eframe(|cc| ViewerApp::new(cc, options, Arc::default()).unwrap())
+}
+
+/// Steps frames (sleeping between them, since the worker and loader run in real time)
+/// until `done` holds.
+fn step_until(h: &mut Harness<'static, ViewerApp>, what: &str, done: impl Fn(&ViewerApp) -> bool) {
+    let start = Instant::now();
+    while !done(h.state()) {
+        assert!(start.elapsed() < LONG, "timed out waiting for {what}");
+        std::thread::sleep(Duration::from_millis(20));
+        h.step();
+    }
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("radiosity-viewer-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn keys_drag_and_wheel_fly_the_camera() {
+    let dir = temp_dir("keys");
+    let mut h = harness("cornell", Some(5), &dir);
+    step_until(&mut h, "the first solution", |a| a.shown.is_some());
+    let start = h.state().view.camera;
+    let centre = Pos2::new(350.0, 320.0);
+    h.hover_at(centre);
+    h.key_down(Key::W);
+    for _ in 0..5 {
+        std::thread::sleep(Duration::from_millis(10));
+        h.step();
+    }
+    h.key_up(Key::W);
+    h.step();
+    let moved = h.state().view.camera.position - start.position;
+    assert!(moved.dot(start.forward()) > 0.0 && moved.length() > 0.0, "W flies forward: {moved}");
+    assert!(moved.cross(start.forward()).length() < 1e-6 * moved.length().max(1.0), "straight ahead");
+
+    // Drag to the right: look right.
+    h.drag_at(centre);
+    h.step();
+    for k in 1..=5 {
+        h.hover_at(centre + Vec2::new(20.0 * k as f32, 0.0));
+        h.step();
+    }
+    h.drop_at(centre + Vec2::new(100.0, 0.0));
+    h.step();
+    assert!(h.state().view.camera.forward().dot(start.right()) > 0.1, "dragging right looks right");
+
+    // Wheel up: faster.
+    h.hover_at(centre);
+    h.event(egui::Event::MouseWheel {
+        unit: egui::MouseWheelUnit::Point,
+        delta: Vec2::new(0.0, 100.0),
+        phase: egui::TouchPhase::Move,
+        modifiers: egui::Modifiers::NONE,
+        source: egui::MouseWheelSource::Wheel,
+    });
+    h.run_steps(10);
+    assert!(h.state().view.camera.speed > start.speed, "the wheel speeds up");
+
+    // R: back to the scene camera; F: frame it all.
+    h.key_press(Key::R);
+    h.step();
+    assert_eq!(h.state().view.camera.position, start.position);
+    assert_eq!(h.state().view.camera.forward(), start.forward());
+    h.key_press(Key::F);
+    h.step();
+    assert_ne!(h.state().view.camera.position, start.position, "F frames the whole box");
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn panel_buttons_pause_step_and_restart_the_solve() {
+    let dir = temp_dir("buttons");
+    let mut h = harness("cornell", None, &dir);
+    step_until(&mut h, "some shots", |a| a.status.progress.shots >= 3);
+    h.get_by_label("Pause").click();
+    step_until(&mut h, "the pause", |a| a.status.state == WorkerState::Paused);
+    let shots = h.state().status.progress.shots;
+    h.get_by_label("Step").click();
+    step_until(&mut h, "one more shot", |a| a.status.progress.shots == shots + 1);
+    h.get_by_label("Restart").click();
+    step_until(&mut h, "the restart", |a| a.status.generation == 2);
+    assert_eq!(h.state().status.progress.shots, 0);
+    assert_eq!(h.state().status.state, WorkerState::Paused, "restart keeps the pause");
+    h.get_by_label("Resume").click();
+    step_until(&mut h, "shots again", |a| a.status.progress.shots > 0);
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// The subdivision sliders change sizes and adaptive levels only: the contacts and crease
+/// angle the command line chose stay.
+#[test]
+fn subdivision_sliders_keep_the_other_mesh_settings() {
+    let dir = temp_dir("sliders");
+    let mut options = ViewerOptions::new(radiosity_io::resolve_scene("cornell").unwrap().scene, "cornell");
+    options.threads = Some(1);
+    options.screenshot_dir = dir.clone();
+    options.solver_params = SolverParams { max_shots: Some(2), ..SolverParams::preview() };
+    let chosen = MeshParams::try_new(140.0, 70.0)
+        .unwrap()
+        .with_contacts(false)
+        .with_crease_angle(10.0)
+        .and_then(|m| m.with_adaptive_levels(1))
+        .unwrap();
+    options.mesh_params = Some(chosen);
+    let mut h = Harness::builder()
+        .with_size(Vec2::new(1000.0, 640.0))
+        .wgpu()
+        .build_eframe(|cc| ViewerApp::new(cc, options, Arc::default()).unwrap());
+    assert_eq!(h.state().subdivision.adaptive_levels, 1);
+    h.state_mut().subdivision.element_size = 35.0;
+    h.state_mut().subdivision.adaptive_levels = 0;
+    h.state_mut().apply_subdivision();
+    let m = h.state().job.mesh_params;
+    assert_eq!((m.patch_size, m.element_size, m.adaptive_levels), (140.0, 35.0, 0));
+    assert!(!m.contacts && m.crease_angle_deg == 10.0, "{m:?}");
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[derive(Debug)]
+struct Dropped(PathBuf);
+
+impl egui::DroppedFile for Dropped {
+    fn path(&self) -> &std::path::Path {
+        &self.0
+    }
+    fn bytes(&self) -> Result<Vec<u8>, String> {
+        std::fs::read(&self.0).map_err(|e| e.to_string())
+    }
+}
+
+#[test]
+fn a_bad_file_shows_its_error_and_the_old_scene_stays_then_a_dropped_one_opens() {
+    let dir = temp_dir("open");
+    let mut h = harness("cornell", Some(20), &dir);
+    step_until(&mut h, "the first solution", |a| a.shown.is_some());
+    let bad = dir.join("bad.toml");
+    std::fs::write(&bad, "name = \"x\"\n[[material]]\nname = \"m\"\nreflectance = [2, 0, 0]\n").unwrap();
+    h.state_mut().open_text = bad.display().to_string();
+    h.get_by_label("Open").click();
+    step_until(&mut h, "the load error", |a| a.load_error.is_some());
+    let expected = crate::load_scene(&bad.display().to_string()).unwrap_err();
+    assert_eq!(h.state().load_error.as_deref(), Some(expected.as_str()));
+    h.step();
+    assert!(h.query_all_by_label_contains(&expected).next().is_some(), "the panel shows: error: {expected}");
+    assert_eq!(h.state().shown.as_ref().unwrap().job.scene.name, "Cornell box", "the old scene stays");
+
+    // Dropping a good file opens it (and the camera moves to it).
+    let good = dir.join("furnace.toml");
+    std::fs::write(
+        &good,
+        "name = \"Dropped furnace\"\n[[material]]\nname = \"m\"\nreflectance = [0.5, 0.5, 0.5]\n\
+         emission = [1, 1, 1]\n[[object]]\nname = \"box\"\ntype = \"box\"\nmin = [0, 0, 0]\n\
+         max = [1, 1, 1]\nnormals = \"inward\"\nmaterial = \"m\"\n",
+    )
+    .unwrap();
+    h.input_mut().dropped_files.push(Arc::new(Dropped(good.clone())));
+    step_until(&mut h, "the dropped scene", |a| {
+        a.shown.as_ref().is_some_and(|s| s.job.scene.name == "Dropped furnace")
+    });
+    assert!(h.state().load_error.is_none());
+    assert!(h.state().extent.diagonal() < 2.0, "the camera works at the new scene's scale");
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn p_writes_the_view_with_red_left_and_green_right() {
+    let dir = temp_dir("p");
+    let mut h = harness("cornell", Some(100), &dir);
+    step_until(&mut h, "100 shots on screen", |a| a.shown.as_ref().is_some_and(|s| s.solution.shots == 100));
+    h.key_press(Key::P);
+    h.step();
+    let path = dir.join("cornell-box-100shots.png");
+    let message = h.state().message.clone().unwrap_or_default();
+    assert!(path.exists(), "{message}");
+    let img = image::open(&path).unwrap().to_rgb8();
+    let [w, h_px] = h.state().view_size;
+    assert_eq!(img.dimensions(), (w, h_px), "the view's size, without the panel");
+    let mean = |x0: f32, x1: f32| {
+        let (mut sum, mut n) = ([0.0; 3], 0.0);
+        for y in h_px / 3..2 * h_px / 3 {
+            for x in (x0 * w as f32) as u32..(x1 * w as f32) as u32 {
+                let p = img.get_pixel(x, y);
+                for c in 0..3 {
+                    sum[c] += f64::from(p[c]);
+                }
+                n += 1.0;
+            }
+        }
+        sum.map(|s| s / n)
+    };
+    let (left, right) = (mean(0.12, 0.22), mean(0.78, 0.88));
+    assert!(left[0] > 2.0 * left[1], "red on the left: {left:?}");
+    assert!(right[1] > 1.5 * right[0], "green on the right: {right:?}");
+    // A second P never overwrites the first.
+    h.key_press(Key::P);
+    h.step();
+    assert!(dir.join("cornell-box-100shots-2.png").exists());
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// G renders the view with a gather in the background; the still arrives in its window
+/// with the view's aspect, red on the left and green on the right, and Save writes it.
+#[test]
+fn g_renders_a_still_in_the_background_and_save_writes_it() {
+    let dir = temp_dir("still");
+    let mut h = harness("cornell", Some(100), &dir);
+    step_until(&mut h, "100 shots on screen", |a| a.shown.as_ref().is_some_and(|s| s.solution.shots == 100));
+    h.key_press(Key::G);
+    h.step();
+    assert!(h.state().still_job.is_some(), "G starts a still");
+    step_until(&mut h, "the still", |a| a.still.is_some());
+    let message = h.state().message.clone().unwrap_or_default();
+    assert!(message.starts_with("still rendered"), "{message}");
+    let (still, _, srgb) = h.state().still.as_ref().unwrap();
+    assert_eq!(still.gather, Gather::Direct);
+    let [w, h_px] = h.state().view_size;
+    let aspect = f64::from(srgb.width) / f64::from(srgb.height);
+    assert!((aspect - f64::from(w) / f64::from(h_px)).abs() < 0.01, "aspect {aspect}");
+    let px = |x: u32, y: u32| srgb.pixels[(y * srgb.width + x) as usize];
+    let (left, right) =
+        (px(srgb.width * 17 / 100, srgb.height / 2), px(srgb.width * 83 / 100, srgb.height / 2));
+    assert!(left[0] > 2 * left[1], "red on the left: {left:?}");
+    assert!(right[1] > right[0], "green on the right: {right:?}");
+    // A new window lays itself out unseen on its first frame.
+    h.step();
+    h.step();
+    h.get_by_label("Save PNG").click();
+    h.step();
+    assert!(dir.join("still.png").exists(), "{:?}", h.state().message);
+    let _ = std::fs::remove_dir_all(dir);
+}
