@@ -15,6 +15,7 @@ mod film;
 mod grading;
 mod mesh;
 mod one_line;
+mod photometry;
 mod planar;
 pub mod random;
 mod scene;
@@ -36,6 +37,10 @@ pub use mesh::{
     estimate_elements, first_object_over_limit,
 };
 pub use one_line::{MAX_PART_CHARS, escape_controls, one_line};
+pub use photometry::{
+    Grid, IntensityError, IntensityTable, LUMENS_PER_WATT, LengthUnit, Lighting, Luminaire, colour_of_cct,
+    photometric_y, unit_luminance,
+};
 pub use planar::distance_to_polygon;
 pub use scene::{
     Camera, Facing, MAX_COORDINATE, MAX_POLYGON_VERTICES, MAX_TIME_LIMIT_SECONDS, Material, Object, Polygon,

@@ -720,6 +720,8 @@ pub struct Scene {
     pub mesh: Option<crate::MeshParams>,
     /// Stop settings given by the scene.
     pub solver: SolverSettings,
+    /// Units, luminaires and calculation grids (photometry); empty by default.
+    pub lighting: crate::Lighting,
 }
 
 impl Scene {
@@ -789,6 +791,7 @@ impl Scene {
             objects,
             mesh: None,
             solver: SolverSettings::default(),
+            lighting: crate::Lighting::default(),
         })
     }
 
