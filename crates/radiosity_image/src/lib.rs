@@ -26,6 +26,7 @@ mod cache;
 mod files;
 mod gather;
 mod hdr;
+mod illuminance;
 mod metrics;
 mod render;
 mod tonemap;
@@ -37,6 +38,7 @@ pub use files::{
 };
 pub use gather::Gather;
 pub use hdr::HdrImage;
+pub use illuminance::{GridIlluminance, GridParams, grid_illuminance, grid_statistics, luminaire_irradiance};
 pub use metrics::{ObjectPixels, difference_image, object_mean_radiance};
 pub use render::{
     RECORD_RAYS_PER_GATHER_RAY, RenderError, RenderParams, Renderer, Rendering, Shading, SurfaceHit,
