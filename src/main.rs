@@ -7,6 +7,7 @@ mod compare_cmd;
 mod export_cmd;
 mod info_cmd;
 mod interrupt;
+mod lighting_cmd;
 mod output;
 mod prepare;
 mod progress;

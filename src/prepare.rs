@@ -84,6 +84,10 @@ pub struct MeshOpts {
     /// else y].
     #[arg(long, value_name = "AXIS", allow_hyphen_values = true)]
     pub up: Option<String>,
+    /// The length unit of the scene's coordinates: m, cm, mm, in or ft; lux and cd/m² are
+    /// reported with it [default: the scene file's `units`, else m].
+    #[arg(long, value_name = "UNIT")]
+    pub units: Option<String>,
     /// Cut surfaces along the outlines of solids standing on them (a block on the floor) and
     /// leave the covered part out of the solve [default: the scene's `[mesh]` contacts, else
     /// true].
@@ -273,6 +277,7 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
         }
     }
     let up = o.mesh.up.as_deref().map(parse_up).transpose()?;
+    let units = o.mesh.units.as_deref().map(parse_units).transpose()?;
     // A model file given where a scene is expected loads as a scene of its parts; what the
     // loader dropped or defaulted (degenerate faces, a missing MTL) is said once, here.
     let options = radiosity_io::LoadOptions {
@@ -283,6 +288,7 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
         // A missing light is returned after the warnings are out, not in place of them.
         allow_no_light: true,
         up,
+        units,
     };
     let radiosity_io::LoadedScene { mut scene, warnings, no_light, up } =
         spinning(&format!("loading {scene_arg}"), || radiosity_io::resolve_scene_with(scene_arg, &options))?;
@@ -396,6 +402,15 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
         ..defaults
     };
     Ok((Settings { scene, mesh_params, solver_params, up }, no_light))
+}
+
+/// `--units`' unit.
+///
+/// # Errors
+/// Any other name, listing the accepted ones (exit code 2).
+fn parse_units(name: &str) -> Result<radiosity_core::LengthUnit> {
+    radiosity_core::LengthUnit::parse(name)
+        .ok_or_else(|| input(format!("--units must be one of m, cm, mm, in, ft, got '{name}'")))
 }
 
 /// `--up`'s axis.
@@ -557,6 +572,7 @@ mod tests {
             crease_angle: Some(0.0),
             sides: Some(1),
             up: None,
+            units: None,
             contacts: None,
             shadow_outlines: None,
             corner_refinement: None,

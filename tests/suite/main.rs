@@ -11,6 +11,7 @@ mod export;
 mod fast_paths;
 mod model_fuzz;
 mod models;
+mod photometry;
 mod progress;
 mod public_models;
 mod readme;
