@@ -355,7 +355,11 @@ pub(crate) fn lighting(
         }
         let divisions = match (&g.divisions, &g.spacing) {
             (Some(_), Some(s)) => {
-                return Err(loc.at(s.span(), format!("{key}.spacing"), "give spacing or divisions, not both"));
+                return Err(loc.at(
+                    s.span(),
+                    format!("{key}.spacing"),
+                    "give spacing or divisions, not both",
+                ));
             }
             (Some(d), None) => {
                 let [a, b] = *d.get_ref();
