@@ -87,6 +87,26 @@ pub fn lighting_json(prepared: &Prepared, grids: &[GridIlluminance]) -> Value {
     })
 }
 
+/// Object `index`'s mean luminance (cd/m²) and mean illuminance (lx) from its mean
+/// radiosity `o` (front face): L = Y(B) / π and E = Y((B − emission) / ρ), the latter `None`
+/// where a channel's reflectance is 0 (a black surface tells nothing of its light) or the
+/// object is not a scene object of one material.
+pub fn object_photometry(
+    scene: &radiosity_core::Scene,
+    index: usize,
+    o: &radiosity_solver::ObjectRadiosity,
+) -> (f64, Option<f64>) {
+    let to_lux = scene.lighting.unit().lux_per_irradiance();
+    let luminance = o.radiosity.luminance() * to_lux / std::f64::consts::PI;
+    let illuminance = scene.objects.get(index).and_then(|object| {
+        let m = &scene.materials[object.material];
+        let rho = m.reflectance;
+        (rho.min_channel() > 0.0 && object.name == o.name)
+            .then(|| (o.radiosity - m.emission).zip_map(rho, |b, r| b / r).luminance() * to_lux)
+    });
+    (luminance, illuminance)
+}
+
 /// The grids as CSV: `grid,x,y,z,lux`, positions in the file's frame.
 pub fn grid_csv(prepared: &Prepared, grids: &[GridIlluminance]) -> String {
     let mut s = String::from("grid,x,y,z,lux\n");

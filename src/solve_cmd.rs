@@ -102,7 +102,7 @@ pub fn run(a: SolveArgs) -> Result<()> {
             "seconds": secs,
             "rays": report.rays,
             "energy": output::energy_json(&energy),
-            "objects": objects.iter().map(|o| {
+            "objects": objects.iter().enumerate().map(|(i, o)| {
                 let mut entry = json!({
                     "name": o.name,
                     "area": o.area,
@@ -111,6 +111,11 @@ pub fn run(a: SolveArgs) -> Result<()> {
                 });
                 if let Some(back) = o.radiosity_back {
                     entry["radiosity_back"] = json!(back.to_array());
+                }
+                if scene.lighting.is_photometric() {
+                    let (luminance, illuminance) = crate::lighting_cmd::object_photometry(scene, i, o);
+                    entry["luminance"] = json!(luminance);
+                    entry["illuminance"] = json!(illuminance);
                 }
                 entry
             }).collect::<Vec<_>>(),

@@ -177,10 +177,10 @@ fn parse_ies(text: &str) -> Result<Photometry, Failed> {
         .ok_or_else(|| (lines.len().max(1), "no TILT= line: not an IES LM-63 file".to_owned()))?;
     for (_, l) in &lines[..tilt_at] {
         let upper = l.to_ascii_uppercase();
-        if let Some(rest) = upper.strip_prefix("[LUMINAIRE]").or_else(|| upper.strip_prefix("[LUMCAT]")) {
-            if label.is_empty() {
-                label = l[l.len() - rest.len()..].trim().to_owned();
-            }
+        if let Some(rest) = upper.strip_prefix("[LUMINAIRE]").or_else(|| upper.strip_prefix("[LUMCAT]"))
+            && label.is_empty()
+        {
+            label = l[l.len() - rest.len()..].trim().to_owned();
         }
     }
     let (tilt_line, tilt) = lines[tilt_at];

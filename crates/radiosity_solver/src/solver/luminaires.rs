@@ -14,7 +14,7 @@
 //! solution.
 
 use radiosity_accel::RayQuery;
-use radiosity_core::glam::{DVec3, Vec3};
+use radiosity_core::glam::DVec3;
 use radiosity_core::{LUMENS_PER_WATT, Luminaire, Mesh, Rgb};
 use rayon::prelude::*;
 
@@ -112,7 +112,7 @@ fn element_irradiance(
             if h.max_channel() <= 0.0 {
                 continue;
             }
-            if !rays.occluded(Vec3::from(l.position.as_vec3()), (p + n * lift).as_vec3()) {
+            if !rays.occluded(l.position.as_vec3(), (p + n * lift).as_vec3()) {
                 sum += h * w;
             }
         }
