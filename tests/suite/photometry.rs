@@ -327,3 +327,58 @@ fn the_office_reports_its_work_plane() {
     let csv = std::fs::read_to_string(dir.path().join("g.csv")).unwrap();
     assert_eq!(csv.lines().count(), 46);
 }
+
+/// The path tracer knows luminaires: over the black plane its grid irradiance is the inverse-
+/// square law (no noise: nothing reflects, the luminaire's term is exact), and in the closed
+/// box its area-weighted mean illuminance is Φ / (A (1 − ρ)) within 3 σ.
+#[test]
+fn the_path_tracer_meets_the_same_closed_forms() {
+    use radiosity_reference::{EstimateParams, PathBudget, Reference};
+    let i = 800.0;
+    let h = 2.0;
+    let (_dir, scene) = load(&over_black_plane("iso.ies", h), &[("iso.ies", ies(&[0.0, 180.0], &[i, i]))]);
+    let points: Vec<(DVec3, DVec3)> =
+        scene.lighting.grids[0].points().into_iter().map(|p| (p, DVec3::Y)).collect();
+    let params = EstimateParams { budget: PathBudget::Fixed { paths: 4096 }, ..EstimateParams::default() };
+    let reference = Reference::new(&scene);
+    let to_lux = scene.lighting.unit().lux_per_irradiance();
+    for ((p, _), e) in points.iter().zip(reference.estimate_points(&points, &params, &|_| {}, &|| false)) {
+        let w = DVec3::new(0.0, h, 0.0) - *p;
+        let expected = i * w.y / w.length().powi(3);
+        assert!(
+            (e.luminance * to_lux / expected - 1.0).abs() < 1e-6,
+            "at {p}: {} vs {expected}",
+            e.luminance * to_lux
+        );
+    }
+
+    let rho = 0.5;
+    let text = format!(
+        r#"
+units = "m"
+[[material]]
+name = "grey"
+reflectance = [{rho}, {rho}, {rho}]
+[[object]]
+name = "box"
+type = "box"
+min = [0, 0, 0]
+max = [1, 1, 1]
+normals = "inward"
+material = "grey"
+[[luminaire]]
+file = "iso.ies"
+position = [0.3, 0.6, 0.5]
+"#
+    );
+    let (_dir, scene) = load(&text, &[("iso.ies", ies(&[0.0, 90.0, 180.0], &[100.0, 60.0, 20.0]))]);
+    let flux = scene.lighting.luminaire_flux();
+    let params = EstimateParams { budget: PathBudget::Fixed { paths: 200_000 }, ..EstimateParams::default() };
+    let estimates = Reference::new(&scene).estimate_objects(&params, &|_| {});
+    let b = &estimates.objects[0].estimate;
+    // E = B / ρ over the whole box (one object of area 6).
+    let (mean, se) = (b.luminance / rho * LUMENS_PER_WATT, b.luminance_stderr / rho * LUMENS_PER_WATT);
+    let expected = flux / (6.0 * (1.0 - rho));
+    assert!((mean - expected).abs() < 3.0 * se, "{mean} ± {se} lx, expected {expected}");
+    assert!(se < 0.01 * expected, "{se}");
+}
