@@ -1,10 +1,9 @@
 //! Photometric files in: IES LM-63 (1986, 1991, 1995, 2002) and EULUMDAT (`.ldt`), type C
 //! only, into an [`IntensityTable`] of absolute candela over the full circle of C planes.
 //!
-//! Our own reader, not a crate: the `eulumdat` crate is AGPL-3.0, which the renderer's
-//! licence cannot take in, and the IES readers on crates.io were either unmaintained or
-//! panicked on truncated files. Both formats are short and fully specified (ANSI/IES
-//! LM-63-02; the EULUMDAT description of Stockmar 1990, as DIALux and Relux read it).
+//! Our own reader, not a crate: the `eulumdat` crate is AGPL-3.0, which this MIT / Apache-2.0
+//! project cannot take in, and both formats are short and fully specified (ANSI/IES
+//! LM-63-02; the EULUMDAT description of Stockmar 1990).
 //!
 //! Symmetry is expanded as each format says:
 //!
