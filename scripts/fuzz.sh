@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Runs every fuzz target in fuzz/ (scene TOML, OBJ + MTL, glTF/GLB, PFM, EXR) for a bounded
+# Runs every fuzz target in fuzz/ (scene TOML, OBJ + MTL, glTF/GLB, PFM, EXR, IES / EULUMDAT) for a bounded
 # time each, with libFuzzer through `cargo fuzz` on nightly Rust. Not part of CI's default
 # run: it needs a nightly toolchain and cargo-fuzz, and minutes per target.
 #
@@ -20,7 +20,7 @@ if ! [[ "$seconds" =~ ^[0-9]+$ ]] || [ "$seconds" -eq 0 ]; then
 fi
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
-    targets=(scene_toml obj_mtl gltf pfm exr)
+    targets=(scene_toml obj_mtl gltf pfm exr photometric)
 fi
 
 if ! rustup toolchain list 2>/dev/null | grep -q '^nightly'; then

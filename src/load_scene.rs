@@ -64,6 +64,7 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
         }
     }
     let up = o.mesh.up.as_deref().map(parse_up).transpose()?;
+    let units = o.mesh.units.as_deref().map(parse_units).transpose()?;
     // A model file given where a scene is expected loads as a scene of its parts; what the
     // loader dropped or defaulted (degenerate faces, a missing MTL) is said once, here.
     let options = radiosity_io::LoadOptions {
@@ -74,6 +75,7 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
         // A missing light is returned after the warnings are out, not in place of them.
         allow_no_light: true,
         up,
+        units,
     };
     let radiosity_io::LoadedScene { mut scene, warnings, no_light, up } =
         spinning(&format!("loading {scene_arg}"), || radiosity_io::resolve_scene_with(scene_arg, &options))?;
@@ -187,6 +189,15 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
         ..defaults
     };
     Ok((Settings { scene, mesh_params, solver_params, up }, no_light))
+}
+
+/// `--units`' unit.
+///
+/// # Errors
+/// Any other name, listing the accepted ones (exit code 2).
+fn parse_units(name: &str) -> Result<radiosity_core::LengthUnit> {
+    radiosity_core::LengthUnit::parse(name)
+        .ok_or_else(|| input(format!("--units must be one of m, cm, mm, in, ft, got '{name}'")))
 }
 
 /// `--up`'s axis.

@@ -9,6 +9,7 @@ mod errors;
 mod export_cmd;
 mod info_cmd;
 mod interrupt;
+mod lighting_cmd;
 mod load_scene;
 mod output;
 mod picture_opts;

@@ -138,6 +138,7 @@ mod tests {
             crease_angle: Some(0.0),
             sides: Some(1),
             up: None,
+            units: None,
             contacts: None,
             shadow_outlines: None,
             corner_refinement: None,

@@ -17,6 +17,9 @@ pub struct SolveArgs {
     /// Write the JSON report here (`-` for stdout).
     #[arg(long)]
     pub json: Option<String>,
+    /// Write every calculation grid's illuminance here as CSV (`grid,x,y,z,lux`).
+    #[arg(long, value_name = "FILE")]
+    pub grid_csv: Option<String>,
     /// Overwrite an existing report file.
     #[arg(long)]
     pub force: bool,
@@ -27,10 +30,14 @@ pub struct SolveArgs {
 /// Runs `solve`.
 pub fn run(a: SolveArgs) -> Result<()> {
     // The report's target is checked before the solve, so no solve is lost to it.
+    let mut targets = Targets::new(a.force);
     if let Some(path) = &a.json
         && path != "-"
     {
-        Targets::new(a.force).file(std::path::Path::new(path), "--json")?;
+        targets.file(std::path::Path::new(path), "--json")?;
+    }
+    if let Some(path) = &a.grid_csv {
+        targets.file(std::path::Path::new(path), "--grid-csv")?;
     }
     let prepared = prepare(&a.scene, &a.solve)?;
     let (solver, report) = run_solver(&prepared)?;
@@ -38,6 +45,11 @@ pub fn run(a: SolveArgs) -> Result<()> {
     let mesh = problem.mesh();
     let objects = solver.object_radiosity();
     let energy = solver.energy();
+    let grids = if scene.lighting.grids.is_empty() {
+        Vec::new()
+    } else {
+        crate::lighting_cmd::compute_grids(&prepared, &solver.solution())?
+    };
     drop(solver);
     let secs = report.elapsed.as_secs_f64();
     let stop = report.stop_reason.map_or("running", |s| s.as_str());
@@ -72,10 +84,16 @@ pub fn run(a: SolveArgs) -> Result<()> {
                 table += &format!("{:<24} {:>12} {:>36} {:>36}\n", "  (back face)", "", "", f(back));
             }
         }
+        if !grids.is_empty() {
+            table += &crate::lighting_cmd::grid_table(&grids);
+        }
         output::stdout(&table)?;
     }
+    if let Some(path) = &a.grid_csv {
+        crate::lighting_cmd::write_grid_csv(std::path::Path::new(path), a.force, &prepared, &grids)?;
+    }
     if let Some(path) = &a.json {
-        let doc = json!({
+        let mut doc = json!({
             "scene": scene.name,
             "patches": mesh.patches.len(),
             "elements": mesh.elements.len(),
@@ -85,7 +103,7 @@ pub fn run(a: SolveArgs) -> Result<()> {
             "seconds": secs,
             "rays": report.rays,
             "energy": output::energy_json(&energy),
-            "objects": objects.iter().map(|o| {
+            "objects": objects.iter().enumerate().map(|(i, o)| {
                 let mut entry = json!({
                     "name": o.name,
                     "area": o.area,
@@ -95,9 +113,20 @@ pub fn run(a: SolveArgs) -> Result<()> {
                 if let Some(back) = o.radiosity_back {
                     entry["radiosity_back"] = json!(back.to_array());
                 }
+                if scene.lighting.is_photometric() {
+                    let (luminance, illuminance) = crate::lighting_cmd::object_photometry(scene, i, o);
+                    entry["luminance"] = json!(luminance);
+                    entry["illuminance"] = json!(illuminance);
+                }
                 entry
             }).collect::<Vec<_>>(),
         });
+        if scene.lighting.is_photometric() {
+            let lighting = crate::lighting_cmd::lighting_json(&prepared, &grids);
+            for key in ["units", "luminaires", "grids"] {
+                doc[key] = lighting[key].clone();
+            }
+        }
         let text = serde_json::to_string_pretty(&doc)? + "\n";
         if path == "-" {
             output::stdout(&text)?;

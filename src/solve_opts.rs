@@ -58,6 +58,10 @@ pub struct MeshOpts {
     /// else y].
     #[arg(long, value_name = "AXIS", allow_hyphen_values = true)]
     pub up: Option<String>,
+    /// The length unit of the scene's coordinates: m, cm, mm, in or ft; lux and cd/m² are
+    /// reported with it [default: the scene file's `units`, else m].
+    #[arg(long, value_name = "UNIT")]
+    pub units: Option<String>,
     /// Cut surfaces along the outlines of solids standing on them (a block on the floor) and
     /// leave the covered part out of the solve [default: the scene's `[mesh]` contacts, else
     /// true].

@@ -54,6 +54,9 @@ pub struct VerifyArgs {
     /// Reference paths per sampled element.
     #[arg(long, default_value_t = 65_536, value_name = "N")]
     pub element_paths: u64,
+    /// Reference paths per calculation-grid point (scenes with `[[grid]]`).
+    #[arg(long, default_value_t = 16_384, value_name = "N")]
+    pub grid_paths: u64,
     /// Write the JSON report here (`-` for stdout).
     #[arg(long)]
     pub json: Option<String>,
@@ -131,7 +134,8 @@ pub fn run(a: VerifyArgs) -> Result<()> {
         let mut mesh = Mesh::clone(prepared.problem.mesh());
         scale_solver_reflectance(&mut mesh, k)?;
         let rays = prepared.problem.ray_queries().clone();
-        prepared.problem = Problem::with_ray_queries(Arc::new(mesh), rays);
+        prepared.problem = Problem::with_ray_queries(Arc::new(mesh), rays)
+            .with_luminaires(prepared.scene.lighting.luminaires.clone());
     }
     let (solver, report) = run_solver(&prepared)?;
     let Prepared { scene, problem, .. } = &prepared;
@@ -255,6 +259,21 @@ pub fn run(a: VerifyArgs) -> Result<()> {
             }
         }
     }
+    // Calculation grids: Em, Emin and U0 of the solve against the path tracer's.
+    let grid_part = if prepared.scene.lighting.grids.is_empty() || crate::interrupt::requested() {
+        None
+    } else {
+        let grids = crate::lighting_cmd::compute_grids(&prepared, &solution)?;
+        let (text, json) = crate::lighting_cmd::verify_grids(
+            &prepared,
+            &reference,
+            &grids,
+            a.grid_paths.max(1),
+            a.solve.seed,
+        );
+        table += &text;
+        Some(json)
+    };
     if a.json.as_deref() != Some("-") {
         let mut out = std::io::stdout().lock();
         match std::io::Write::write_all(&mut out, table.as_bytes())
@@ -313,6 +332,9 @@ pub fn run(a: VerifyArgs) -> Result<()> {
         }
         if let Some(part) = element_part {
             doc["element_sample"] = part.json;
+        }
+        if let Some(grids) = grid_part {
+            doc["grids"] = grids;
         }
         write_report(path, a.force, &serde_json::to_string_pretty(&doc)?)?;
     }

@@ -12,6 +12,7 @@ mod fast_paths;
 mod model_fuzz;
 mod models;
 mod modules;
+mod photometry;
 mod progress;
 mod public_models;
 mod readme;

@@ -158,6 +158,7 @@ fn budget(args: &mut Vec<String>) -> Option<Check> {
         "verify" => {
             small_solve(args);
             set(args, "--paths", "64");
+            set(args, "--grid-paths", "64");
             Check::Run
         }
         "info" | "compare" | "tonemap" => Check::Run,

@@ -13,6 +13,7 @@ mod film;
 mod limits;
 mod mesh_params;
 mod one_line;
+mod photometry;
 pub mod random;
 mod scene;
 mod scene_error;
@@ -32,6 +33,10 @@ pub use mesh_params::{
     MeshParams,
 };
 pub use one_line::{MAX_PART_CHARS, escape_controls, one_line};
+pub use photometry::{
+    Grid, IntensityError, IntensityTable, LUMENS_PER_WATT, LengthUnit, Lighting, Luminaire, colour_of_cct,
+    photometric_y, unit_luminance,
+};
 pub use scene::{
     Camera, Facing, Material, Object, Polygon, PolygonMesh, Scene, Shape, Sides, SolverSettings, Sphere,
     box_faces, check_coordinate, coordinate_in_range, unique_names,

@@ -522,6 +522,8 @@ pub struct Scene {
     pub mesh: Option<MeshParams>,
     /// Stop settings given by the scene.
     pub solver: SolverSettings,
+    /// Units, luminaires and calculation grids (photometry); empty by default.
+    pub lighting: crate::Lighting,
 }
 
 impl Scene {
@@ -591,6 +593,7 @@ impl Scene {
             objects,
             mesh: None,
             solver: SolverSettings::default(),
+            lighting: crate::Lighting::default(),
         })
     }
 

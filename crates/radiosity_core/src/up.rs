@@ -185,6 +185,7 @@ impl Scene {
             c.look_at = f(c.look_at);
             c.up = f(c.up);
         }
+        self.lighting.map_exactly(&f);
     }
 
     /// An axis other than +y that the scene seems to have up, when the signs agree: building

@@ -27,6 +27,7 @@ mod files;
 mod framing;
 mod gather;
 mod hdr;
+mod illuminance;
 mod metrics;
 mod render;
 mod tonemap;
@@ -39,6 +40,7 @@ pub use files::{
 pub use framing::{camera_or_framing, lit_share_seen_by};
 pub use gather::Gather;
 pub use hdr::HdrImage;
+pub use illuminance::{GridIlluminance, GridParams, grid_illuminance, grid_statistics, luminaire_irradiance};
 pub use metrics::{ObjectPixels, difference_image, object_mean_radiance};
 pub use render::{
     RECORD_RAYS_PER_GATHER_RAY, RenderError, RenderParams, Renderer, Rendering, Shading, SurfaceHit,

@@ -38,12 +38,12 @@ fn face_of(f: Spanned<Vec<Spanned<Exactly3>>>) -> Face {
 }
 
 /// A [`Point`] of exactly three numbers.
-fn point<'de, D: Deserializer<'de>>(d: D) -> Result<Point, D::Error> {
+pub(crate) fn point<'de, D: Deserializer<'de>>(d: D) -> Result<Point, D::Error> {
     Spanned::<Exactly3>::deserialize(d).map(point_of)
 }
 
 /// An optional [`Point`] of exactly three numbers.
-fn point_opt<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Point>, D::Error> {
+pub(crate) fn point_opt<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Point>, D::Error> {
     Ok(Option::<Spanned<Exactly3>>::deserialize(d)?.map(point_of))
 }
 
@@ -81,6 +81,14 @@ pub(crate) struct SceneDesc {
     pub(crate) mesh: Option<MeshDesc>,
     /// `[solver]`; every key optional.
     pub(crate) solver: Option<SolverDesc>,
+    /// Length unit of every coordinate: `"m"`, `"cm"`, `"mm"`, `"in"` or `"ft"`.
+    pub(crate) units: Option<Spanned<String>>,
+    /// `[[luminaire]]` entries (photometric files placed in the scene).
+    #[serde(default)]
+    pub(crate) luminaire: Vec<Spanned<crate::lighting_file::LuminaireDesc>>,
+    /// `[[grid]]` entries (calculation grids).
+    #[serde(default)]
+    pub(crate) grid: Vec<Spanned<crate::lighting_file::GridDesc>>,
 }
 
 /// `[camera]`.
@@ -112,6 +120,15 @@ pub(crate) struct MaterialDesc {
     /// Emitted radiosity W/m² per channel, each ≥ 0; default 0.
     #[serde(default, deserialize_with = "point_opt")]
     pub(crate) emission: Option<Spanned<[f64; 3]>>,
+    /// Luminous flux of each whole object using the material, lm (instead of `emission`).
+    pub(crate) lumens: Option<Spanned<f64>>,
+    /// Luminance of the emitting faces, cd/m² (instead of `emission`).
+    pub(crate) luminance: Option<Spanned<f64>>,
+    /// Colour of `lumens` or `luminance` light, linear RGB (scaled to luminance 1).
+    #[serde(default, deserialize_with = "point_opt")]
+    pub(crate) colour: Option<Spanned<[f64; 3]>>,
+    /// Colour of `lumens` or `luminance` light as a correlated colour temperature, K.
+    pub(crate) cct: Option<Spanned<f64>>,
     /// Faces that exchange light, `1` (default) or `2` (signed so any other number gets our
     /// message, at its span).
     pub(crate) sides: Option<Spanned<i64>>,

@@ -30,16 +30,22 @@ mod builtin;
 mod desc;
 mod error;
 mod gltf_in;
+mod lighting_file;
 mod load_model;
 mod locate;
 mod model;
 mod obj;
+mod photometric;
 mod scene_file;
 
 pub use builtin::{BUILTIN_SCENES, builtin_scene, resolve_scene, resolve_scene_with};
 pub use error::LoadError;
+pub use lighting_file::{MAX_GRID_POINTS, MAX_LUMINAIRES};
 pub use load_model::{load_model, parse_model};
 pub use model::{CLAMPED_REFLECTANCE, DEFAULT_GREY, Model, ModelFormat, ModelPart, Transform};
+pub use photometric::{
+    MAX_ANGLES, MAX_PHOTOMETRIC_BYTES, PhotometricFormat, Photometry, load_photometry, parse_photometry,
+};
 pub use scene_file::{LoadOptions, LoadedScene, load_scene, load_scene_with, parse_scene, parse_scene_with};
 
 use radiosity_core::Scene;

@@ -12,7 +12,7 @@ use std::path::Path;
 
 use radiosity_core::glam::DVec3;
 use radiosity_core::{
-    Camera, Facing, Material, MeshParams, Object, Polygon, Rgb, Scene, SceneError, Shape, Sides,
+    Camera, Facing, LengthUnit, Material, MeshParams, Object, Polygon, Rgb, Scene, SceneError, Shape, Sides,
     SolverSettings, Sphere, UpAxis, box_faces,
 };
 use toml::Spanned;
@@ -77,6 +77,9 @@ pub struct LoadOptions {
     /// The up axis of the file, over a scene file's `up` key; `None`: the key, else +y. The
     /// loaded scene is turned so that this axis is +y ([`Scene::rotate_to_y_up`]).
     pub up: Option<UpAxis>,
+    /// The length unit of the file's coordinates (`--units`), over a scene file's `units`
+    /// key; `None`: the key, else none declared (metres for photometric figures).
+    pub units: Option<LengthUnit>,
 }
 
 /// Whether the back face of `sides` emits.
@@ -157,6 +160,7 @@ fn scene_from_model(path: &Path, opts: &LoadOptions) -> Result<LoadedScene, Load
         // The caller shows the warnings before it reports or returns the missing light.
         let mut scene =
             Scene::try_new_unlit(&name, model.camera, model.materials, objects).map_err(|e| error(e, ""))?;
+        scene.lighting.units = opts.units;
         scene.rotate_to_y_up(opts.up.unwrap_or_default());
         let no_light = (!lit).then(|| error(SceneError::NoEmitter, ""));
         return Ok(LoadedScene { scene, warnings: model.warnings, no_light, up: opts.up });
@@ -166,6 +170,7 @@ fn scene_from_model(path: &Path, opts: &LoadOptions) -> Result<LoadedScene, Load
     let notes: String = model.warnings.iter().map(|w| format!(" (warning: {w})")).collect();
     let mut scene =
         Scene::try_new(&name, model.camera, model.materials, objects).map_err(|e| error(e, &notes))?;
+    scene.lighting.units = opts.units;
     scene.rotate_to_y_up(opts.up.unwrap_or_default());
     Ok(LoadedScene { scene, warnings: model.warnings, no_light: None, up: opts.up })
 }
@@ -226,6 +231,15 @@ pub fn parse_scene_with(text: &str, origin: &str, opts: &LoadOptions) -> Result<
         Some(up) => Some(up),
         None => desc.up.as_ref().map(|u| up_axis(&loc, u)).transpose()?,
     };
+    let units = crate::lighting_file::units(&loc, &desc, opts.units)?;
+    crate::lighting_file::photometric_emission(
+        &loc,
+        &desc.material,
+        &mut materials,
+        &mut objects,
+        units.unwrap_or_default(),
+    )?;
+    let lighting = crate::lighting_file::lighting(&loc, &desc, units, up.unwrap_or_default())?;
     let camera = desc.camera.as_ref().map(|c| camera(&loc, c, up.unwrap_or_default())).transpose()?;
     let mesh = desc.mesh.as_ref().map(|m| mesh_params(&loc, m)).transpose()?;
     let solver = desc.solver.as_ref().map(|s| solver_settings(&loc, s)).transpose()?.unwrap_or_default();
@@ -242,8 +256,9 @@ pub fn parse_scene_with(text: &str, origin: &str, opts: &LoadOptions) -> Result<
         }
     }
     let unused_light = materials.iter().enumerate().position(|(i, m)| m.is_emitter() && !used[i]);
-    let lit = objects.iter().any(|o| materials.get(o.material).is_some_and(Material::is_emitter));
-    let build = if opts.allow_no_light { Scene::try_new_unlit } else { Scene::try_new };
+    let lit = !lighting.luminaires.is_empty()
+        || objects.iter().any(|o| materials.get(o.material).is_some_and(Material::is_emitter));
+    let build = if opts.allow_no_light || lit { Scene::try_new_unlit } else { Scene::try_new };
     let scene_error = |e: SceneError| match e {
         SceneError::NoObjects => loc.at(
             0..0,
@@ -269,6 +284,7 @@ pub fn parse_scene_with(text: &str, origin: &str, opts: &LoadOptions) -> Result<
     let mut scene = build(&name, camera, materials, objects).map_err(scene_error)?;
     scene.mesh = mesh;
     scene.solver = solver;
+    scene.lighting = lighting;
     check_element_count(&loc, &desc, &scene, &origins)?;
     // Last, once every error has pointed at the file's own coordinates.
     scene.rotate_to_y_up(up.unwrap_or_default());

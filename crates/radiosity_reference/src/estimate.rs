@@ -18,6 +18,7 @@ pub(crate) const BATCH: u64 = 4096;
 /// Task keys of the streams: objects, regions, pixels.
 pub(crate) const OBJECT_TASK: u64 = 0x6f62_6a00_0000_0000; // "obj"
 pub(crate) const REGION_TASK: u64 = 0x7265_6700_0000_0000; // "reg"
+pub(crate) const POINT_TASK: u64 = 0x7074_0000_0000_0000; // "pt"
 
 /// Sums of one batch (or of several), per channel and for luminance.
 #[derive(Clone, Copy, Debug, Default)]
@@ -97,6 +98,8 @@ impl Moments {
 pub(crate) enum Target<'a> {
     Object(u32),
     Region(&'a PreparedRegion),
+    /// The irradiance at a point facing a unit normal (a calculation-grid point).
+    Point(DVec3, DVec3),
 }
 
 /// A region ready to sample: its fan triangles by area, its normal, and how to put points
@@ -162,6 +165,7 @@ fn batch(g: &Geometry, target: &Target, seed: u64, task: u64, index: u64, max_re
                     g.sample_object(*o, [rng.next_f64(), rng.next_f64(), rng.next_f64(), rng.next_f64()])
                 }
                 Target::Region(r) => r.sample([rng.next_f64(), rng.next_f64(), rng.next_f64()]),
+                Target::Point(p, n) => return g.irradiance_at(*p, *n, &mut rng),
             };
             g.radiosity_at(x, max_reflections, &mut rng)
         })

@@ -98,6 +98,8 @@ pub(crate) struct Geometry {
     /// Distance rays start off their surface: 1e-5 of the scene's diagonal (far above the
     /// BVH's single-precision error, far below any feature).
     pub offset: f64,
+    /// The scene's point luminaires (next-event estimation towards each, every vertex).
+    pub luminaires: Vec<radiosity_core::Luminaire>,
 }
 
 /// Index of the first entry of the non-decreasing `cdf` that exceeds `u · total`.
@@ -125,6 +127,7 @@ impl Geometry {
             emitters: Vec::new(),
             emitter_cdf: Vec::new(),
             offset: 0.0,
+            luminaires: scene.lighting.luminaires.clone(),
         };
         for (oi, o) in scene.objects.iter().enumerate() {
             let material = &scene.materials[o.material];

@@ -37,7 +37,7 @@ use radiosity_core::glam::DVec3;
 use radiosity_core::{Camera, Rgb, Scene};
 use thiserror::Error;
 
-use estimate::{OBJECT_TASK, PreparedRegion, REGION_TASK, Target, estimate_targets};
+use estimate::{OBJECT_TASK, POINT_TASK, PreparedRegion, REGION_TASK, Target, estimate_targets};
 use geometry::Geometry;
 
 /// How many paths an estimate takes.
@@ -290,6 +290,27 @@ impl Reference {
             prepared.iter().enumerate().map(|(i, r)| (Target::Region(r), REGION_TASK | i as u64)).collect();
         let (moments, _) = estimate_targets(&self.geometry, &targets, params, progress, stop);
         Ok(moments.iter().map(|m| m.estimate()).collect())
+    }
+
+    /// The irradiance (W/unit² per channel, not radiosity) at each point facing its unit
+    /// normal, with its standard error: the luminaires' light by next-event estimation and
+    /// the light of every surface by cosine-weighted paths. Points may lie in the air (a
+    /// work plane) or on a surface (lift them off it by a hair). Lux are
+    /// `estimate.luminance · LengthUnit::lux_per_irradiance()`.
+    pub fn estimate_points(
+        &self,
+        points: &[(DVec3, DVec3)],
+        params: &EstimateParams,
+        progress: &(dyn Fn(Progress) + Sync),
+        stop: &(dyn Fn() -> bool + Sync),
+    ) -> Vec<Estimate> {
+        let targets: Vec<(Target, u64)> = points
+            .iter()
+            .enumerate()
+            .map(|(i, &(p, n))| (Target::Point(p, n.normalize()), POINT_TASK | i as u64))
+            .collect();
+        let (moments, _) = estimate_targets(&self.geometry, &targets, params, progress, stop);
+        moments.iter().map(|m| m.estimate()).collect()
     }
 
     /// Renders what `camera` sees: per pixel the mean radiance of `samples_per_pixel` paths;

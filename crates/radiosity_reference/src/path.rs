@@ -58,34 +58,66 @@ impl Geometry {
         self.objects[y_object as usize].emission.sum() / total * r2 / cos_y
     }
 
+    /// Irradiance at `p` (unit normal `n`) straight from the point luminaires: each one's
+    /// I(C, γ) · cos θ / d² when a shadow ray to it is clear (a point light cannot be met by
+    /// a bounce, so its next-event estimate is the whole of it, with no noise but visibility).
+    pub(crate) fn luminaire_irradiance(&self, p: DVec3, n: DVec3) -> Rgb {
+        let mut sum = Rgb::ZERO;
+        for l in &self.luminaires {
+            let h = l.irradiance_unblocked(p, n);
+            if h.max_channel() > 0.0 && !self.occluded(p + n * self.offset, l.position) {
+                sum += h;
+            }
+        }
+        sum
+    }
+
+    /// One estimate of the irradiance at point `p` facing unit `n` (a calculation-grid
+    /// point, in the air or on a surface): the luminaires' light by next-event estimation,
+    /// plus the radiosity B(y) (emission included) met by one cosine-weighted ray, whose
+    /// density makes the estimate of ∫ B/π cos θ dω simply B(y).
+    pub(crate) fn irradiance_at(&self, p: DVec3, n: DVec3, rng: &mut Rng) -> Rgb {
+        let mut h = self.luminaire_irradiance(p, n);
+        let dir = cosine_direction(n, rng.next_f64(), rng.next_f64());
+        if let Some(hit) = self.intersect(p + n * self.offset, dir)
+            && hit.front
+        {
+            h += self.radiosity_at(hit.point, u32::MAX, rng);
+        }
+        h
+    }
+
     /// Irradiance at `x` straight from the emitters, one next-event sample weighted by the
-    /// balance heuristic against the cosine-sampled bounce (Veach & Guibas 1995).
+    /// balance heuristic against the cosine-sampled bounce (Veach & Guibas 1995), plus the
+    /// luminaires' exact share.
     fn direct_irradiance(&self, x: &SurfacePoint, rng: &mut Rng) -> Rgb {
+        let luminaires =
+            if self.luminaires.is_empty() { Rgb::ZERO } else { self.luminaire_irradiance(x.p, x.n) };
         if self.emitters.is_empty() {
-            return Rgb::ZERO;
+            return luminaires;
         }
         let piece = self.emitters[pick(&self.emitter_cdf, rng.next_f64())];
         let y = self.sample_piece(piece, [rng.next_f64(), rng.next_f64(), rng.next_f64()]);
         let w = y.p - x.p;
         let r2 = w.length_squared();
         if r2 <= 0.0 {
-            return Rgb::ZERO;
+            return luminaires;
         }
         let r = r2.sqrt();
         let cos_x = x.n.dot(w) / r;
         let cos_y = -y.n.dot(w) / r;
         if cos_x <= 0.0 || cos_y <= 0.0 {
-            return Rgb::ZERO;
+            return luminaires;
         }
         if self.occluded(x.p + x.n * self.offset, y.p + y.n * self.offset) {
-            return Rgb::ZERO;
+            return luminaires;
         }
         // L cos θ_x / p_light · p_light / (p_light + p_cos) = (E/π) cos θ_x / (p_light + p_cos):
         // bounded (≤ E) even where r → 0 along an edge the emitter shares with x, where
         // light sampling alone has infinite variance.
         let p_light = self.light_density(y.object, r2, cos_y);
         let p_cos = cos_x / PI;
-        self.objects[y.object as usize].emission * (cos_x / PI / (p_light + p_cos))
+        luminaires + self.objects[y.object as usize].emission * (cos_x / PI / (p_light + p_cos))
     }
 
     /// One estimate of the radiosity leaving `x` (its lit side), emission included, counting

@@ -8,7 +8,7 @@
 use std::sync::Arc;
 
 use radiosity_accel::{Bvh, RayQuery};
-use radiosity_core::{MeshParams, Rgb, Scene};
+use radiosity_core::{Luminaire, MeshParams, Rgb, Scene};
 use radiosity_mesh::{MAX_ELEMENTS, Mesh, MeshError, Refinement};
 
 use crate::solution::VertexElements;
@@ -119,6 +119,8 @@ pub struct Problem {
     ray_queries: Arc<dyn RayQuery>,
     /// Elements before adaptive subdivision.
     unrefined_elements: usize,
+    /// The scene's point luminaires, which shoot first in every solver made here.
+    luminaires: Arc<[Luminaire]>,
 }
 
 impl Problem {
@@ -136,7 +138,8 @@ impl Problem {
     /// # Errors
     /// [`MeshError`] when the scene cannot be meshed with these sizes (too many elements, …).
     pub fn new(scene: &Scene, mesh_params: &MeshParams) -> Result<Self, MeshError> {
-        let problem = Self::from_mesh(Arc::new(Mesh::build(scene, mesh_params)?));
+        let problem = Self::from_mesh(Arc::new(Mesh::build(scene, mesh_params)?))
+            .with_luminaires(scene.lighting.luminaires.clone());
         Ok(problem.refined(scene, mesh_params))
     }
 
@@ -179,7 +182,10 @@ impl Problem {
                 break;
             }
             match Mesh::build_refined(scene, params, &refinement) {
-                Ok(m) => problem = Self::with_ray_queries(Arc::new(m), problem.ray_queries.clone()),
+                Ok(m) => {
+                    problem = Self::with_ray_queries(Arc::new(m), problem.ray_queries.clone())
+                        .with_luminaires(problem.luminaires.to_vec());
+                }
                 Err(_) => break,
             }
         }
@@ -192,7 +198,19 @@ impl Problem {
     pub fn from_mesh(mesh: Arc<Mesh>) -> Self {
         let ray_queries = Arc::new(Bvh::new(&occluder_triangles(&mesh)));
         let unrefined_elements = mesh.elements.len();
-        Self { mesh, ray_queries, unrefined_elements }
+        Self { mesh, ray_queries, unrefined_elements, luminaires: Arc::from([]) }
+    }
+
+    /// The same problem lit by `luminaires` too (each shoots first in every solver made
+    /// from it).
+    pub fn with_luminaires(mut self, luminaires: Vec<Luminaire>) -> Self {
+        self.luminaires = Arc::from(luminaires);
+        self
+    }
+
+    /// The point luminaires every solver of this problem starts from.
+    pub fn luminaires(&self) -> &[Luminaire] {
+        &self.luminaires
     }
 
     /// A problem with a ray-query backend of the caller's choice (for example
@@ -200,7 +218,7 @@ impl Problem {
     /// against it). The backend must answer for the occluders of `mesh`.
     pub fn with_ray_queries(mesh: Arc<Mesh>, ray_queries: Arc<dyn RayQuery>) -> Self {
         let unrefined_elements = mesh.elements.len();
-        Self { mesh, ray_queries, unrefined_elements }
+        Self { mesh, ray_queries, unrefined_elements, luminaires: Arc::from([]) }
     }
 
     /// How many elements the mesh had before adaptive subdivision (its own count when it was
@@ -224,7 +242,7 @@ impl Problem {
     /// # Errors
     /// As [`Solver::new`]: out-of-range params, a scene that emits nothing.
     pub fn solver(&self, params: SolverParams) -> Result<Solver, SolverError> {
-        Solver::new(self.mesh.clone(), self.ray_queries.clone(), params)
+        Solver::with_luminaires(self.mesh.clone(), self.ray_queries.clone(), params, &self.luminaires)
     }
 }
 

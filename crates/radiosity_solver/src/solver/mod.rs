@@ -40,6 +40,7 @@ mod clusters;
 mod enclosure;
 mod error;
 mod first_shots;
+mod luminaires;
 mod mesh_tables;
 mod parallel;
 mod params;
@@ -112,9 +113,26 @@ impl Solver {
     /// [`SolverError::EmptyMesh`], [`SolverError::NoEmission`], or
     /// [`SolverError::BadParameter`] for out-of-range parameters.
     pub fn new(mesh: Arc<Mesh>, accel: Arc<dyn RayQuery>, params: SolverParams) -> Result<Self, SolverError> {
+        Self::with_luminaires(mesh, accel, params, &[])
+    }
+
+    /// A solver at shot 0 whose `luminaires` have shot first, exactly: B = E + ρ·E_lum and
+    /// ΔB the same on every element, E_lum the luminaires' direct irradiance by shadow rays
+    /// (see `luminaires`).
+    ///
+    /// # Errors
+    /// As [`Solver::new`]; [`SolverError::NoEmission`] only when nothing emits and no
+    /// luminaire lights any element.
+    pub fn with_luminaires(
+        mesh: Arc<Mesh>,
+        accel: Arc<dyn RayQuery>,
+        params: SolverParams,
+        luminaires: &[radiosity_core::Luminaire],
+    ) -> Result<Self, SolverError> {
         params.validate()?;
         mesh_tables::check_patch_runs(&mesh)?;
-        let tally = Tally::new(&mesh)?;
+        let light = luminaires::LuminaireLight::new(&mesh, accel.as_ref(), luminaires);
+        let tally = Tally::lit(&mesh, light.as_ref())?;
         let mut clusters = Clusters::new(&mesh, params.clustering);
         clusters.sum(&tally.patch_abs);
         let shooters = mesh.patches.len() + clusters.len();

@@ -6,6 +6,7 @@ use radiosity_mesh::Mesh;
 use rayon::prelude::*;
 
 use super::SolverError;
+use super::luminaires::LuminaireLight;
 use super::mesh_tables::MeshTables;
 use super::parallel::Carve;
 use super::row::{CLUSTER_TERM, NearField, Row};
@@ -83,10 +84,10 @@ pub(super) struct Tally {
     patch_unshot_emission: Vec<Rgb>,
     /// Σ E·A, W.
     pub(super) emitted: Rgb,
-    absorbed: Rgb,
-    escaped: Rgb,
+    pub(super) absorbed: Rgb,
+    pub(super) escaped: Rgb,
     /// Power delivered beyond a shot's own (see [`EnergyBalance::created`]).
-    created: Rgb,
+    pub(super) created: Rgb,
     /// Σ |unshot power| / Σ emitted power, summed over channels.
     pub(super) unshot_fraction: f64,
     /// Per patch, its |unshot power| summed over channels, as last tallied.
@@ -161,11 +162,20 @@ impl Tally {
     ///
     /// # Errors
     /// [`SolverError::NoEmission`] when nothing emits.
+    #[cfg(test)]
     pub(super) fn new(mesh: &Mesh) -> Result<Self, SolverError> {
+        Self::lit(mesh, None)
+    }
+
+    /// Shot 0: B = E and ΔB = E on every element, plus ρ times the luminaires' direct light.
+    ///
+    /// # Errors
+    /// [`SolverError::NoEmission`] when nothing emits and no luminaire lights anything.
+    pub(super) fn lit(mesh: &Mesh, luminaires: Option<&LuminaireLight>) -> Result<Self, SolverError> {
         let n = mesh.elements.len();
         let emission: Vec<Rgb> = (0..n).map(|e| mesh.element_material(e).emission).collect();
         let emitted: Rgb = mesh.elements.iter().zip(&emission).map(|(el, e)| *e * el.area).sum();
-        if emitted.sum() <= 0.0 {
+        if emitted.sum() <= 0.0 && luminaires.is_none_or(LuminaireLight::is_dark) {
             return Err(SolverError::NoEmission);
         }
         let patch_unshot_emission = (mesh.patches.iter())
@@ -187,6 +197,9 @@ impl Tally {
             since_sum: RESUM,
             changed: Vec::new(),
         };
+        if let Some(light) = luminaires {
+            light.add_to(&mut tally, mesh);
+        }
         for (p, patch) in mesh.patches.iter().enumerate() {
             tally.patch_unshot_power[p] = (patch.elements.start..patch.elements.end)
                 .map(|e| tally.unshot[e as usize] * mesh.elements[e as usize].area)

@@ -1,0 +1,410 @@
+//! The photometric keys of a scene file: `units`, `lumens` / `luminance` / `colour` / `cct`
+//! on materials, `[[luminaire]]` and `[[grid]]`, validated into [`Lighting`] and material
+//! emission (the RGB ↔ lumen rule is [`radiosity_core::photometric_y`]'s: 683 lm/W of
+//! Rec. 709 Y).
+
+use std::path::Path;
+use std::sync::Arc;
+
+use radiosity_core::glam::DVec3;
+use radiosity_core::{
+    Grid, IntensityTable, LUMENS_PER_WATT, LengthUnit, Lighting, Luminaire, Material, Object, Rgb, Shape,
+    Sides, UpAxis, colour_of_cct, unit_luminance,
+};
+use serde::Deserialize;
+use toml::Spanned;
+
+use crate::LoadError;
+use crate::desc::{MaterialDesc, SceneDesc, point_opt};
+use crate::locate::Locator;
+use crate::photometric::load_photometry;
+
+/// Most luminaires one scene may place.
+pub const MAX_LUMINAIRES: usize = 100_000;
+
+/// Most points in all the grids of a scene.
+pub const MAX_GRID_POINTS: u64 = 4_000_000;
+
+/// One `[[luminaire]]`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct LuminaireDesc {
+    /// Name in reports; default the file stem.
+    name: Option<String>,
+    /// IES (`.ies`) or EULUMDAT (`.ldt`) file, relative to the scene file's folder.
+    file: Spanned<String>,
+    /// Photometric centre of one luminaire.
+    #[serde(default, deserialize_with = "point_opt")]
+    position: Option<Spanned<[f64; 3]>>,
+    /// Photometric centres of a row of the same luminaire.
+    positions: Option<Spanned<Vec<[f64; 3]>>>,
+    /// Direction of the photometric nadir (γ = 0); default straight down.
+    #[serde(default, deserialize_with = "point_opt")]
+    aim: Option<Spanned<[f64; 3]>>,
+    /// Turn of the C0 plane about the nadir towards C90 (counter-clockwise seen from above a
+    /// downlight), degrees; default 0 (C0 towards +x).
+    rotation_deg: Option<Spanned<f64>>,
+    /// Luminous flux to scale each luminaire to, lm; default the file's.
+    lumens: Option<Spanned<f64>>,
+    /// Factor on the intensities (maintenance factor, dimming); default 1.
+    multiplier: Option<Spanned<f64>>,
+    /// Linear RGB colour of the light, scaled to luminance 1; default white.
+    #[serde(default, deserialize_with = "point_opt")]
+    colour: Option<Spanned<[f64; 3]>>,
+    /// Colour as a correlated colour temperature, K.
+    cct: Option<Spanned<f64>>,
+}
+
+/// One `[[grid]]`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct GridDesc {
+    /// Name in reports; default `grid N`.
+    name: Option<String>,
+    /// A corner of the rectangle.
+    #[serde(deserialize_with = "crate::desc::point")]
+    origin: Spanned<[f64; 3]>,
+    /// First edge.
+    #[serde(deserialize_with = "crate::desc::point")]
+    u: Spanned<[f64; 3]>,
+    /// Second edge.
+    #[serde(deserialize_with = "crate::desc::point")]
+    v: Spanned<[f64; 3]>,
+    /// Largest distance between points, scene units; default EN 12464-1's for the longer
+    /// side.
+    spacing: Option<Spanned<f64>>,
+    /// Cells along u and v.
+    divisions: Option<Spanned<[i64; 2]>>,
+    /// Direction the illuminance is measured facing; default up.
+    #[serde(default, deserialize_with = "point_opt")]
+    normal: Option<Spanned<[f64; 3]>>,
+    /// Offset of the points along the normal, scene units; default 0.
+    height: Option<Spanned<f64>>,
+}
+
+/// The scene's unit: `opts_units` (a command-line `--units`) over the file's `units` key.
+pub(crate) fn units(
+    loc: &Locator,
+    desc: &SceneDesc,
+    opts_units: Option<LengthUnit>,
+) -> Result<Option<LengthUnit>, LoadError> {
+    if opts_units.is_some() {
+        return Ok(opts_units);
+    }
+    desc.units
+        .as_ref()
+        .map(|u| {
+            LengthUnit::parse(u.get_ref()).ok_or_else(|| {
+                let names: Vec<String> = LengthUnit::ALL.iter().map(|(n, _)| format!("\"{n}\"")).collect();
+                loc.at(
+                    u.span(),
+                    "units",
+                    format!("expected one of {}, got {:?}", names.join(", "), u.get_ref()),
+                )
+            })
+        })
+        .transpose()
+}
+
+/// The Y = 1 colour of `colour` or `cct` (white without either), or an error at the key.
+fn light_colour(
+    loc: &Locator,
+    key: &str,
+    colour: Option<&Spanned<[f64; 3]>>,
+    cct: Option<&Spanned<f64>>,
+) -> Result<Rgb, LoadError> {
+    match (colour, cct) {
+        (Some(c), Some(_)) => Err(loc.at(c.span(), format!("{key}.colour"), "give colour or cct, not both")),
+        (Some(c), None) => unit_luminance(Rgb::from_array(*c.get_ref())).ok_or_else(|| {
+            loc.at(c.span(), format!("{key}.colour"), "colour must be finite, ≥ 0 and not black")
+        }),
+        (None, Some(t)) => {
+            let k = *t.get_ref();
+            if (1000.0..=40000.0).contains(&k) {
+                Ok(colour_of_cct(k))
+            } else {
+                Err(loc.at(t.span(), format!("{key}.cct"), format!("cct must be in 1000–40000 K, got {k}")))
+            }
+        }
+        (None, None) => Ok(Rgb::ONE),
+    }
+}
+
+fn positive(loc: &Locator, key: String, v: &Spanned<f64>) -> Result<f64, LoadError> {
+    let x = *v.get_ref();
+    if x.is_finite() && x > 0.0 {
+        Ok(x)
+    } else {
+        Err(loc.at(v.span(), key, format!("expected a finite number > 0, got {x}")))
+    }
+}
+
+/// Area of `object` that emits: its area, twice for a two-sided object whose back emits.
+fn emitting_area(object: &Object) -> f64 {
+    let area = match &object.shape {
+        Shape::Polygons(ps) => ps.iter().map(|p| p.area()).sum(),
+        Shape::Sphere(s) => 4.0 * std::f64::consts::PI * s.radius * s.radius,
+        Shape::Mesh(m) => m.area(),
+    };
+    if matches!(object.sides, Sides::Two { emits_back: true }) { 2.0 * area } else { area }
+}
+
+/// Emission from the materials' `luminance` and `lumens` keys: luminance L cd/m² is an
+/// exitance π·L lm/m², π·L/683 · s² W/unit²; `lumens` Φ over an object's emitting area A
+/// (unit²) is Φ / 683 / A W/unit². A material giving `lumens` used by objects of different
+/// areas is copied per object (`NAME (OBJECT)`), so each whole object emits Φ.
+pub(crate) fn photometric_emission(
+    loc: &Locator,
+    descs: &[Spanned<MaterialDesc>],
+    materials: &mut Vec<Material>,
+    objects: &mut [Object],
+    unit: LengthUnit,
+) -> Result<(), LoadError> {
+    for (i, m) in descs.iter().enumerate() {
+        let m = m.get_ref();
+        let key = format!("material[{i}]");
+        let given = [m.lumens.as_ref(), m.luminance.as_ref()];
+        if given.iter().all(Option::is_none) {
+            for (k, span) in
+                [("colour", m.colour.as_ref().map(Spanned::span)), ("cct", m.cct.as_ref().map(Spanned::span))]
+            {
+                if let Some(span) = span {
+                    return Err(loc.at(
+                        span,
+                        format!("{key}.{k}"),
+                        format!("{k} colours `lumens` or `luminance` light; give one of those"),
+                    ));
+                }
+            }
+            continue;
+        }
+        if let (Some(a), Some(_)) = (m.lumens.as_ref(), m.luminance.as_ref()) {
+            return Err(loc.at(a.span(), format!("{key}.lumens"), "give lumens or luminance, not both"));
+        }
+        if let (Some(e), Some(_)) = (m.emission.as_ref(), given.iter().flatten().next()) {
+            return Err(loc.at(
+                e.span(),
+                format!("{key}.emission"),
+                "give emission (W) or lumens/luminance, not both",
+            ));
+        }
+        let colour = light_colour(loc, &key, m.colour.as_ref(), m.cct.as_ref())?;
+        if let Some(l) = &m.luminance {
+            let l = positive(loc, format!("{key}.luminance"), l)?;
+            let s = unit.metres();
+            materials[i].emission = colour * (std::f64::consts::PI * l / LUMENS_PER_WATT * s * s);
+        }
+        if let Some(f) = &m.lumens {
+            let flux = positive(loc, format!("{key}.lumens"), f)?;
+            let mut first_area: Option<f64> = None;
+            for o in objects.iter_mut().filter(|o| o.material == i) {
+                let area = emitting_area(o);
+                let emission = colour * (flux / LUMENS_PER_WATT / area);
+                match first_area {
+                    None => {
+                        first_area = Some(area);
+                        materials[i].emission = emission;
+                    }
+                    Some(a) if a == area => {}
+                    Some(_) => {
+                        let mut copy = materials[i].clone();
+                        copy.name = format!("{} ({})", copy.name, o.name);
+                        copy.emission = emission;
+                        materials.push(copy);
+                        o.material = materials.len() - 1;
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+fn finite3(loc: &Locator, key: String, v: &Spanned<[f64; 3]>) -> Result<DVec3, LoadError> {
+    let a = *v.get_ref();
+    if radiosity_core::coordinate_in_range(a) {
+        Ok(DVec3::from_array(a))
+    } else {
+        Err(loc.at(
+            v.span(),
+            key,
+            format!("expected finite coordinates within ±{:e}, got {a:?}", radiosity_core::MAX_COORDINATE),
+        ))
+    }
+}
+
+fn direction(loc: &Locator, key: String, v: &Spanned<[f64; 3]>) -> Result<DVec3, LoadError> {
+    let d = finite3(loc, key.clone(), v)?;
+    if d.length() > 0.0 {
+        Ok(d.normalize())
+    } else {
+        Err(loc.at(v.span(), key, "a direction must not be zero"))
+    }
+}
+
+/// The `[[luminaire]]` and `[[grid]]` entries, in the file's frame (`up`: the file's up axis,
+/// for the default aim and grid normal).
+pub(crate) fn lighting(
+    loc: &Locator,
+    desc: &SceneDesc,
+    units: Option<LengthUnit>,
+    up: UpAxis,
+) -> Result<Lighting, LoadError> {
+    let file_up = up.from_y_up(DVec3::Y);
+    let unit = units.unwrap_or_default();
+    let folder = Path::new(loc.origin).parent().unwrap_or(Path::new(""));
+    let mut luminaires = Vec::new();
+    let mut tables: Vec<(String, Arc<IntensityTable>, f64)> = Vec::new();
+    for (i, l) in desc.luminaire.iter().enumerate() {
+        let key = format!("luminaire[{i}]");
+        let l = l.get_ref();
+        let path = folder.join(l.file.get_ref());
+        let stem = Path::new(l.file.get_ref())
+            .file_stem()
+            .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+        let (table, file_flux) = match tables.iter().find(|t| t.0 == *l.file.get_ref()) {
+            Some(t) => (t.1.clone(), t.2),
+            None => {
+                let p = load_photometry(&path)?;
+                let table = Arc::new(p.table);
+                let flux = table.flux();
+                tables.push((l.file.get_ref().clone(), table.clone(), flux));
+                (table, flux)
+            }
+        };
+        let mut scale = l
+            .multiplier
+            .as_ref()
+            .map(|m| positive(loc, format!("{key}.multiplier"), m))
+            .transpose()?
+            .unwrap_or(1.0);
+        if let Some(f) = &l.lumens {
+            let want = positive(loc, format!("{key}.lumens"), f)?;
+            if file_flux <= 0.0 {
+                return Err(loc.at(f.span(), format!("{key}.lumens"), "the file's intensities are all zero"));
+            }
+            scale *= want / file_flux;
+        }
+        let aim =
+            l.aim.as_ref().map(|a| direction(loc, format!("{key}.aim"), a)).transpose()?.unwrap_or(-file_up);
+        let rotation = match &l.rotation_deg {
+            Some(r) if r.get_ref().is_finite() => *r.get_ref(),
+            Some(r) => {
+                return Err(loc.at(
+                    r.span(),
+                    format!("{key}.rotation_deg"),
+                    "expected a finite number of degrees",
+                ));
+            }
+            None => 0.0,
+        };
+        let colour = light_colour(loc, &key, l.colour.as_ref(), l.cct.as_ref())?;
+        let positions: Vec<DVec3> = match (&l.position, &l.positions) {
+            (Some(p), None) => vec![finite3(loc, format!("{key}.position"), p)?],
+            (None, Some(ps)) => {
+                if ps.get_ref().is_empty() {
+                    return Err(loc.at(
+                        ps.span(),
+                        format!("{key}.positions"),
+                        "expected at least one [x, y, z]",
+                    ));
+                }
+                let at =
+                    |p: &[f64; 3]| finite3(loc, format!("{key}.positions"), &Spanned::new(ps.span(), *p));
+                ps.get_ref().iter().map(at).collect::<Result<_, _>>()?
+            }
+            (Some(p), Some(_)) => {
+                return Err(loc.at(
+                    p.span(),
+                    format!("{key}.position"),
+                    "give position or positions, not both",
+                ));
+            }
+            (None, None) => {
+                return Err(loc.at(
+                    l.file.span(),
+                    key.clone(),
+                    "a luminaire needs position = [x, y, z] or positions = [[x, y, z], …]",
+                ));
+            }
+        };
+        let name = l.name.clone().unwrap_or(stem);
+        let many = positions.len() > 1;
+        for (k, p) in positions.into_iter().enumerate() {
+            if luminaires.len() >= MAX_LUMINAIRES {
+                return Err(loc.at(l.file.span(), key, format!("more than {MAX_LUMINAIRES} luminaires")));
+            }
+            let name = if many { format!("{name} #{}", k + 1) } else { name.clone() };
+            luminaires.push(Luminaire::aimed(name, p, aim, rotation, table.clone(), scale, colour));
+        }
+    }
+    let mut grids = Vec::new();
+    let mut total_points = 0u64;
+    for (i, g) in desc.grid.iter().enumerate() {
+        let key = format!("grid[{i}]");
+        let g = g.get_ref();
+        let origin = finite3(loc, format!("{key}.origin"), &g.origin)?;
+        let u = finite3(loc, format!("{key}.u"), &g.u)?;
+        let v = finite3(loc, format!("{key}.v"), &g.v)?;
+        if u.cross(v).length() <= 1e-12 * u.length() * v.length() || u.length() == 0.0 {
+            return Err(loc.at(
+                g.v.span(),
+                format!("{key}.v"),
+                "u and v must span a rectangle (non-zero, not parallel)",
+            ));
+        }
+        let divisions = match (&g.divisions, &g.spacing) {
+            (Some(_), Some(s)) => {
+                return Err(loc.at(
+                    s.span(),
+                    format!("{key}.spacing"),
+                    "give spacing or divisions, not both",
+                ));
+            }
+            (Some(d), None) => {
+                let [a, b] = *d.get_ref();
+                if !(1..=100_000).contains(&a) || !(1..=100_000).contains(&b) {
+                    return Err(loc.at(
+                        d.span(),
+                        format!("{key}.divisions"),
+                        format!("expected two whole numbers in 1..=100000, got [{a}, {b}]"),
+                    ));
+                }
+                [a as u32, b as u32]
+            }
+            (None, spacing) => {
+                let p = match spacing {
+                    Some(s) => positive(loc, format!("{key}.spacing"), s)?,
+                    // EN 12464-1: p = 0.2 · 5^log10(d), d the longer side in metres.
+                    None => {
+                        Grid::standard_spacing(u.length().max(v.length()) * unit.metres()) / unit.metres()
+                    }
+                };
+                let cells = |len: f64| (len / p).ceil().clamp(1.0, 100_000.0) as u32;
+                [cells(u.length()), cells(v.length())]
+            }
+        };
+        total_points += u64::from(divisions[0]) * u64::from(divisions[1]);
+        if total_points > MAX_GRID_POINTS {
+            return Err(loc.at(
+                g.origin.span(),
+                key,
+                format!("the grids have more than {MAX_GRID_POINTS} points"),
+            ));
+        }
+        let normal = g
+            .normal
+            .as_ref()
+            .map(|n| direction(loc, format!("{key}.normal"), n))
+            .transpose()?
+            .unwrap_or(file_up);
+        let height = match &g.height {
+            Some(h) if h.get_ref().is_finite() => *h.get_ref(),
+            Some(h) => return Err(loc.at(h.span(), format!("{key}.height"), "expected a finite number")),
+            None => 0.0,
+        };
+        let name = g.name.clone().unwrap_or_else(|| format!("grid {}", i + 1));
+        grids.push(Grid { name, origin, u, v, divisions, normal, height });
+    }
+    Ok(Lighting { units, luminaires, grids })
+}

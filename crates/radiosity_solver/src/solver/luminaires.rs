@@ -1,0 +1,122 @@
+//! Luminaires shoot first, exactly: before the first shot, every element receives the
+//! direct irradiance of every point luminaire (inverse-square law with the luminaire's
+//! goniometric intensity, E = I(C, γ) · cos θ / d², CIE 171:2006 test case 5.2), each sample
+//! point tested by a shadow ray to the luminaire. The element then holds ρ·E as radiosity and
+//! as unshot radiosity, and the surfaces' shooting carries the inter-reflections as for any
+//! other light.
+//!
+//! Each element is sampled at the centroids of the triangles fanned from its centre to its
+//! sides, weighted by their areas (one point per side; second order, so a room's elements of
+//! a few centimetres integrate the 1/d² falloff to well under 0.1 %).
+//!
+//! The luminaires' light is not the emitters' *direct part* ([`super::Tally::direct`]): a
+//! final gather recomputes only area emitters per pixel, and takes this light from the
+//! solution.
+
+use radiosity_accel::RayQuery;
+use radiosity_core::glam::DVec3;
+use radiosity_core::{LUMENS_PER_WATT, Luminaire, Rgb};
+use radiosity_mesh::Mesh;
+use rayon::prelude::*;
+
+use super::tally::Tally;
+
+/// Direct light of the luminaires on every element.
+pub(super) struct LuminaireLight {
+    /// Irradiance per element, W/unit².
+    pub(super) irradiance: Vec<Rgb>,
+    /// The luminaires' total flux, W per channel (lm / 683 × colour).
+    pub(super) power: Rgb,
+}
+
+impl LuminaireLight {
+    /// The direct light of `luminaires` on the elements of `mesh`, shadowed by `rays`; `None`
+    /// without luminaires.
+    pub(super) fn new(mesh: &Mesh, rays: &dyn RayQuery, luminaires: &[Luminaire]) -> Option<Self> {
+        if luminaires.is_empty() {
+            return None;
+        }
+        let (lo, hi) = mesh.bounds();
+        let lift = 1e-6 * (hi - lo).length().max(f64::MIN_POSITIVE);
+        let irradiance = (0..mesh.elements.len())
+            .into_par_iter()
+            .with_min_len(64)
+            .map(|e| element_irradiance(mesh, e, rays, luminaires, lift))
+            .collect();
+        let power = luminaires.iter().map(|l| l.colour * (l.flux() / LUMENS_PER_WATT)).sum();
+        Some(Self { irradiance, power })
+    }
+
+    /// Whether no light arrives anywhere.
+    pub(super) fn is_dark(&self) -> bool {
+        self.irradiance.iter().all(|h| h.max_channel() <= 0.0)
+    }
+
+    /// Puts the light into the tally: B and ΔB gain ρ·E; the luminaires' power counts as
+    /// emitted, what the elements absorb of it as absorbed, and the rest as escaped (or, if
+    /// the sampled elements received more than the luminaires emit, as created).
+    pub(super) fn add_to(&self, tally: &mut Tally, mesh: &Mesh) {
+        let mut received = Rgb::ZERO;
+        let mut absorbed = Rgb::ZERO;
+        for (e, h) in self.irradiance.iter().enumerate() {
+            let rho = mesh.element_material(e).reflectance;
+            let area = mesh.elements[e].area;
+            tally.radiosity[e] += rho * *h;
+            tally.unshot[e] += rho * *h;
+            received += *h * area;
+            absorbed += (Rgb::ONE - rho) * *h * area;
+        }
+        tally.emitted += self.power;
+        tally.absorbed += absorbed;
+        let gap = self.power - received;
+        tally.escaped += gap.map(|g| g.max(0.0));
+        tally.created += gap.map(|g| (-g).max(0.0));
+    }
+}
+
+/// Sample points of element `e` and their area weights (summing to 1).
+fn sample_points(mesh: &Mesh, e: usize) -> ([(DVec3, f64); 4], usize) {
+    let el = &mesh.elements[e];
+    let corners: Vec<DVec3> = mesh.element_corners(e).collect();
+    let n = corners.len().min(4);
+    let mut out = [(el.centre, 0.0); 4];
+    let mut total = 0.0;
+    for k in 0..n {
+        let (a, b) = (corners[k], corners[(k + 1) % n]);
+        let w = (a - el.centre).cross(b - el.centre).length();
+        out[k] = ((el.centre + a + b) / 3.0, w);
+        total += w;
+    }
+    if total > 0.0 {
+        for p in &mut out[..n] {
+            p.1 /= total;
+        }
+        (out, n)
+    } else {
+        ([(el.centre, 1.0); 4], 1)
+    }
+}
+
+fn element_irradiance(
+    mesh: &Mesh,
+    e: usize,
+    rays: &dyn RayQuery,
+    luminaires: &[Luminaire],
+    lift: f64,
+) -> Rgb {
+    let n = mesh.elements[e].normal;
+    let (points, count) = sample_points(mesh, e);
+    let mut sum = Rgb::ZERO;
+    for l in luminaires {
+        for &(p, w) in &points[..count] {
+            let h = l.irradiance_unblocked(p, n);
+            if h.max_channel() <= 0.0 {
+                continue;
+            }
+            if !rays.occluded(l.position.as_vec3(), (p + n * lift).as_vec3()) {
+                sum += h * w;
+            }
+        }
+    }
+    sum
+}
