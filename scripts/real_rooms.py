@@ -28,7 +28,9 @@ or checked from here):
   rooms (living-room, dining-room, classroom, ...) are Mitsuba or Tungsten scenes of several
   OBJ files, each with its own transform; they must be merged into one OBJ first (apply
   each shape's toWorld matrix, one `g` group per shape, `usemtl` per BSDF, Kd from the
-  BSDF's reflectance). Pass the merged OBJ.
+  BSDF's reflectance). `scripts/mitsuba_to_obj.py scene.xml room.obj` does that merge
+  (also for the minpt ports of these rooms, github.com/guijiangheng/minpt-scenes). Pass the
+  merged OBJ.
 
 Each model keeps its own licence (most are CC BY 3.0: credit the author); read the one that
 comes with the download.
