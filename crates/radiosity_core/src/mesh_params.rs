@@ -11,7 +11,9 @@ pub struct MeshParams {
     /// slower (more shots).
     pub patch_size: f64,
     /// Longest element edge, scene units, > 0; clamped to `patch_size`. Elements receive;
-    /// smaller gives sharper shadows and smoother shading.
+    /// smaller gives sharper shadows and smoother shading. A quad's elements are squares of
+    /// this side at most; a model's triangles are cut by bisection into pieces whose longest
+    /// edge is at most the diagonal of that square (√2 times it), as are patches.
     pub element_size: f64,
     /// Smooth shading joins the surfaces of one object at a shared corner when their normals
     /// differ by less than this, degrees in [0, 180); 0 keeps every surface apart. Default

@@ -10,12 +10,14 @@ use rustc_hash::FxHashMap as HashMap;
 use glam::DVec3;
 use radiosity_core::{Material, MeshParams, Polygon, Rgb, Scene, Shape, Sides};
 
+use crate::bisection::mesh_triangles;
 use crate::builder::{SurfaceBuilder, is_large, polygon_area_normal};
 use crate::contacts::{Contacts, PolygonId};
 use crate::grading;
 use crate::lattice::{mesh_polygon, mesh_sphere};
 use crate::limits::{MAX_ELEMENTS, MeshError, estimate_polygon_elements, first_object_over_limit};
 use crate::model_faces::{group_mesh_faces, mesh_triangle_group, pair_as_quad};
+use crate::outline::{Outline, outline};
 use crate::refinement::{Refinement, centre_key};
 use crate::shadows::ShadowOutlines;
 use crate::{Element, Mesh, Patch, Smoothing, Surface};
@@ -125,7 +127,7 @@ impl Mesh {
                     mesh.push_surface(b, oi, o.material, refinement);
                 }
                 Shape::Mesh(m) => {
-                    for group in group_mesh_faces(m, params) {
+                    for group in group_mesh_faces(m) {
                         let first = group[0] as usize;
                         if m.faces()[first].len() > 3 {
                             let id = PolygonId { object: oi, index: first };
@@ -138,8 +140,20 @@ impl Mesh {
                             // quad) are meshed as that quad, exactly as a quad polygon would be.
                             cut(&mut mesh, &quad, None);
                         } else {
+                            // The group's outline decides its meshing, not how it was
+                            // triangulated (see `outline`).
+                            let outline = if group.len() > 1 { outline(m, &group) } else { None };
+                            if let Some(Outline::Convex(p)) = &outline {
+                                cut(&mut mesh, p, None);
+                                continue;
+                            }
                             let mut b = SurfaceBuilder::default();
-                            mesh_triangle_group(&mut b, m, &group, params);
+                            match &outline {
+                                Some(Outline::Triangles(ts)) => {
+                                    mesh_triangles(&mut b, ts, m.polygons()[first].normal(), params);
+                                }
+                                _ => mesh_triangle_group(&mut b, m, &group, params),
+                            }
                             if let Some(c) = contacts.as_ref() {
                                 let edges: Vec<(DVec3, DVec3)> = if grades_or_refines(params) {
                                     group

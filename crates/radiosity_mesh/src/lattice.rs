@@ -10,6 +10,7 @@ use rustc_hash::FxHashMap as HashMap;
 use glam::DVec3;
 use radiosity_core::{Facing, MeshParams, Polygon, Sphere};
 
+use crate::bisection::mesh_triangles;
 use crate::builder::{SurfaceBuilder, divisions, polygon_area_normal};
 
 /// A convex planar quad: one bilinear lattice whose lines at every `ne` step are patch edges.
@@ -98,6 +99,12 @@ pub(crate) fn mesh_polygon(b: &mut SurfaceBuilder, poly: &Polygon, params: &Mesh
         mesh_quad(b, [v[0], v[1], v[2], v[3]], poly.normal(), params);
         return;
     }
+    if v.len() == 3 {
+        // As a model's triangles are: a scene file's triangle and the same triangle in an OBJ
+        // mesh alike, and a sliver in a few pieces rather than a lattice.
+        mesh_triangles(b, &[[v[0], v[1], v[2]]], poly.normal(), params);
+        return;
+    }
     // Fan triangles share the lattice step count so that points on shared diagonals are
     // computed by the same formula and merge exactly.
     let fans: Vec<[DVec3; 3]> = (1..v.len() - 1).map(|i| [v[0], v[i], v[i + 1]]).collect();
@@ -145,12 +152,4 @@ pub(crate) fn mesh_sphere(b: &mut SurfaceBuilder, s: &Sphere, params: &MeshParam
             b.elements.push((verts, b.patches.len() - 1));
         }
     }
-}
-
-/// Patch and element steps per edge for a triangle meshed on its own, as [`mesh_polygon`]
-/// chooses them for a one-triangle fan.
-pub(crate) fn triangle_steps(t: &[DVec3; 3], params: &MeshParams) -> (usize, usize) {
-    let longest = t[0].distance(t[1]).max(t[1].distance(t[2])).max(t[2].distance(t[0]));
-    let np = divisions(longest, params.patch_size);
-    (np, divisions(longest / np as f64, params.element_size))
 }

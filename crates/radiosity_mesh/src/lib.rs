@@ -29,6 +29,7 @@
 #![warn(missing_docs)]
 #![forbid(unsafe_code)]
 
+mod bisection;
 mod build;
 mod builder;
 mod contacts;
@@ -37,6 +38,7 @@ mod lattice;
 mod limits;
 mod mesh;
 mod model_faces;
+mod outline;
 mod planar;
 mod pooling;
 mod refinement;

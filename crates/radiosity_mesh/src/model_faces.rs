@@ -6,21 +6,20 @@
 // model; nothing here is keyed by untrusted input an attacker could collide.
 use rustc_hash::FxHashMap as HashMap;
 
+use glam::DVec3;
 use radiosity_core::{MeshParams, Polygon, PolygonMesh};
 
+use crate::bisection::mesh_triangles;
 use crate::builder::SurfaceBuilder;
-use crate::lattice::{mesh_triangle_lattice, triangle_steps};
 use crate::union_find::UnionFind;
 
 /// How the faces of a [`PolygonMesh`] are cut into surfaces: groups of triangles (face
 /// numbers), each meshed with shared vertices; a face of 4+ vertices is a group of its own.
 ///
 /// Two triangles join one group when they share an edge (by vertex index) used by no other
-/// face, are coplanar (normals within ~1e-4 rad, the far vertex within 1e-6 of the longest
-/// edge off the plane) and either their whole coplanar set needs step counts within a factor
-/// 2 of each other (then all are meshed with the set's largest steps) or they need the same
-/// steps; either way the lattice points on a common edge coincide bit for bit.
-pub(crate) fn group_mesh_faces(m: &PolygonMesh, params: &MeshParams) -> Vec<Vec<u32>> {
+/// face and are coplanar (normals within ~1e-4 rad, the far vertex within 1e-6 of the longest
+/// edge off the plane): a wall however its exporter triangulated it is one surface.
+pub(crate) fn group_mesh_faces(m: &PolygonMesh) -> Vec<Vec<u32>> {
     let faces = m.faces();
     let polys = m.polygons();
     let is_tri = |f: usize| faces[f].len() == 3;
@@ -49,10 +48,6 @@ pub(crate) fn group_mesh_faces(m: &PolygonMesh, params: &MeshParams) -> Vec<Vec<
         let longest = (0..3).map(|k| v[k].distance(v[(k + 1) % 3])).fold(0.0, f64::max);
         pb.vertices().iter().all(|p| (*p - v[0]).dot(pa.normal()).abs() <= 1e-6 * longest)
     };
-    let steps = |f: usize| {
-        let v = polys[f].vertices();
-        triangle_steps(&[v[0], v[1], v[2]], params)
-    };
     let mut pairs: Vec<(u32, u32)> = edges
         .values()
         .filter(|&&(a, b, count)| count == 2 && b != u32::MAX && coplanar(a as usize, b as usize))
@@ -60,38 +55,16 @@ pub(crate) fn group_mesh_faces(m: &PolygonMesh, params: &MeshParams) -> Vec<Vec<
         .collect();
     // HashMap order is arbitrary; sorting keeps the grouping (and so the mesh) deterministic.
     pairs.sort_unstable();
-    // First pass: every coplanar edge-connected set. A set of exactly two triangles is kept
-    // whole (it becomes a quad when convex); larger sets are split where the steps differ.
-    let mut all = UnionFind::new(faces.len());
+    // Every coplanar edge-connected set is one surface: its triangles are cut where each is
+    // long (see `mesh_triangle_group`), so they need not share a step count to fit together.
+    let mut coplanar_sets = UnionFind::new(faces.len());
     for &(a, b) in &pairs {
-        all.union(a, b);
-    }
-    // Per set: its size and the least and most lattice steps (np · ne) of its triangles.
-    let mut size = vec![0u32; faces.len()];
-    let mut step_range = vec![(usize::MAX, 0usize); faces.len()];
-    for f in 0..faces.len() as u32 {
-        let r = all.find(f) as usize;
-        size[r] += 1;
-        if is_tri(f as usize) {
-            let (np, ne) = steps(f as usize);
-            step_range[r] = (step_range[r].0.min(np * ne), step_range[r].1.max(np * ne));
-        }
-    }
-    let mut same_steps = UnionFind::new(faces.len());
-    for &(a, b) in &pairs {
-        let r = all.find(a) as usize;
-        // A set whose triangles need at most twice as many steps as each other is meshed
-        // whole with the largest steps (at most 2× finer per edge than each one needs, the
-        // common case of an n-gon split by an exporter); otherwise only equal steps join.
-        let whole = size[r] == 2 || step_range[r].1 <= 2 * step_range[r].0;
-        if whole || steps(a as usize) == steps(b as usize) {
-            same_steps.union(a, b);
-        }
+        coplanar_sets.union(a, b);
     }
     let mut group_of: HashMap<u32, usize> = HashMap::default();
     let mut groups: Vec<Vec<u32>> = Vec::new();
     for f in 0..faces.len() as u32 {
-        let r = same_steps.find(f);
+        let r = coplanar_sets.find(f);
         let g = *group_of.entry(r).or_insert_with(|| {
             groups.push(Vec::new());
             groups.len() - 1
@@ -119,52 +92,20 @@ pub(crate) fn pair_as_quad(m: &PolygonMesh, a: usize, b: usize) -> Option<Polygo
     None
 }
 
-/// Meshes a group of coplanar triangles into `b` with the same steps for all, placing lattice
-/// points on an edge from the edge's lower vertex index so both triangles on a shared edge
-/// compute the same bits and their vertices merge.
+/// Meshes a group of coplanar triangles into `b`, each cut by bisection (see `bisection`).
 pub(crate) fn mesh_triangle_group(
     b: &mut SurfaceBuilder,
     m: &PolygonMesh,
     group: &[u32],
     params: &MeshParams,
 ) {
-    let (mut np, mut ne) = (1, 1);
-    for &f in group {
-        let v = m.polygons()[f as usize].vertices();
-        let (p, e) = triangle_steps(&[v[0], v[1], v[2]], params);
-        np = np.max(p);
-        ne = ne.max(e);
-    }
-    let n = np * ne;
     let pos = m.positions();
-    for &f in group {
-        let idx = &m.faces()[f as usize];
-        let normal = m.polygons()[f as usize].normal();
-        let t = [idx[0], idx[1], idx[2]];
-        let edge = |p: u32, q: u32, k: usize| {
-            // Point k of n from vertex p towards q, computed from the lower index.
-            let (a, c, k) = if p < q { (p, q, k) } else { (q, p, n - k) };
-            let (pa, pc) = (pos[a as usize], pos[c as usize]);
-            if k == 0 {
-                pa
-            } else if k == n {
-                pc
-            } else {
-                pa + (pc - pa) * (k as f64 / n as f64)
-            }
-        };
-        let at = |i: usize, j: usize| {
-            if j == 0 {
-                edge(t[0], t[1], i)
-            } else if i == 0 {
-                edge(t[0], t[2], j)
-            } else if i + j == n {
-                edge(t[1], t[2], j)
-            } else {
-                let [p0, p1, p2] = t.map(|i| pos[i as usize]);
-                p0 + (p1 - p0) * (i as f64 / n as f64) + (p2 - p0) * (j as f64 / n as f64)
-            }
-        };
-        mesh_triangle_lattice(b, &at, normal, np, ne);
-    }
+    let triangles: Vec<[DVec3; 3]> = group
+        .iter()
+        .map(|&f| {
+            let idx = &m.faces()[f as usize];
+            [idx[0], idx[1], idx[2]].map(|i| pos[i as usize])
+        })
+        .collect();
+    mesh_triangles(b, &triangles, m.polygons()[group[0] as usize].normal(), params);
 }

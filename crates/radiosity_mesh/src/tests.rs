@@ -31,8 +31,11 @@ fn check_mesh(mesh: &Mesh, expected_area: f64, params: &MeshParams) {
             let el = &mesh.elements[e as usize];
             assert!(el.normal.dot(p.normal) > 0.999);
             let pts: Vec<DVec3> = mesh.element_corners(e as usize).collect();
+            // A quad's sides are at most the element size; a triangle's longest edge at most
+            // the diagonal of that square (a model's triangles are cut by bisection to it).
+            let limit = if pts.len() == 3 { std::f64::consts::SQRT_2 } else { 1.0 } * params.element_size;
             for k in 0..pts.len() {
-                assert!(pts[k].distance(pts[(k + 1) % pts.len()]) <= params.element_size * (1.0 + 1e-9));
+                assert!(pts[k].distance(pts[(k + 1) % pts.len()]) <= limit * (1.0 + 1e-9));
             }
         }
     }
@@ -132,11 +135,13 @@ fn triangle_grid(n: u32) -> PolygonMesh {
 #[test]
 fn coplanar_connected_triangles_form_one_surface_with_shared_vertices() {
     let grid = triangle_grid(4);
-    let params = MeshParams::try_new(2.0, 1.0).unwrap();
+    let params = MeshParams::try_new(2.0, 0.5).unwrap();
     let mesh = Mesh::build(&scene_of(Shape::Mesh(grid)), &params).unwrap();
     assert_eq!(mesh.surfaces.len(), 1);
-    // Each triangle (longest edge √2) gets 2 element steps: 4 elements, 32 triangles.
-    assert_eq!(mesh.elements.len(), 128);
+    // Its outline is the 4 × 4 square (the grid's points on its sides dropped): meshed as
+    // that quad, 2 × 2 patches of 4 × 4 square elements.
+    assert_eq!(mesh.patches.len(), 4);
+    assert_eq!(mesh.elements.len(), 64);
     assert_eq!(mesh.positions.len(), 81);
     // Shared exactly: every lattice point of the 9×9 grid once, none doubled along an edge.
     let mut distinct: Vec<[u64; 3]> =
@@ -164,8 +169,8 @@ fn euler_characteristic(mesh: &Mesh) -> i64 {
 
 #[test]
 fn an_exporters_split_of_an_l_shaped_face_is_one_surface() {
-    // An L fanned into four triangles as an exporter splits an n-gon: the two on the long
-    // arm need 8 steps per edge, the two on the short arm 6 — one surface, 8 steps.
+    // An L fanned into four triangles as an exporter splits an n-gon, long thin ones among
+    // them: one surface, each triangle bisected where it is long.
     let positions = [(0.0, 0.0), (3.0, 0.0), (3.0, 1.0), (1.0, 1.0), (1.0, 2.0), (0.0, 2.0)]
         .map(|(x, y)| DVec3::new(x, y, 0.0))
         .to_vec();
@@ -174,7 +179,11 @@ fn an_exporters_split_of_an_l_shaped_face_is_one_surface() {
     let params = MeshParams::try_new(1.0, 0.5).unwrap();
     let mesh = Mesh::build(&scene_of(Shape::Mesh(l)), &params).unwrap();
     assert_eq!(mesh.surfaces.len(), 1);
-    assert_eq!(mesh.elements.len(), 4 * 8 * 8);
+    // Its outline, triangulated afresh and bisected to √2 · 0.5, gives pieces of about
+    // 0.125 (half a square of the element size): a lattice of 8 steps per edge, set by the
+    // longest diagonal, gave 4 · 8 · 8 = 256 for the same area of 4.
+    let n = mesh.elements.len();
+    assert!((32..=80).contains(&n), "{n} elements");
     check_mesh(&mesh, 4.0, &params);
     // A disc (V − E + F = 1) only when the fan's shared diagonals merged exactly.
     assert_eq!(euler_characteristic(&mesh), 1);
@@ -534,4 +543,138 @@ fn walls_facing_away_from_every_emitter_are_found() {
     assert_eq!(away.len(), 7);
     assert!(away[..6].iter().all(|a| (a - 1.0).abs() < 1e-9), "{away:?}");
     assert_eq!(away[6], 0.0, "emitters are not counted");
+}
+
+/// The point `k` quarters of the way along edge `p → q`, made once per edge.
+fn quarter_point(
+    p: u32,
+    q: u32,
+    k: u32,
+    positions: &mut Vec<DVec3>,
+    on_edge: &mut HashMap<(u32, u32, u32), u32>,
+) -> u32 {
+    match k {
+        0 => p,
+        4 => q,
+        _ => {
+            let (lo, hi, k) = if p < q { (p, q, k) } else { (q, p, 4 - k) };
+            *on_edge.entry((lo, hi, k)).or_insert_with(|| {
+                let (x, y) = (positions[lo as usize], positions[hi as usize]);
+                positions.push(x + (y - x) * (f64::from(k) / 4.0));
+                (positions.len() - 1) as u32
+            })
+        }
+    }
+}
+
+/// `m` with every triangle cut into 16 by a 4 × 4 barycentric lattice, the points on an edge
+/// shared by the triangles on both sides (as a modeller's subdivision writes them).
+fn cut_into_16(m: &PolygonMesh) -> PolygonMesh {
+    let mut positions = m.positions().to_vec();
+    let mut on_edge = HashMap::default();
+    let mut faces = Vec::new();
+    for f in m.faces() {
+        let (a, b, c) = (f[0], f[1], f[2]);
+        let mut at = HashMap::default();
+        for i in 0..=4u32 {
+            for j in 0..=4 - i {
+                let v = if j == 0 {
+                    quarter_point(a, b, i, &mut positions, &mut on_edge)
+                } else if i == 0 {
+                    quarter_point(a, c, j, &mut positions, &mut on_edge)
+                } else if i + j == 4 {
+                    quarter_point(b, c, j, &mut positions, &mut on_edge)
+                } else {
+                    let [pa, pb, pc] = [a, b, c].map(|v| positions[v as usize]);
+                    positions.push(pa + (pb - pa) * (f64::from(i) / 4.0) + (pc - pa) * (f64::from(j) / 4.0));
+                    (positions.len() - 1) as u32
+                };
+                at.insert((i, j), v);
+            }
+        }
+        for i in 0..4 {
+            for j in 0..4 - i {
+                faces.push(vec![at[&(i, j)], at[&(i + 1, j)], at[&(i, j + 1)]]);
+                if i + j + 2 <= 4 {
+                    faces.push(vec![at[&(i + 1, j)], at[&(i + 1, j + 1)], at[&(i, j + 1)]]);
+                }
+            }
+        }
+    }
+    PolygonMesh::try_new(positions, faces).unwrap()
+}
+
+#[test]
+fn a_model_cut_into_16_meshes_as_the_model_does() {
+    // A room of quads (each written as two triangles), a slanted roof triangle, a fan of
+    // slivers and a small object's facets: cut into 16 pieces each, still the same surfaces.
+    let mut positions = Vec::new();
+    let mut faces: Vec<Vec<u32>> = Vec::new();
+    let quad = |q: [DVec3; 4], positions: &mut Vec<DVec3>, faces: &mut Vec<Vec<u32>>| {
+        let base = positions.len() as u32;
+        positions.extend(q);
+        faces.push(vec![base, base + 1, base + 2]);
+        faces.push(vec![base, base + 2, base + 3]);
+    };
+    let (w, h, d) = (6.0, 2.8, 5.0);
+    let p = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+    quad([p(0.0, 0.0, 0.0), p(0.0, 0.0, d), p(w, 0.0, d), p(w, 0.0, 0.0)], &mut positions, &mut faces);
+    quad([p(0.0, h, 0.0), p(w, h, 0.0), p(w, h, d), p(0.0, h, d)], &mut positions, &mut faces);
+    quad([p(0.0, 0.0, 0.0), p(w, 0.0, 0.0), p(w, h, 0.0), p(0.0, h, 0.0)], &mut positions, &mut faces);
+    // A fan of slivers from one corner of the far wall, as an exporter writes an n-gon.
+    let base = positions.len() as u32;
+    positions.push(p(0.0, 0.0, d));
+    for k in 0..=8 {
+        positions.push(p(w * f64::from(k) / 8.0, h, d));
+    }
+    positions.push(p(w, 0.0, d));
+    for k in 0..8 {
+        faces.push(vec![base, base + 2 + k, base + 1 + k]);
+    }
+    faces.push(vec![base, base + 10, base + 9]);
+    // Small facets of an object: a tetrahedron 10 cm across.
+    let t = positions.len() as u32;
+    positions.extend([p(3.0, 1.0, 2.0), p(3.1, 1.0, 2.0), p(3.0, 1.1, 2.0), p(3.0, 1.0, 2.1)]);
+    faces.extend([
+        vec![t, t + 2, t + 1],
+        vec![t, t + 1, t + 3],
+        vec![t, t + 3, t + 2],
+        vec![t + 1, t + 2, t + 3],
+    ]);
+    let model = PolygonMesh::try_new(positions, faces).unwrap();
+    let cut = cut_into_16(&model);
+    assert_eq!(cut.faces().len(), 16 * model.faces().len());
+    let params = MeshParams::try_new(1.0, 0.25).unwrap();
+    let a = Mesh::build(&scene_of(Shape::Mesh(model)), &params).unwrap();
+    let b = Mesh::build(&scene_of(Shape::Mesh(cut)), &params).unwrap();
+    assert_eq!(b.surfaces.len(), a.surfaces.len());
+    assert_eq!(b.patches.len(), a.patches.len());
+    assert_eq!(b.elements.len(), a.elements.len());
+    assert!((a.total_area() - b.total_area()).abs() < 1e-9 * a.total_area());
+    assert_eq!(euler_characteristic(&b), euler_characteristic(&a));
+}
+
+#[test]
+fn a_face_with_a_hole_is_one_surface_around_it() {
+    // A 3 × 3 square with a 1 × 1 window in the middle, triangulated by hand around it.
+    let ring =
+        |s: f64, o: f64| [(o, o), (o + s, o), (o + s, o + s), (o, o + s)].map(|(x, y)| DVec3::new(x, y, 0.0));
+    let positions: Vec<DVec3> = ring(3.0, 0.0).into_iter().chain(ring(1.0, 1.0)).collect();
+    let mut faces = Vec::new();
+    for k in 0..4u32 {
+        let (o0, o1, i0, i1) = (k, (k + 1) % 4, 4 + k, 4 + (k + 1) % 4);
+        faces.push(vec![o0, o1, i1]);
+        faces.push(vec![o0, i1, i0]);
+    }
+    let wall = PolygonMesh::try_new(positions, faces).unwrap();
+    let params = MeshParams::try_new(1.0, 0.25).unwrap();
+    let mesh = Mesh::build(&scene_of(Shape::Mesh(wall)), &params).unwrap();
+    assert_eq!(mesh.surfaces.len(), 1);
+    check_mesh(&mesh, 8.0, &params);
+    // An annulus: V − E + F = 0 only when every piece's points merged and none covers the hole.
+    assert_eq!(euler_characteristic(&mesh), 0);
+    for e in &mesh.elements {
+        let c = e.centre;
+        assert!(!(c.x > 1.0 && c.x < 2.0 && c.y > 1.0 && c.y < 2.0), "an element in the hole at {c}");
+    }
 }

@@ -928,25 +928,18 @@ mod tests {
         assert!(seen.iter().filter(|&&n| n == 1).count() > mesh.patches.len() / 2);
     }
 
-    /// A flat face tessellated into many small coplanar triangles (a CAD model's) is one
-    /// surface of many patches: its patches are facets and shoot in groups, while a wall cut
-    /// into patch-size pieces stays alone.
+    /// A flat face tessellated into many small coplanar triangles (a CAD model's disc, fanned
+    /// from its centre) is one surface of many patches: its patches are facets and shoot in
+    /// groups, while a wall cut into patch-size pieces stays alone.
     #[test]
     fn a_tessellated_flat_face_groups_and_a_wall_does_not() {
-        let n = 20u32;
-        let positions: Vec<DVec3> = (0..=n)
-            .flat_map(|j| (0..=n).map(move |i| DVec3::new(f64::from(i) * 0.01, f64::from(j) * 0.01, 0.0)))
-            .collect();
-        let at = |i: u32, j: u32| j * (n + 1) + i;
-        let faces: Vec<Vec<u32>> = (0..n)
-            .flat_map(|j| (0..n).map(move |i| (i, j)))
-            .flat_map(|(i, j)| {
-                [
-                    vec![at(i, j), at(i + 1, j), at(i + 1, j + 1)],
-                    vec![at(i, j), at(i + 1, j + 1), at(i, j + 1)],
-                ]
-            })
-            .collect();
+        let n = 128u32;
+        let rim = (0..n).map(|k| {
+            let a = std::f64::consts::TAU * f64::from(k) / f64::from(n);
+            DVec3::new(0.1 * a.cos(), 0.1 * a.sin(), 0.0)
+        });
+        let positions: Vec<DVec3> = std::iter::once(DVec3::ZERO).chain(rim).collect();
+        let faces: Vec<Vec<u32>> = (0..n).map(|k| vec![0, 1 + k, 1 + (k + 1) % n]).collect();
         let plate = PolygonMesh::try_new(positions, faces).unwrap();
         let white = Material::try_new("white", Rgb::splat(0.5), Rgb::splat(1.0)).unwrap();
         let wall = radiosity_core::Polygon::try_new(vec![
