@@ -141,10 +141,14 @@ impl Solver {
             }
             Shooter::Group(g) => self.clusters.probe_points(g),
         };
-        let (lo, hi) = mesh.bounds();
-        let reach = 2.0 * (hi - lo).length();
-        let known =
-            super::enclosure::encloses(&*self.accel, hull, &points, reach, self.params.seed, key as u64);
+        let known = super::enclosure::encloses(
+            &*self.accel,
+            hull,
+            &points,
+            self.probe_reach,
+            self.params.seed,
+            key as u64,
+        );
         self.enclosed[key] = Some(known);
         known
     }
