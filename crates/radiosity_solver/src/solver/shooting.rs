@@ -41,7 +41,7 @@ impl Solver {
 
     /// One shot.
     fn shoot(&mut self) {
-        // 1. The shooter: a patch, or a group of a model's facets (`clusters.rs`).
+        // 1. The shooter: a patch, or a group of a model's facets (`clusters`).
         let shooter = self.clusters.brightest(&self.tally.patch_abs);
         let key = match shooter {
             Shooter::Patch(p) => p,
