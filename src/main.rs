@@ -7,6 +7,7 @@ mod compare_cmd;
 mod comparison;
 mod errors;
 mod export_cmd;
+mod false_colour_cmd;
 mod grid_cmd;
 mod info_cmd;
 mod interrupt;

@@ -1,5 +1,6 @@
 //! A rendered picture in false colour by illuminance: each pixel coloured by the lux falling
-//! on the surface it sees, in the bands of a [`LuxScale`], with the legend beside it.
+//! on the surface it sees, in the bands of a [`LuxScale`], iso-lux lines between the bands,
+//! with the legend beside it.
 //!
 //! A diffuse surface of reflectance ρ and emission Lₑ under irradiance E sends radiance
 //! L = (Lₑ + ρ E) / π towards the eye, so the picture's own radiance gives back
@@ -13,6 +14,9 @@ use crate::canvas::{BLACK, Canvas, WHITE};
 use crate::font::text_height;
 use crate::lux_scale::{LuxScale, format_lux};
 use crate::{Rendering, SrgbImage};
+
+/// The colour of the iso-lux lines between bands.
+const ISO_LINE: [u8; 3] = [40, 40, 40];
 
 /// The colour of a pixel whose illuminance is unknown.
 pub const NO_DATA: [u8; 3] = [96, 96, 96];
@@ -79,9 +83,16 @@ pub fn false_colour_picture(lux: &[Option<f64>], width: u32, height: u32) -> Srg
     let legend_w = (14 + 6) * s + crate::font::text_width("100000", s) + 12;
     let foot = text_height(s) + 12;
     let mut c = Canvas::new(width + 16 + legend_w, height + foot, WHITE);
+    let band = |e: &Option<f64>| e.map(|e| scale.band(e));
+    let w = width as usize;
     for (i, e) in lux.iter().enumerate() {
-        let (x, y) = ((i % width as usize) as i64, (i / width as usize) as i64);
-        c.set(x, y, e.map_or(NO_DATA, |e| scale.colour(e)));
+        let (x, y) = ((i % w) as i64, (i / w) as i64);
+        // Iso-lux lines where the band changes between two pixels that both have a value.
+        let here = band(e);
+        let right = (i % w + 1 < w).then(|| band(&lux[i + 1])).flatten();
+        let below = lux.get(i + w).and_then(band);
+        let edge = here.is_some_and(|b| [right, below].into_iter().flatten().any(|o| o != b));
+        c.set(x, y, if edge { ISO_LINE } else { e.map_or(NO_DATA, |e| scale.colour(e)) });
     }
     scale.draw_legend(&mut c, i64::from(width) + 12, 4, height.saturating_sub(8), s);
     let seen: Vec<f64> = lux.iter().flatten().copied().collect();
