@@ -9,6 +9,7 @@ mod dependencies;
 mod discretisation;
 mod export;
 mod fast_paths;
+mod grid_outputs;
 mod model_fuzz;
 mod models;
 mod modules;
