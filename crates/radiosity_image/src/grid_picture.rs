@@ -244,3 +244,71 @@ pub fn picture_sheet(pictures: &[SrgbImage]) -> SrgbImage {
     }
     c.into_image()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::grid_statistics;
+
+    fn grid(v: DVec3) -> (Grid, GridIlluminance) {
+        let g = Grid {
+            name: "desk".into(),
+            origin: DVec3::ZERO,
+            u: DVec3::new(3.0, 0.0, 0.0),
+            v,
+            divisions: [3, 2],
+            normal: DVec3::Y,
+            height: 0.0,
+        };
+        let lux = vec![100.0, 200.0, 300.0, 400.0, 500.0, 600.0];
+        let (min, avg, max, uniformity) = grid_statistics(&lux);
+        let points = g.points();
+        let r = GridIlluminance {
+            name: "desk".into(),
+            points,
+            direct_lux: lux.clone(),
+            lux,
+            min,
+            avg,
+            max,
+            uniformity,
+        };
+        (g, r)
+    }
+
+    /// The plot's top-left pixel, a few pixels in from the frame.
+    fn top_left(image: &SrgbImage) -> [u8; 3] {
+        let x = MARGIN + text_width("00.00", 1) + 8 + 3;
+        let y = MARGIN + text_height(BIG) + 10 + 3;
+        image.pixels[(y * image.width + x) as usize]
+    }
+
+    #[test]
+    fn a_work_plane_is_seen_from_above_and_a_flipped_one_too() {
+        let scale = LuxScale::for_range(100.0, 600.0);
+        // u = +x, v = +z, seen from +y: v runs down the page, the first point top left.
+        let (g, r) = grid(DVec3::new(0.0, 0.0, 2.0));
+        let image = grid_picture(&g, &r, "m", Some(&scale), &[]);
+        assert_eq!(top_left(&image), scale.colour(100.0));
+        // v = −z: seen from +y the second row of points is at the top.
+        let (g, r) = grid(DVec3::new(0.0, 0.0, -2.0));
+        let image = grid_picture(&g, &r, "m", Some(&scale), &[]);
+        assert_eq!(top_left(&image), scale.colour(400.0));
+        // The plot keeps the grid's proportions: 640 px for 3 m, about 427 px for 2 m.
+        assert!(image.height > 427 && image.width > 640);
+        for band in 0..=scale.levels.len() {
+            assert!(image.pixels.contains(&scale.band_colour(band)), "band {band}");
+        }
+    }
+
+    #[test]
+    fn luminaires_over_the_grid_are_marked_and_others_not() {
+        let (g, r) = grid(DVec3::new(0.0, 0.0, 2.0));
+        let plain = grid_picture(&g, &r, "m", None, &[]);
+        let away = grid_picture(&g, &r, "m", None, &[DVec3::new(10.0, 2.8, 1.0)]);
+        assert_eq!(plain, away, "a luminaire beside the grid is not drawn");
+        let over = grid_picture(&g, &r, "m", None, &[DVec3::new(1.5, 2.8, 1.0)]);
+        let changed = plain.pixels.iter().zip(&over.pixels).filter(|(a, b)| a != b).count();
+        assert!((20..400).contains(&changed), "{changed} pixels of a mark");
+    }
+}
