@@ -18,6 +18,7 @@ mod progress;
 mod public_models;
 mod readme;
 mod rooms;
+mod surface_grids;
 mod up_axis;
 mod verify;
 mod viewer;

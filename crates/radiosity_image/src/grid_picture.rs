@@ -40,6 +40,53 @@ fn field(lux: &[f64], nu: usize, nv: usize, s: f64, t: f64) -> f64 {
     top * (1.0 - fb) + bottom * fb
 }
 
+/// How a grid's parameters (s along u, t along v, both 0..1) lie on its plot: the plot is
+/// the grid seen from the side its normal points to; a plan (a grid facing up or down) has u
+/// to the right, a vertical grid the world's up (+y) up the page.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct View {
+    /// u runs down the page and v across.
+    transpose: bool,
+    /// The parameter across runs right to left.
+    flip_across: bool,
+    /// The parameter down runs bottom to top.
+    flip_down: bool,
+}
+
+impl View {
+    fn of(grid: &Grid) -> Self {
+        let (u, v, n) = (grid.u, grid.v, grid.normal);
+        let plan = n.normalize().y.abs() >= 0.5;
+        // The edge down the page, and the one across.
+        let transpose = !plan && u.y.abs() > v.y.abs();
+        let (down, across) = if transpose { (u, v) } else { (v, u) };
+        let flip_down = if plan { u.cross(v).dot(n) > 0.0 } else { down.y > 0.0 };
+        let down = if flip_down { -down } else { down };
+        // Right × down points away from the viewer, who looks along −n.
+        let flip_across = across.cross(down).dot(n) > 0.0;
+        Self { transpose, flip_across, flip_down }
+    }
+
+    /// (s, t) at plot fractions `a` (left to right) and `b` (top to bottom).
+    fn st(self, a: f64, b: f64) -> (f64, f64) {
+        let a = if self.flip_across { 1.0 - a } else { a };
+        let b = if self.flip_down { 1.0 - b } else { b };
+        if self.transpose { (b, a) } else { (a, b) }
+    }
+
+    /// Plot fractions (a, b) of (s, t): the inverse of [`View::st`].
+    fn ab(self, s: f64, t: f64) -> (f64, f64) {
+        let (a, b) = if self.transpose { (t, s) } else { (s, t) };
+        (if self.flip_across { 1.0 - a } else { a }, if self.flip_down { 1.0 - b } else { b })
+    }
+
+    /// Lengths of the edges across and down the page.
+    fn sides(self, grid: &Grid) -> (f64, f64) {
+        let (lu, lv) = (grid.u.length(), grid.v.length());
+        if self.transpose { (lv, lu) } else { (lu, lv) }
+    }
+}
+
 /// A rectangle taken by a label: x, y, w, h.
 type Rect = (i64, i64, i64, i64);
 
@@ -66,8 +113,8 @@ fn luminaire_mark(c: &mut Canvas, x: i64, y: i64) {
 
 /// The false-colour picture of one grid's result (`unit`: the scene's length unit, for the
 /// edge lengths). `scale` gives the levels; `None` chooses them from the grid's own range.
-/// `luminaires` (positions in the grid's frame) are marked where they project onto the grid
-/// along its normal.
+/// On a plan (a grid facing up or down), `luminaires` (positions in the grid's frame) are
+/// marked where they project onto it along its normal.
 ///
 /// # Panics
 /// When `result` does not hold `grid`'s points (a bug in the caller).
@@ -89,11 +136,11 @@ pub fn grid_picture(
         }
     };
     let (lu, lv) = (grid.u.length(), grid.v.length());
-    // Seen from the normal's side: u to the right, v down when u × v points away.
-    let v_down = grid.u.cross(grid.v).dot(grid.normal) <= 0.0;
+    let view = View::of(grid);
+    let (l_across, l_down) = view.sides(grid);
     let ppu = PLOT_SIDE / lu.max(lv).max(1e-12);
-    let pw = (lu * ppu).max(MIN_SIDE).round() as u32;
-    let ph = (lv * ppu).max(MIN_SIDE).round() as u32;
+    let pw = (l_across * ppu).max(MIN_SIDE).round() as u32;
+    let ph = (l_down * ppu).max(MIN_SIDE).round() as u32;
 
     let small = 1;
     let title_h = text_height(BIG) + 10;
@@ -112,9 +159,7 @@ pub fn grid_picture(
     let mut bands = vec![0usize; w * h];
     for py in 0..h {
         for px in 0..w {
-            let s = (px as f64 + 0.5) / w as f64;
-            let t_down = (py as f64 + 0.5) / h as f64;
-            let t = if v_down { t_down } else { 1.0 - t_down };
+            let (s, t) = view.st((px as f64 + 0.5) / w as f64, (py as f64 + 0.5) / h as f64);
             let e = field(&result.lux, nu, nv, s, t);
             let b = scale.band(e);
             bands[py * w + px] = b;
@@ -140,9 +185,8 @@ pub fn grid_picture(
     // The calculation points.
     for j in 0..nv {
         for i in 0..nu {
-            let px = ((i as f64 + 0.5) / nu as f64 * w as f64) as i64;
-            let t = (j as f64 + 0.5) / nv as f64;
-            let py = ((if v_down { t } else { 1.0 - t }) * h as f64) as i64;
+            let (a, b) = view.ab((i as f64 + 0.5) / nu as f64, (j as f64 + 0.5) / nv as f64);
+            let (px, py) = ((a * w as f64) as i64, (b * h as f64) as i64);
             c.fill_rect(plot_x + px - 1, plot_y + py - 1, 2, 2, [70, 70, 70]);
         }
     }
@@ -151,8 +195,9 @@ pub fn grid_picture(
     let mut taken: Vec<Rect> = Vec::new();
     let (uu, uv, vv) = (grid.u.dot(grid.u), grid.u.dot(grid.v), grid.v.dot(grid.v));
     let det = uu * vv - uv * uv;
+    let plan = grid.normal.normalize().y.abs() >= 0.5;
     for &p in luminaires {
-        if det.abs() <= 1e-18 * uu * vv {
+        if !plan || det.abs() <= 1e-18 * uu * vv {
             break;
         }
         let d = p - grid.origin;
@@ -161,7 +206,8 @@ pub fn grid_picture(
         if !(0.0..=1.0).contains(&s) || !(0.0..=1.0).contains(&t) {
             continue;
         }
-        let (x, y) = ((s * w as f64) as i64, ((if v_down { t } else { 1.0 - t }) * h as f64) as i64);
+        let (a, b) = view.ab(s, t);
+        let (x, y) = ((a * w as f64) as i64, (b * h as f64) as i64);
         luminaire_mark(&mut c, plot_x + x, plot_y + y);
         taken.push((x - 10, y - 10, 20, 20));
     }
@@ -188,17 +234,18 @@ pub fn grid_picture(
     }
     c.outline_rect(plot_x - 1, plot_y - 1, pw + 2, ph + 2, BLACK);
 
-    // Edge lengths: 0 and the full length along each edge, in the scene's unit.
+    // Edge lengths from the plot's bottom-left corner, in the scene's unit.
     let fmt = |x: f64| {
         let s = format!("{x:.2}");
         s.trim_end_matches('0').trim_end_matches('.').to_owned()
     };
     let below = plot_y + i64::from(ph) + 5;
     c.text(plot_x, below, "0", small, BLACK);
-    let u_label = format!("{} {unit}", fmt(lu));
-    c.text(plot_x + i64::from(pw) - i64::from(text_width(&u_label, small)), below, &u_label, small, BLACK);
-    let v_label = format!("{} {unit}", fmt(lv));
-    let (v_top, v_bottom) = if v_down { ("0", v_label.as_str()) } else { (v_label.as_str(), "0") };
+    let across_label = format!("{} {unit}", fmt(l_across));
+    let right = plot_x + i64::from(pw) - i64::from(text_width(&across_label, small));
+    c.text(right, below, &across_label, small, BLACK);
+    let down_label = format!("{} {unit}", fmt(l_down));
+    let (v_top, v_bottom) = (down_label.as_str(), "0");
     let right_align = |c: &mut Canvas, y: i64, s: &str| {
         c.text(plot_x - 6 - i64::from(text_width(s, small)), y, s, small, BLACK);
     };
@@ -310,5 +357,36 @@ mod tests {
         let over = grid_picture(&g, &r, "m", None, &[DVec3::new(1.5, 2.8, 1.0)]);
         let changed = plain.pixels.iter().zip(&over.pixels).filter(|(a, b)| a != b).count();
         assert!((20..400).contains(&changed), "{changed} pixels of a mark");
+    }
+
+    #[test]
+    fn a_wall_stands_upright_seen_from_the_room() {
+        let wall = |u: DVec3, v: DVec3, normal: DVec3| Grid {
+            name: "wall".into(),
+            origin: DVec3::ZERO,
+            u,
+            v,
+            divisions: [2, 2],
+            normal,
+            height: 0.0,
+        };
+        let (x, y, z) = (DVec3::X, DVec3::Y, DVec3::Z);
+        // A north wall at z = 4 seen from the room (normal −z), its corners in either order.
+        for g in [wall(2.8 * y, 6.0 * x, -z), wall(6.0 * x, 2.8 * y, -z), wall(-2.8 * y, -6.0 * x, -z)] {
+            let view = View::of(&g);
+            let at = |a: f64, b: f64| {
+                let (s, t) = view.st(a, b);
+                g.origin + g.u * s + g.v * t
+            };
+            // Up the page is up in the room; seen from −z, +x runs right to left.
+            assert!(at(0.5, 0.0).y > at(0.5, 1.0).y, "{g:?}");
+            assert!(at(0.0, 0.5).x > at(1.0, 0.5).x, "{g:?}");
+            assert_eq!(view.sides(&g), (6.0, 2.8));
+            for (s, t) in [(0.1, 0.7), (0.9, 0.2)] {
+                let (a, b) = view.ab(s, t);
+                let back = view.st(a, b);
+                assert!((back.0 - s).abs() < 1e-12 && (back.1 - t).abs() < 1e-12);
+            }
+        }
     }
 }
