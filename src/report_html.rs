@@ -29,6 +29,56 @@ pub fn escape(text: &str) -> String {
     text.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
 }
 
+/// A luminaire's type: its name without the number of its place in a row (`downlight #3`).
+fn luminaire_type(name: &str) -> &str {
+    name.rsplit_once(" #").map_or(name, |(base, n)| if n.parse::<u32>().is_ok() { base } else { name })
+}
+
+/// The luminaire schedule (each type with its count, flux each and in all, and the total),
+/// then every luminaire's position in a folded table.
+fn luminaire_tables(prepared: &Prepared) -> String {
+    let lighting = &prepared.scene.lighting;
+    let unit = lighting.unit().as_str();
+    // Types in the order they first appear; one row per type and flux.
+    let mut rows: Vec<(&str, f64, usize)> = Vec::new();
+    for l in &lighting.luminaires {
+        let (kind, flux) = (luminaire_type(&l.name), l.flux());
+        match rows.iter_mut().find(|r| r.0 == kind && (r.1 - flux).abs() <= 1e-9 * flux.abs()) {
+            Some(r) => r.2 += 1,
+            None => rows.push((kind, flux, 1)),
+        }
+    }
+    let mut h = String::from(
+        "<table><tr><th>luminaire</th><th>count</th><th>flux each (lm)</th><th>flux (lm)</th></tr>\n",
+    );
+    for (kind, flux, count) in &rows {
+        h += &format!(
+            "<tr><td>{}</td><td class=\"n\">{count}</td><td class=\"n\">{flux:.0}</td><td class=\"n\">{:.0}</td></tr>\n",
+            escape(kind),
+            flux * *count as f64
+        );
+    }
+    let total: f64 = lighting.luminaires.iter().map(|l| l.flux()).sum();
+    h += &format!(
+        "<tr><th>total</th><th class=\"n\">{}</th><th></th><th class=\"n\">{total:.0}</th></tr></table>\n",
+        lighting.luminaires.len()
+    );
+    h += &format!(
+        "<details><summary>Positions</summary><table><tr><th>luminaire</th><th>x, y, z ({unit})</th></tr>\n"
+    );
+    for l in &lighting.luminaires {
+        let p = prepared.up.from_y_up(l.position);
+        h += &format!(
+            "<tr><td>{}</td><td class=\"n\">{:.2}, {:.2}, {:.2}</td></tr>\n",
+            escape(&l.name),
+            p.x,
+            p.y,
+            p.z
+        );
+    }
+    h + "</table></details>\n"
+}
+
 const STYLE: &str = "body{font-family:Helvetica,Arial,sans-serif;max-width:60em;margin:2em auto;color:#222}\
 h1{font-size:1.6em;margin-bottom:0.2em}h2{font-size:1.2em;margin-top:1.6em;border-bottom:1px solid #999}\
 table{border-collapse:collapse;margin:0.6em 0}th,td{border:1px solid #bbb;padding:0.25em 0.7em}\
@@ -56,24 +106,7 @@ pub fn grid_report(prepared: &Prepared, grids: &[GridIlluminance], pictures: &[&
     if lighting.luminaires.is_empty() {
         h += "<p>No photometric luminaires: the light comes from the scene's emitting surfaces.</p>\n";
     } else {
-        let total: f64 = lighting.luminaires.iter().map(|l| l.flux()).sum();
-        h += &format!("<table><tr><th>luminaire</th><th>position ({unit})</th><th>flux (lm)</th></tr>\n");
-        for l in &lighting.luminaires {
-            let p = prepared.up.from_y_up(l.position);
-            h += &format!(
-                "<tr><td>{}</td><td class=\"n\">{:.2}, {:.2}, {:.2}</td><td class=\"n\">{:.0}</td></tr>\n",
-                escape(&l.name),
-                p.x,
-                p.y,
-                p.z,
-                l.flux()
-            );
-        }
-        h += &format!(
-            "<tr><th>{} luminaires</th><th></th><th class=\"n\">{:.0}</th></tr></table>\n",
-            lighting.luminaires.len(),
-            total
-        );
+        h += &luminaire_tables(prepared);
     }
 
     h += "<h2>Results</h2>\n<table><tr><th>grid</th><th>points</th><th>E<sub>m</sub> (lx)</th>\
@@ -128,6 +161,13 @@ mod tests {
             assert_eq!(base64(raw.as_bytes()), coded);
         }
         assert_eq!(base64(&[0xff, 0xfe, 0xfd]), "//79");
+    }
+
+    #[test]
+    fn a_row_of_one_fitting_is_one_type() {
+        assert_eq!(luminaire_type("downlight #12"), "downlight");
+        assert_eq!(luminaire_type("panel"), "panel");
+        assert_eq!(luminaire_type("spot #A"), "spot #A");
     }
 
     #[test]

@@ -80,7 +80,9 @@ fn grid_writes_the_csv_the_sheet_and_the_report() {
     let html = std::fs::read_to_string(dir.path().join("r.html")).unwrap();
     assert!(html.starts_with("<!DOCTYPE html>") && html.trim_end().ends_with("</html>"));
     assert!(html.contains("<h1>Office</h1>"));
-    assert!(html.contains("6 luminaires"), "the luminaires' table");
+    // The schedule: one type, six of it, and the total; then each position.
+    assert!(html.contains("<td>downlight</td><td class=\"n\">6</td>"), "the luminaires' schedule");
+    assert_eq!(html.matches("<td>downlight #").count(), 6);
     assert!(html.contains("U<sub>0</sub>"));
     // Self-contained: no link to any other file.
     assert!(!html.contains("src=\"http") && !html.contains("href="));
