@@ -7,6 +7,8 @@ mod compare_cmd;
 mod comparison;
 mod errors;
 mod export_cmd;
+mod false_colour_cmd;
+mod grid_cmd;
 mod info_cmd;
 mod interrupt;
 mod lighting_cmd;
@@ -17,6 +19,7 @@ mod prepare;
 mod progress;
 mod reference_run;
 mod render_cmd;
+mod report_html;
 mod solve_cmd;
 mod solve_opts;
 mod tonemap_cmd;
@@ -61,6 +64,9 @@ enum Command {
     View(view_cmd::ViewArgs),
     /// Solve a scene and write the lit mesh (glTF, GLB, PLY) with baked colours, and lightmaps.
     Export(export_cmd::ExportArgs),
+    /// Solve a photometric scene and write its calculation grids: lux as CSV, false-colour
+    /// pictures and an HTML report.
+    Grid(grid_cmd::GridArgs),
     /// Solve a scene and check it against an independent Monte Carlo reference, per object.
     Verify(verify_cmd::VerifyArgs),
     /// Compare two linear pictures (.exr / .pfm): per-channel errors and a difference picture.
@@ -83,6 +89,7 @@ fn main() -> ExitCode {
         Command::Tonemap(a) => tonemap_cmd::run(a),
         Command::View(a) => view_cmd::run(a),
         Command::Export(a) => export_cmd::run(a),
+        Command::Grid(a) => grid_cmd::run(a),
         Command::Verify(a) => verify_cmd::run(a),
         Command::Compare(a) => compare_cmd::run(a),
     };

@@ -13,6 +13,7 @@ use radiosity_image::{
 };
 
 use crate::errors::InputError;
+use crate::false_colour_cmd::{FalseColourArg, check_photometric, write_false_colour};
 use crate::output::{self, Targets, note};
 use crate::picture_opts::{GatherArg, ShadingArg, ToneOpts, write_tonemapped};
 use crate::prepare::{prepare, run_solver};
@@ -84,6 +85,10 @@ pub struct RenderArgs {
     pub fov: Option<f64>,
     #[command(flatten)]
     pub tone: ToneOpts,
+    /// Colour `-o`'s pixels by the illuminance (lx) of the surface each one sees, with a
+    /// legend, instead of tone mapping them (photometric scenes only: `units` or luminaires).
+    #[arg(long, value_enum, value_name = "QUANTITY")]
+    pub false_colour: Option<FalseColourArg>,
     /// Render with the independent Monte Carlo reference (a diffuse path tracer of the input
     /// geometry) instead of the radiosity solution, for `radiosity compare`.
     #[arg(long)]
@@ -145,7 +150,13 @@ pub fn run(a: RenderArgs) -> Result<()> {
     if let Some(path) = &a.output {
         PictureFormat::of(path).map_err(|e| input(format!("-o: {e}")))?;
     }
+    if a.false_colour.is_some() && (a.output.is_none() || a.reference) {
+        return Err(input("--false-colour: give -o out.png for the picture (and no --reference)".into()));
+    }
     let prepared = prepare(&a.scene, &a.solve)?;
+    if a.false_colour.is_some() {
+        check_photometric(&prepared, &a.scene)?;
+    }
     let base = radiosity_image::camera_or_framing(&prepared.scene);
     // The points given are in the file's frame; the scene has been turned +y up.
     let turned = |p: DVec3| prepared.up.to_y_up(p);
@@ -204,6 +215,12 @@ pub fn run(a: RenderArgs) -> Result<()> {
         params.gather.as_str(),
         render_secs
     ))?;
+    if a.false_colour.is_some()
+        && let Some(path) = &a.output
+    {
+        write_false_colour(&prepared, &rendering, path, a.force)?;
+        return write_pictures(&RenderArgs { output: None, ..a }, &rendering.radiance);
+    }
     write_pictures(&a, &rendering.radiance)
 }
 

@@ -8,7 +8,7 @@ use std::path::Path;
 use std::process::{Command, Output, Stdio};
 
 /// The commands whose first argument is a SCENE; their help must name every form it takes.
-const SCENE_COMMANDS: [&str; 6] = ["solve", "info", "render", "view", "export", "verify"];
+const SCENE_COMMANDS: [&str; 7] = ["solve", "info", "render", "view", "export", "grid", "verify"];
 
 /// The READMEs and reference pages whose `sh` blocks are run.
 const READMES: [&str; 7] = [
@@ -146,7 +146,7 @@ fn budget(args: &mut Vec<String>) -> Option<Check> {
         }
     };
     Some(match args[0].as_str() {
-        "solve" | "export" => {
+        "solve" | "export" | "grid" => {
             small_solve(args);
             Check::Run
         }

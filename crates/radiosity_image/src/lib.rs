@@ -23,15 +23,22 @@
 #![forbid(unsafe_code)]
 
 mod cache;
+mod canvas;
+mod false_colour;
 mod files;
+mod font;
 mod framing;
 mod gather;
+mod grid_picture;
 mod hdr;
 mod illuminance;
+mod lux_scale;
 mod metrics;
 mod render;
 mod tonemap;
 
+pub use canvas::Canvas;
+pub use false_colour::{NO_DATA, SurfaceLight, false_colour_picture, picture_scale, pixel_illuminance};
 pub use files::{
     HdrFormat, ImageFileError, MAX_PICTURE_PIXELS, PictureFormat, decode_pfm, encode_exr, encode_pfm,
     encode_picture, encode_png, read_exr, read_hdr, read_pfm, read_png, write_exr, write_file_atomic,
@@ -39,8 +46,10 @@ pub use files::{
 };
 pub use framing::{camera_or_framing, lit_share_seen_by};
 pub use gather::Gather;
+pub use grid_picture::{grid_picture, picture_sheet};
 pub use hdr::HdrImage;
 pub use illuminance::{GridIlluminance, GridParams, grid_illuminance, grid_statistics, luminaire_irradiance};
+pub use lux_scale::{LuxScale, format_lux};
 pub use metrics::{ObjectPixels, difference_image, object_mean_radiance};
 pub use render::{
     RECORD_RAYS_PER_GATHER_RAY, RenderError, RenderParams, Renderer, Rendering, Shading, SurfaceHit,

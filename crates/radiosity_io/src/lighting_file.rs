@@ -62,14 +62,17 @@ pub(crate) struct GridDesc {
     /// Name in reports; default `grid N`.
     name: Option<String>,
     /// A corner of the rectangle.
-    #[serde(deserialize_with = "crate::desc::point")]
-    origin: Spanned<[f64; 3]>,
+    #[serde(default, deserialize_with = "point_opt")]
+    origin: Option<Spanned<[f64; 3]>>,
     /// First edge.
-    #[serde(deserialize_with = "crate::desc::point")]
-    u: Spanned<[f64; 3]>,
+    #[serde(default, deserialize_with = "point_opt")]
+    u: Option<Spanned<[f64; 3]>>,
     /// Second edge.
-    #[serde(deserialize_with = "crate::desc::point")]
-    v: Spanned<[f64; 3]>,
+    #[serde(default, deserialize_with = "point_opt")]
+    v: Option<Spanned<[f64; 3]>>,
+    /// Instead of `origin`, `u` and `v`: the name of a four-cornered `polygon` object whose
+    /// front the grid covers.
+    surface: Option<Spanned<String>>,
     /// Largest distance between points, scene units; default EN 12464-1's for the longer
     /// side.
     spacing: Option<Spanned<f64>>,
@@ -340,19 +343,38 @@ pub(crate) fn lighting(
     }
     let mut grids = Vec::new();
     let mut total_points = 0u64;
-    for (i, g) in desc.grid.iter().enumerate() {
+    for (i, spanned) in desc.grid.iter().enumerate() {
         let key = format!("grid[{i}]");
-        let g = g.get_ref();
-        let origin = finite3(loc, format!("{key}.origin"), &g.origin)?;
-        let u = finite3(loc, format!("{key}.u"), &g.u)?;
-        let v = finite3(loc, format!("{key}.v"), &g.v)?;
-        if u.cross(v).length() <= 1e-12 * u.length() * v.length() || u.length() == 0.0 {
-            return Err(loc.at(
-                g.v.span(),
-                format!("{key}.v"),
-                "u and v must span a rectangle (non-zero, not parallel)",
-            ));
-        }
+        let g = spanned.get_ref();
+        let ((origin, u, v), on_surface) = match (&g.surface, &g.origin, &g.u, &g.v) {
+            (Some(name), None, None, None) => (surface_frame(loc, desc, &key, name)?, true),
+            (Some(name), ..) => {
+                return Err(loc.at(
+                    name.span(),
+                    format!("{key}.surface"),
+                    "give surface or origin, u and v, not both",
+                ));
+            }
+            (None, Some(o), Some(u), Some(v)) => {
+                let origin = finite3(loc, format!("{key}.origin"), o)?;
+                let (a, b) = (finite3(loc, format!("{key}.u"), u)?, finite3(loc, format!("{key}.v"), v)?);
+                if a.cross(b).length() <= 1e-12 * a.length() * b.length() || a.length() == 0.0 {
+                    return Err(loc.at(
+                        v.span(),
+                        format!("{key}.v"),
+                        "u and v must span a rectangle (non-zero, not parallel)",
+                    ));
+                }
+                ((origin, a, b), false)
+            }
+            (None, ..) => {
+                return Err(loc.at(
+                    spanned.span(),
+                    key,
+                    "a grid needs origin, u and v (a rectangle), or surface (an object's name)",
+                ));
+            }
+        };
         let divisions = match (&g.divisions, &g.spacing) {
             (Some(_), Some(s)) => {
                 return Err(loc.at(
@@ -387,24 +409,71 @@ pub(crate) fn lighting(
         total_points += u64::from(divisions[0]) * u64::from(divisions[1]);
         if total_points > MAX_GRID_POINTS {
             return Err(loc.at(
-                g.origin.span(),
+                spanned.span(),
                 key,
                 format!("the grids have more than {MAX_GRID_POINTS} points"),
             ));
         }
+        // A surface's grid faces out of its front, as the polygon's corners turn.
+        let default_normal = if on_surface { u.cross(v).normalize() } else { file_up };
         let normal = g
             .normal
             .as_ref()
             .map(|n| direction(loc, format!("{key}.normal"), n))
             .transpose()?
-            .unwrap_or(file_up);
+            .unwrap_or(default_normal);
         let height = match &g.height {
             Some(h) if h.get_ref().is_finite() => *h.get_ref(),
             Some(h) => return Err(loc.at(h.span(), format!("{key}.height"), "expected a finite number")),
+            // On a surface the points stand 1 mm off it, so that it cannot shadow them.
+            None if on_surface => SURFACE_LIFT_METRES / unit.metres(),
             None => 0.0,
         };
-        let name = g.name.clone().unwrap_or_else(|| format!("grid {}", i + 1));
+        let name = g.name.clone().unwrap_or_else(|| match &g.surface {
+            Some(s) => s.get_ref().clone(),
+            None => format!("grid {}", i + 1),
+        });
         grids.push(Grid { name, origin, u, v, divisions, normal, height });
     }
     Ok(Lighting { units, luminaires, grids })
+}
+
+/// How far a surface's grid points stand off it, metres.
+pub const SURFACE_LIFT_METRES: f64 = 1e-3;
+
+/// The rectangle (corner, first edge, second edge) of the object `name` names, for a grid on
+/// its front: a `polygon` of four corners that make a parallelogram; corners 0, 1 and 3 give
+/// the corner and the edges, so u × v is the polygon's front normal.
+fn surface_frame(
+    loc: &Locator,
+    desc: &SceneDesc,
+    key: &str,
+    name: &Spanned<String>,
+) -> Result<(DVec3, DVec3, DVec3), LoadError> {
+    let err = |msg: String| loc.at(name.span(), format!("{key}.surface"), msg);
+    let object = desc
+        .object
+        .iter()
+        .map(Spanned::get_ref)
+        .find(|o| o.name.get_ref() == name.get_ref())
+        .ok_or_else(|| err(format!("no object is named '{}'", name.get_ref())))?;
+    let corners: Vec<DVec3> = match (object.kind.get_ref().as_str(), &object.vertices) {
+        ("polygon", Some(face)) => face.get_ref().iter().map(|p| DVec3::from_array(*p.get_ref())).collect(),
+        _ => Vec::new(),
+    };
+    let parallelogram = corners.len() == 4 && {
+        let d = corners[0] + corners[2] - corners[1] - corners[3];
+        d.length() <= 1e-9 * (corners[2] - corners[0]).length().max(f64::MIN_POSITIVE)
+    };
+    if !parallelogram {
+        return Err(err(format!(
+            "'{}' is not a polygon of four corners making a rectangle or parallelogram; a grid covers only such a surface (give origin, u and v for any other)",
+            name.get_ref()
+        )));
+    }
+    let (u, v) = (corners[1] - corners[0], corners[3] - corners[0]);
+    if u.cross(v).length() <= 1e-12 * u.length() * v.length() || u.length() == 0.0 {
+        return Err(err(format!("'{}' has no area", name.get_ref())));
+    }
+    Ok((corners[0], u, v))
 }
