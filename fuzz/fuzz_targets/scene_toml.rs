@@ -4,7 +4,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use radiosity_core::{Mesh, estimate_elements};
+use radiosity_mesh::{Mesh, estimate_elements};
 
 /// Largest estimated mesh that is meshed: big enough for every canonical scene, small enough
 /// to keep each run quick.
