@@ -82,16 +82,21 @@ impl MeshParams {
                 return Err(SceneError::BadMeshSize { key, value });
             }
         }
-        Ok(Self {
+        Ok(Self::with_defaults(patch_size, element_size.min(patch_size)))
+    }
+
+    /// `patch_size` and `element_size` as given, every other setting at its default.
+    fn with_defaults(patch_size: f64, element_size: f64) -> Self {
+        Self {
             patch_size,
-            element_size: element_size.min(patch_size),
+            element_size,
             crease_angle_deg: DEFAULT_CREASE_ANGLE_DEG,
             contacts: true,
             shadow_outlines: true,
             corner_refinement: DEFAULT_CORNER_REFINEMENT,
             proximity_refinement: DEFAULT_PROXIMITY_REFINEMENT,
             adaptive_levels: DEFAULT_ADAPTIVE_LEVELS,
-        })
+        }
     }
 
     /// The same parameters with contact cutting on or off.
@@ -153,16 +158,7 @@ impl MeshParams {
     /// 1/8 and elements of 1/32 of it.
     pub fn for_extent(diagonal: f64) -> Self {
         let d = if diagonal.is_finite() && diagonal > 0.0 { diagonal } else { 1.0 };
-        Self {
-            patch_size: d / 8.0,
-            element_size: d / 32.0,
-            crease_angle_deg: DEFAULT_CREASE_ANGLE_DEG,
-            contacts: true,
-            shadow_outlines: true,
-            corner_refinement: DEFAULT_CORNER_REFINEMENT,
-            proximity_refinement: DEFAULT_PROXIMITY_REFINEMENT,
-            adaptive_levels: DEFAULT_ADAPTIVE_LEVELS,
-        }
+        Self::with_defaults(d / 8.0, d / 32.0)
     }
 
     /// The same parameters with both sizes multiplied by `factor` (e.g. 0.5 for a finer mesh).

@@ -5,6 +5,7 @@ use glam::DVec3;
 use radiosity_core::MeshParams;
 
 use crate::builder::SurfaceBuilder;
+use crate::planar::lexicographic;
 
 /// Meshes coplanar triangles into `b`: each triangle cut by longest-edge
 /// bisection (Rivara 1984) into patches whose longest edge is at most `√2 · patch_size`, each
@@ -38,9 +39,7 @@ pub(crate) fn mesh_triangles(
         // Started from its least corner, a triangle is cut into the same pieces in the same
         // order however its corners were listed (a scene file's, an OBJ's and a glTF's copy of
         // one triangle alike), so the seeded rays that reach them are the same too.
-        let key = |p: DVec3| (p.x, p.y, p.z);
-        let first = (0..3)
-            .fold(0, |m, k| if key(t[k]).partial_cmp(&key(t[m])).is_some_and(|o| o.is_lt()) { k } else { m });
+        let first = (0..3).fold(0, |m, k| if lexicographic(t[k], t[m]).is_lt() { k } else { m });
         let t = [t[first], t[(first + 1) % 3], t[(first + 2) % 3]];
         bisect(t, patch_limit, &mut |patch| {
             let label = b.patches.len();

@@ -18,7 +18,7 @@
 // Fx hashing: the mesher's maps hold millions of small integer keys (a vertex's bits, an
 // edge's two indices), where SipHash was a third of the meshing time of a 834 k-triangle
 // model; nothing here is keyed by untrusted input an attacker could collide.
-use rustc_hash::FxHashMap as HashMap;
+use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
 
 use glam::{DVec2, DVec3};
 use radiosity_core::{Polygon, PolygonMesh};
@@ -71,16 +71,16 @@ pub(crate) fn outline(m: &PolygonMesh, group: &[u32]) -> Option<Outline> {
     // Loops, each started from its lowest index so the result does not depend on hash order.
     let mut starts: Vec<u32> = next.keys().copied().collect();
     starts.sort_unstable();
-    let mut seen: HashMap<u32, ()> = HashMap::default();
+    let mut seen: HashSet<u32> = HashSet::default();
     let mut loops: Vec<Vec<DVec3>> = Vec::new();
     for s in starts {
-        if seen.contains_key(&s) {
+        if seen.contains(&s) {
             continue;
         }
         let mut ring = Vec::new();
         let mut v = s;
         loop {
-            if seen.insert(v, ()).is_some() {
+            if !seen.insert(v) {
                 return None;
             }
             ring.push(pos[v as usize]);
