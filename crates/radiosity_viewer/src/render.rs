@@ -742,54 +742,6 @@ fn colour_buffer(device: &wgpu::Device, label: &str, corners: usize) -> wgpu::Bu
     })
 }
 
-/// The mesh's element triangles, each wound counter-clockwise seen from the side its element
-/// faces, so back-face culling keeps the lit side whatever order the mesher used.
-pub fn oriented_triangles(mesh: &Mesh) -> Vec<(u32, [u32; 3])> {
-    mesh.element_triangles()
-        .map(|(e, [a, b, c])| {
-            let p = |i: u32| mesh.positions[i as usize];
-            let n = (p(b) - p(a)).cross(p(c) - p(a));
-            if n.dot(mesh.elements[e as usize].normal) < 0.0 { (e, [a, c, b]) } else { (e, [a, b, c]) }
-        })
-        .collect()
-}
-
-/// Wireframe flags of every triangle: for edge i (opposite corner i), bit 2i when it is an
-/// element edge (not a quad's diagonal) and bit 2i+1 when it is also on its patch's outline
-/// (no other element of the same patch shares it).
-pub fn edge_flags(mesh: &Mesh, triangles: &[(u32, [u32; 3])]) -> Vec<u32> {
-    use std::collections::HashMap;
-    let key = |a: u32, b: u32| (a.min(b), a.max(b));
-    // How many elements of each patch use each element edge.
-    let mut uses: HashMap<(u32, (u32, u32)), u32> = HashMap::new();
-    for el in &mesh.elements {
-        let v = el.vertex_indices();
-        for i in 0..v.len() {
-            *uses.entry((el.patch, key(v[i], v[(i + 1) % v.len()]))).or_default() += 1;
-        }
-    }
-    triangles
-        .iter()
-        .map(|&(e, tri)| {
-            let el = &mesh.elements[e as usize];
-            let v = el.vertex_indices();
-            let is_element_edge =
-                |a: u32, b: u32| (0..v.len()).any(|i| key(v[i], v[(i + 1) % v.len()]) == key(a, b));
-            let mut flags = 0;
-            for i in 0..3 {
-                let (a, b) = (tri[(i + 1) % 3], tri[(i + 2) % 3]);
-                if is_element_edge(a, b) {
-                    flags |= 1 << (2 * i);
-                    if uses.get(&(el.patch, key(a, b))) == Some(&1) {
-                        flags |= 2 << (2 * i);
-                    }
-                }
-            }
-            flags
-        })
-        .collect()
-}
-
 /// The false-colour range, log10 of luminance, of what `mode` shows: four decades below the
 /// brightest value (a dark corner must not squash the whole scale), or `(−1, 0)` when nothing
 /// is lit yet.
@@ -812,47 +764,6 @@ pub fn false_colour_range(solution: &Solution, mode: DisplayMode) -> (f64, f64) 
     if hi - lo < 1e-3 { (hi - 0.5, hi + 0.5) } else { (lo, hi) }
 }
 
-/// Most elements [`auto_exposure_ev`] looks at per call; bigger meshes are sampled evenly so
-/// the estimate stays a fraction of a millisecond.
-pub const AUTO_EXPOSURE_SAMPLES: usize = 50_000;
-
-/// Automatic exposure for what the camera sees, in stops: the same meter as
-/// `render --exposure auto` over its pixels ([`radiosity_image::metered_exposure_ev`]: the
-/// log-average luminance of the lit, non-highlight radiance B/π goes to middle grey, held down
-/// so the brightest lit surfaces stay under display white). Each element in front of the
-/// camera, inside the view and facing it counts with its solid angle, area·cosθ/d² — the
-/// share of pixels it would cover, occlusion aside — and is flagged as an emitter when its
-/// material emits, so a lamp in view is left out of the meter. `None` when nothing lit is in
-/// view.
-pub fn auto_exposure_ev(mesh: &Mesh, solution: &Solution, clip_from_world: DMat4, eye: DVec3) -> Option<f64> {
-    if solution.element_radiosity.len() != mesh.elements.len() {
-        return None;
-    }
-    let step = mesh.elements.len().div_ceil(AUTO_EXPOSURE_SAMPLES).max(1);
-    let samples = mesh.elements.iter().zip(&solution.element_radiosity).enumerate().step_by(step).filter_map(
-        |(e, (el, b))| {
-            let to_eye = eye - el.centre;
-            let d2 = to_eye.length_squared();
-            let cos = el.normal.dot(to_eye) / d2.sqrt();
-            // Back faces are culled, so only the lit side is ever seen (NaN: a degenerate
-            // element).
-            if cos.is_nan() || cos <= 0.0 {
-                return None;
-            }
-            let c = clip_from_world * el.centre.extend(1.0);
-            if c.w <= 0.0 || c.x.abs() > c.w || c.y.abs() > c.w {
-                return None;
-            }
-            Some(radiosity_image::MeterSample {
-                luminance: b.luminance() / std::f64::consts::PI,
-                weight: el.area * cos / d2,
-                emitter: mesh.element_material(e).emission.max_channel() > 0.0,
-            })
-        },
-    );
-    radiosity_image::metered_exposure_ev(samples)
-}
-
 /// The Turbo false-colour ramp at t in [0, 1], display values in [0, 1]; the same polynomial
 /// as `false_colour` in `tonemap.wgsl` (for the legend drawn by egui).
 pub fn false_colour(t: f64) -> [f64; 3] {
@@ -865,6 +776,12 @@ pub fn false_colour(t: f64) -> [f64; 3] {
         dot([0.10667330, 12.64194608, -60.58204836, 110.36276771, -89.90310912, 27.34824973]),
     ]
 }
+
+mod exposure;
+mod triangles;
+
+pub use exposure::{AUTO_EXPOSURE_SAMPLES, auto_exposure_ev};
+pub use triangles::{edge_flags, oriented_triangles};
 
 #[cfg(test)]
 mod tests;
