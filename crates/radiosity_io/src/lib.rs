@@ -37,6 +37,7 @@ mod model;
 mod obj;
 mod photometric;
 mod scene_file;
+mod scene_settings;
 
 pub use builtin::{BUILTIN_SCENES, builtin_scene, resolve_scene, resolve_scene_with};
 pub use error::LoadError;
