@@ -12,6 +12,7 @@ use radiosity_core::{Material, MeshParams, Polygon, Rgb, Scene, Shape, Sides};
 
 use crate::bisection::mesh_triangles;
 use crate::builder::{SurfaceBuilder, is_large, polygon_area_normal};
+use crate::contacts::seams::cut_triangles;
 use crate::contacts::{Contacts, PolygonId};
 use crate::grading;
 use crate::lattice::{mesh_polygon, mesh_sphere};
@@ -150,7 +151,20 @@ impl Mesh {
                             let mut b = SurfaceBuilder::default();
                             match &outline {
                                 Some(Outline::Triangles(ts)) => {
-                                    mesh_triangles(&mut b, ts, m.polygons()[first].normal(), params);
+                                    let normal = m.polygons()[first].normal();
+                                    // Cut along the seams other faces make across it (see
+                                    // `contacts::seams`), as a convex outline's pieces are.
+                                    let seams = contacts
+                                        .as_ref()
+                                        .filter(|_| params.contacts)
+                                        .map(|c| c.seams(ts, normal, None))
+                                        .unwrap_or_default();
+                                    if seams.is_empty() {
+                                        mesh_triangles(&mut b, ts, normal, params);
+                                    } else {
+                                        let cut = cut_triangles(ts.clone(), &seams, normal);
+                                        mesh_triangles(&mut b, &cut, normal, params);
+                                    }
                                 }
                                 _ => mesh_triangle_group(&mut b, m, &group, params),
                             }

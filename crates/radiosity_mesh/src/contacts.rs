@@ -376,12 +376,16 @@ impl<'a> Contacts<'a> {
         id: Option<PolygonId>,
         estimate: impl Fn(&Polygon) -> usize,
     ) -> Option<Cut> {
-        let footprints = self.footprints(target, id);
-        if footprints.is_empty() {
-            return None;
-        }
         let n = target.normal();
-        let mut pieces = vec![target.vertices().to_vec()];
+        let whole = target.area();
+        let tiny = 1e-9 * whole;
+        // Seams first (lines across the surface), then the footprints out of their pieces.
+        let mut seamed = vec![target.vertices().to_vec()];
+        for seam in self.seams(std::slice::from_ref(&target.vertices()), n, id) {
+            seamed = seams::cut_pieces(seamed, &seam, n, tiny);
+        }
+        let footprints = self.footprints(target, id);
+        let mut pieces = seamed.clone();
         let mut hidden = 0.0;
         for f in &footprints {
             let mut next = Vec::new();
@@ -392,25 +396,41 @@ impl<'a> Contacts<'a> {
             }
             pieces = next;
         }
-        let whole = target.area();
-        if hidden <= 1e-9 * whole {
-            return None; // the footprints lie elsewhere on the plane
+        // The footprints lie elsewhere on the plane.
+        let footprinted = hidden > tiny;
+        if !footprinted {
+            (pieces, hidden) = (seamed.clone(), 0.0);
         }
-        let mut polygons = Vec::new();
-        for piece in pieces {
-            if area(&piece, n) <= 1e-9 * whole {
-                continue;
+        let polygons = |pieces: Vec<Vec<DVec3>>| -> Option<Vec<Polygon>> {
+            let mut polygons = Vec::new();
+            for piece in pieces {
+                if area(&piece, n) <= tiny {
+                    continue;
+                }
+                // A piece the validation refuses (a sliver of round-off): keep the surface whole.
+                polygons.push(Polygon::try_new(clean(piece, target)).ok()?);
             }
-            // A piece the validation refuses (a sliver of round-off): keep the surface whole.
-            polygons.push(Polygon::try_new(clean(piece, target)).ok()?);
+            Some(polygons)
+        };
+        // Slivers mesh into many thin elements: footprints cut only when their pieces cost at
+        // most four times the surface's elements. Seams are few and run across the surface
+        // (strips, not wedges), and always cut.
+        let seams_only =
+            || polygons(seamed.clone()).filter(|p| p.len() > 1).map(|pieces| Cut { pieces, hidden: 0.0 });
+        if !footprinted {
+            return seams_only();
         }
-        // Slivers mesh into many thin elements: cut only when the pieces cost at most four
-        // times the whole surface's elements.
-        let pieces_elements: usize = polygons.iter().map(&estimate).sum();
-        if pieces_elements > 4 * estimate(target).max(1) {
-            return None;
+        let cut = polygons(pieces)?;
+        let pieces_elements: usize = cut.iter().map(&estimate).sum();
+        let before = if seamed.len() == 1 {
+            estimate(target)
+        } else {
+            seamed.iter().filter_map(|p| Polygon::try_new(p.clone()).ok()).map(|p| estimate(&p)).sum()
+        };
+        if pieces_elements > 4 * before.max(1) {
+            return seams_only();
         }
-        Some(Cut { pieces: polygons, hidden })
+        Some(Cut { pieces: cut, hidden })
     }
 
     /// The convex footprints of the solids standing on `target`, each counter-clockwise about
@@ -623,6 +643,8 @@ fn convex_loop(lp: Vec<DVec3>, n: DVec3) -> Option<Vec<DVec3>> {
     corners.rotate_left(first);
     Some(corners)
 }
+
+pub(crate) mod seams;
 
 #[cfg(test)]
 mod tests;

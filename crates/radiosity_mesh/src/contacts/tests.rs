@@ -159,3 +159,50 @@ fn a_footprint_over_the_edge_hides_its_overlap() {
     let kept: f64 = cut.pieces.iter().map(Polygon::area).sum();
     assert!((kept - 15.5).abs() < 1e-9, "{kept}");
 }
+
+/// A vertical board standing on the floor 2 cm from its edge, `length` long from x = 0.
+fn board(length: f64) -> Vec<Polygon> {
+    let p = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+    vec![
+        Polygon::try_new(vec![
+            p(0.0, 0.0, 0.02),
+            p(length, 0.0, 0.02),
+            p(length, 0.2, 0.02),
+            p(0.0, 0.2, 0.02),
+        ])
+        .unwrap(),
+        // Its top, closing the gap behind it up to the floor's edge.
+        Polygon::try_new(vec![
+            p(0.0, 0.2, 0.02),
+            p(length, 0.2, 0.02),
+            p(length, 0.2, 0.0),
+            p(0.0, 0.2, 0.0),
+        ])
+        .unwrap(),
+    ]
+}
+
+/// A skirting board along the whole of the floor's edge cuts the floor along its foot, so
+/// no element lies both in the 2 cm gap behind it and in the lit room; one along a quarter
+/// of the edge does not cut the whole floor.
+#[test]
+fn a_board_along_the_surface_cuts_a_seam_and_a_short_one_does_not() {
+    let scene = floor_and(board(4.0));
+    let contacts = Contacts::new(&scene);
+    let Shape::Polygons(floor) = &scene.objects[0].shape else { unreachable!() };
+    let id = Some(PolygonId { object: 0, index: 0 });
+    let seams = contacts.seams(std::slice::from_ref(&floor[0].vertices()), DVec3::Y, id);
+    assert_eq!(seams.len(), 1, "{seams:?}");
+    assert!(seams[0].dir.abs().abs_diff_eq(DVec3::X, 1e-12) && (seams[0].at.z - 0.02).abs() < 1e-12);
+    let cut = contacts.cut(&floor[0], id, |q| (q.area() * 100.0) as usize).expect("a seam");
+    assert_eq!(cut.hidden, 0.0);
+    let mut areas: Vec<f64> = cut.pieces.iter().map(Polygon::area).collect();
+    areas.sort_by(f64::total_cmp);
+    assert!((areas[0] - 0.08).abs() < 1e-12 && (areas[1] - 15.92).abs() < 1e-9, "{areas:?}");
+
+    let scene = floor_and(board(1.0));
+    let contacts = Contacts::new(&scene);
+    let Shape::Polygons(floor) = &scene.objects[0].shape else { unreachable!() };
+    assert!(contacts.seams(std::slice::from_ref(&floor[0].vertices()), DVec3::Y, id).is_empty());
+    assert!(contacts.cut(&floor[0], id, |q| (q.area() * 100.0) as usize).is_none());
+}
