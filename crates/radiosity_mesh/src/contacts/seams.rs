@@ -221,14 +221,19 @@ pub(crate) fn cut_pieces(pieces: Vec<Vec<DVec3>>, seam: &Seam, n: DVec3, tiny: f
 }
 
 /// Triangles (counter-clockwise about unit normal `n`) cut along `seams`, each cut triangle
-/// into three (a triangle and a quad split by its diagonal). A shared edge is cut at the
+/// into three (a triangle and a quad split by its diagonal), or two where the line passes
+/// through a corner. A shared edge is cut at the
 /// same point from both sides (its ends taken in a fixed order), so the triangles still meet
 /// corner to corner.
 pub(crate) fn cut_triangles(mut triangles: Vec<[DVec3; 3]>, seams: &[Seam], n: DVec3) -> Vec<[DVec3; 3]> {
+    let Some(first) = triangles.first().map(|t| t[0]) else {
+        return triangles;
+    };
+    let (lo, hi) = triangles.iter().flatten().fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+    // A corner this near the line counts as on it, the same for every triangle that has
+    // it: a cut would leave a sliver thinner than the seams' own tolerance.
+    let on = 1e-4 * lo.distance(hi).max(f64::MIN_POSITIVE);
     for seam in seams {
-        let scale =
-            triangles.iter().flat_map(|t| t.iter().map(|&p| seam.side(n, p).abs())).fold(0.0, f64::max);
-        let on = 1e-9 * scale.max(f64::MIN_POSITIVE);
         let mut out = Vec::with_capacity(triangles.len() + 8);
         for t in triangles {
             let s = t.map(|p| seam.side(n, p));
