@@ -669,3 +669,61 @@ fn a_face_with_a_hole_is_one_surface_around_it() {
         assert!(!(c.x > 1.0 && c.x < 2.0 && c.y > 1.0 && c.y < 2.0), "an element in the hole at {c}");
     }
 }
+
+/// A wall (4 × 2.5, a 1 × 1 window in it when `window`) with a skirting board 1.5 cm in
+/// front of it along its whole width, 0.2 high, whose top closes the gap: one model. No
+/// element of the wall lies across the line where the board's top meets it (the light above
+/// the line and the dark gap below would be averaged and shot into the gap), the wall keeps
+/// its area, and its elements still meet corner to corner.
+#[test]
+fn a_wall_is_cut_where_a_skirting_boards_top_meets_it() {
+    for window in [false, true] {
+        let p = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+        let mut positions = vec![p(0.0, 0.0, 0.0), p(4.0, 0.0, 0.0), p(4.0, 2.5, 0.0), p(0.0, 2.5, 0.0)];
+        let mut faces: Vec<Vec<u32>> = Vec::new();
+        if window {
+            positions.extend([p(1.5, 1.0, 0.0), p(2.5, 1.0, 0.0), p(2.5, 2.0, 0.0), p(1.5, 2.0, 0.0)]);
+            for k in 0..4u32 {
+                let (o0, o1, i0, i1) = (k, (k + 1) % 4, 4 + k, 4 + (k + 1) % 4);
+                faces.push(vec![o0, o1, i1]);
+                faces.push(vec![o0, i1, i0]);
+            }
+        } else {
+            faces.extend([vec![0, 1, 2], vec![0, 2, 3]]);
+        }
+        let b = positions.len() as u32;
+        // The board's front (facing +z) and its top (facing +y), down to the wall.
+        positions.extend([p(0.0, 0.0, 0.015), p(4.0, 0.0, 0.015), p(4.0, 0.2, 0.015), p(0.0, 0.2, 0.015)]);
+        positions.extend([p(0.0, 0.2, 0.0), p(4.0, 0.2, 0.0)]);
+        faces.extend([vec![b, b + 1, b + 2], vec![b, b + 2, b + 3]]);
+        faces.extend([vec![b + 3, b + 2, b + 5], vec![b + 3, b + 5, b + 4]]);
+        let model = PolygonMesh::try_new(positions, faces).unwrap();
+        let params = MeshParams::try_new(1.0, 0.25).unwrap();
+        let mesh = Mesh::build(&scene_of(Shape::Mesh(model)), &params).unwrap();
+        let wall: Vec<&Element> =
+            mesh.elements.iter().filter(|e| e.normal.z > 0.999 && e.centre.z.abs() < 1e-9).collect();
+        let area: f64 = wall.iter().map(|e| e.area).sum();
+        let expected = if window { 9.0 } else { 10.0 };
+        assert!((area - expected).abs() < 1e-9, "window {window}: wall area {area}");
+        for e in &wall {
+            let ys: Vec<f64> = e.vertex_indices().iter().map(|&v| mesh.positions[v as usize].y).collect();
+            let across = ys.iter().any(|&y| y < 0.2 - 1e-9) && ys.iter().any(|&y| y > 0.2 + 1e-9);
+            assert!(!across, "window {window}: an element across the board's top: {ys:?}");
+        }
+        if window {
+            // One surface around a hole: V − E + F = 0 when every element meets its
+            // neighbours corner to corner.
+            let mut edges = HashSet::default();
+            let mut vertices = HashSet::default();
+            for e in &wall {
+                let v = e.vertex_indices();
+                for k in 0..v.len() {
+                    let (a, b) = (v[k], v[(k + 1) % v.len()]);
+                    edges.insert((a.min(b), a.max(b)));
+                    vertices.insert(a);
+                }
+            }
+            assert_eq!(vertices.len() as i64 - edges.len() as i64 + wall.len() as i64, 0);
+        }
+    }
+}
