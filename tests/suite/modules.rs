@@ -11,33 +11,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// Circles that are known and left as they are, each with why.
-///
-/// The solver's shooting loop (a row of form factors, the rays that weigh it, the receivers'
-/// shares, a shot and its tally, the clusters of a group's shot) was one file before it was
-/// split for reading, and its files still call each other both ways, with `solver/mod.rs`
-/// holding types they all use. Ordering them into layers (geometry of one interaction →
-/// rays → a receiver's share → a row → a shot and its tally → the loop) is a change of its
-/// own; until then the circle is listed here, and no other file may join it.
 const KNOWN_CIRCLES: &[(&str, &[&str])] = &[
-    (
-        "radiosity_solver",
-        &[
-            "solver",
-            "solver::clusters",
-            "solver::first_shots",
-            "solver::luminaires",
-            "solver::penumbra",
-            "solver::ray_ends",
-            "solver::rays",
-            "solver::receive",
-            "solver::row",
-            "solver::row_cache",
-            "solver::shared",
-            "solver::shot",
-            "solver::tally",
-            "solver::uneven",
-        ],
-    ),
     // The scene file's description holds the `[[luminaire]]` and `[[grid]]` tables, whose types
     // live beside the photometric loading and read the description's point parser; moving those
     // two types into `desc.rs` ends it.

@@ -9,7 +9,7 @@
 //! sides, weighted by their areas (one point per side; second order, so a room's elements of
 //! a few centimetres integrate the 1/d² falloff to well under 0.1 %).
 //!
-//! The luminaires' light is not the emitters' *direct part* ([`super::Tally::direct`]): a
+//! The luminaires' light is not the emitters' *direct part* (`Tally::direct`): a
 //! final gather recomputes only area emitters per pixel, and takes this light from the
 //! solution.
 
@@ -18,8 +18,6 @@ use radiosity_core::glam::DVec3;
 use radiosity_core::{LUMENS_PER_WATT, Luminaire, Rgb};
 use radiosity_mesh::Mesh;
 use rayon::prelude::*;
-
-use super::tally::Tally;
 
 /// Direct light of the luminaires on every element.
 pub(super) struct LuminaireLight {
@@ -50,27 +48,6 @@ impl LuminaireLight {
     /// Whether no light arrives anywhere.
     pub(super) fn is_dark(&self) -> bool {
         self.irradiance.iter().all(|h| h.max_channel() <= 0.0)
-    }
-
-    /// Puts the light into the tally: B and ΔB gain ρ·E; the luminaires' power counts as
-    /// emitted, what the elements absorb of it as absorbed, and the rest as escaped (or, if
-    /// the sampled elements received more than the luminaires emit, as created).
-    pub(super) fn add_to(&self, tally: &mut Tally, mesh: &Mesh) {
-        let mut received = Rgb::ZERO;
-        let mut absorbed = Rgb::ZERO;
-        for (e, h) in self.irradiance.iter().enumerate() {
-            let rho = mesh.element_material(e).reflectance;
-            let area = mesh.elements[e].area;
-            tally.radiosity[e] += rho * *h;
-            tally.unshot[e] += rho * *h;
-            received += *h * area;
-            absorbed += (Rgb::ONE - rho) * *h * area;
-        }
-        tally.emitted += self.power;
-        tally.absorbed += absorbed;
-        let gap = self.power - received;
-        tally.escaped += gap.map(|g| g.max(0.0));
-        tally.created += gap.map(|g| (-g).max(0.0));
     }
 }
 

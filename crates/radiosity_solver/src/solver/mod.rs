@@ -17,17 +17,26 @@
 //! over-relaxation (Gortler, Cohen & Slusallek 1993, "Radiosity and relaxation methods"):
 //! shoot ω·ΔB_i and leave (1 − ω)·ΔB_i, which may be negative, unshot.
 //!
-//! The files, by what they do:
+//! The files, in layers: each imports only files of the layers before it (and of its own
+//! layer listed before it), so reading can start at the top of this list or at `shooting`.
 //!
-//! * `shooting`: the loop, step by step (start here);
-//! * `params`, `error`, `stop`: settings, errors, stop criteria and the NotConverging rule;
-//! * state by lifetime: `mesh_tables` (per mesh), `first_shots` and `row_cache` (per
-//!   shooter), `shot` (per shot: what receivers read, and scratch), `tally` (the physics:
-//!   B, ΔB and the power bookkeeping, and applying a shot);
-//! * computing a row: `row` (the passes), `plans` (per receiving patch), `ray_ends` (where
-//!   rays end on the shooter), `receive` (form factors and pilot rays), `quadrature`,
-//!   `rays` (drawing and tracing; near receivers draw their ends by the form factor), `penumbra` (which receivers take more rays), `uneven`
-//!   (shooters whose unshot radiosity is uneven), `parallel`.
+//! * settings and per-mesh tables: `error`, `params`, `stop` (stop criteria and the
+//!   NotConverging rule), `parallel`, `quadrature`, `enclosure`, `mesh_tables`, `plans` (per
+//!   receiving patch);
+//! * the geometry of one interaction: `elements` (a shooter element, an element's corners,
+//!   whether the two face each other whole), `received` (what a receiver learns),
+//!   `ray_ends` (where rays end on the shooter), `near_runs` (near receivers' ray ends by the
+//!   form factor), `uneven` (shooters whose unshot radiosity is uneven);
+//! * state by lifetime: `row` (a row of form factors, with its geometry and near field),
+//!   `luminaires`, `tally` (the physics: B, ΔB and the power bookkeeping, and applying a
+//!   row), `first_shots` and `row_cache` (per shooter), `clusters` (the shooter groups) and
+//!   `shared` (receiving groups that share their visibility), `shot` (per shot: what
+//!   receivers read, and scratch);
+//! * a receiver's share of a shot: `rays` (drawing and tracing), `near_field`, `receive`
+//!   (form factors and pilot rays), `penumbra` (which receivers take more rays);
+//! * the loop: this file ([`Solver`]'s state and snapshots), then the files that add its
+//!   steps: `patch_row` (a patch's row, pass by pass), `shooting` (the loop, step by step:
+//!   start here) and the shooter groups' `clusters::{power, frozen, row}`.
 
 use std::sync::Arc;
 use std::time::Duration;
@@ -37,19 +46,24 @@ use radiosity_core::Rgb;
 use radiosity_mesh::Mesh;
 
 mod clusters;
+mod elements;
 mod enclosure;
 mod error;
 mod first_shots;
 mod luminaires;
 mod mesh_tables;
+mod near_field;
+mod near_runs;
 mod parallel;
 mod params;
+mod patch_row;
 mod penumbra;
 mod plans;
 mod quadrature;
 mod ray_ends;
 mod rays;
 mod receive;
+mod received;
 mod row;
 mod row_cache;
 mod shared;

@@ -1,7 +1,7 @@
 //! The penumbra decision: which receivers trace more rays from a bright shooter, decided
 //! from their neighbours' pilot rays.
 
-use super::receive::Received;
+use super::received::Received;
 
 /// What an element's pilot rays said.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

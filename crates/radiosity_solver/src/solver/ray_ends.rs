@@ -2,11 +2,11 @@
 //! grid over the unit square, mapped onto the shooter by its unshot power at its first shot
 //! (see [`super::first_shots`]). A ray's stratified `(u, v)` picks its cell's point, so the
 //! rays keep their stratification and cost a lookup each instead of a draw. (Receivers near
-//! the shooter draw theirs afresh by the form factor instead, see `rays::NearEnds`.)
+//! the shooter draw theirs afresh by the form factor instead, see `near_runs::NearEnds`.)
 
 use glam::{DVec3, Vec3};
 
-use super::shot::ShooterElement;
+use super::elements::ShooterElement;
 use crate::sampling::{Rng, point_on};
 
 /// Ray-end cells per side of the unit square: 256 points on each shooter, far more than the

@@ -3,14 +3,16 @@
 //! and how they are answered (the patch's candidate list four at a time, or the ray
 //! structure one by one).
 
-use glam::{DVec3, Vec3, Vec4};
+use glam::{DVec3, Vec3};
 use radiosity_accel::Segments4;
 
+use super::elements::{corners_of, element_facing};
 use super::mesh_tables::patch_radius;
+use super::near_runs::NearEnds;
 use super::plans::PatchPlan;
 use super::ray_ends::{shooter_point, target_cell};
-use super::receive::{Seen, corners_of, element_facing};
-use super::shot::{ShooterElement, Shot};
+use super::received::Seen;
+use super::shot::Shot;
 use crate::form_factor::distance_to_polygon;
 use crate::sampling::{ONE_BELOW, Rng, Strata, four_units, point_on, point_on_f32};
 use crate::shaft::{FEW, Visibility, bounds};
@@ -72,128 +74,21 @@ pub(super) fn near(shot: &Shot, e: usize) -> bool {
 /// this share of its centre's distance to the shooter.
 const SMALL: f64 = 0.5;
 
-/// The ray ends of a receiver near the shooter, drawn in proportion to the point-to-point
-/// form factor kernel cos θ cos θ' / r² from the receiver's centre (Cohen & Wallace §4.9)
-/// times each shooter element's share of the shooter's unshot power (see `first_shots`).
-///
-/// The fraction of unblocked rays is then the visibility as the form factor counts it:
-/// Σ_k F_k V_k / Σ_k F_k over the parts k of the shooter. Ends drawn by area alone count
-/// every part by its area instead. Far from the shooter the two agree; near it they do not.
-/// A facet between two shelves, a few centimetres from the wall behind them, sees the wall
-/// between the shelves under a large form factor and the wall above and below them (hidden
-/// by the shelves) under a small one; drawn by area, most of its rays went to the hidden
-/// part, and the facets on a furnished room's shelves came out 5–7 % dark.
-struct NearEnds {
-    /// Cumulative kernel × unshot share over runs of consecutive shooter elements.
-    cumulative: [f64; RUNS],
-    /// Runs in use.
-    runs: usize,
-    /// Elements per run (the last may hold fewer).
-    per_run: usize,
-}
-
-/// Most runs of shooter elements a near receiver weighs: a shooter of more elements is cut
-/// into this many runs of consecutive ones (pieces of its rows: small beside the distance).
-const RUNS: usize = 256;
-
-/// The shooter's runs of elements as every near receiver weighs them (see [`NearEnds`]),
-/// laid out once per row: each run's middle element's centre about the shooter's centre
-/// and its share of the unshot power, in single precision, coordinate by coordinate.
-#[derive(Default)]
-pub(super) struct NearRuns {
-    origin: DVec3,
-    /// Four runs to a lane group; the last group is padded with runs of no share.
-    x: Vec<Vec4>,
-    y: Vec<Vec4>,
-    z: Vec<Vec4>,
-    share: Vec<Vec4>,
-    runs: usize,
-    per_run: usize,
-}
-
-impl NearRuns {
-    /// Lays out the runs of `elements`, whose cumulative unshot shares are `cdf`, about
-    /// `origin`.
-    pub(super) fn load(&mut self, elements: &[ShooterElement], cdf: &[f64], origin: DVec3) {
-        let per_run = elements.len().div_ceil(RUNS).max(1);
-        let runs = elements.len().div_ceil(per_run);
-        (self.origin, self.per_run, self.runs) = (origin, per_run, runs);
-        let groups = runs.div_ceil(4);
-        for v in [&mut self.x, &mut self.y, &mut self.z, &mut self.share] {
-            v.clear();
-            v.resize(groups, Vec4::ZERO);
-        }
-        for r in 0..runs {
-            let (first, end) = (r * per_run, ((r + 1) * per_run).min(elements.len()));
-            let (below, above) = shares(cdf, first..end);
-            let c = (elements[(first + end) / 2].centre - origin).as_vec3();
-            let (g, lane) = (r / 4, r % 4);
-            self.x[g][lane] = c.x;
-            self.y[g][lane] = c.y;
-            self.z[g][lane] = c.z;
-            self.share[g][lane] = (above - below) as f32;
-        }
+/// The kernel's table for element `e` (see [`NearEnds`]), or `None` when it is far from the
+/// shooter (or sees none of it).
+fn near_ends(shot: &Shot, e: usize) -> Option<NearEnds> {
+    if !near(shot, e) {
+        return None;
     }
-}
-
-impl NearEnds {
-    /// The kernel's table for element `e`, or `None` when it is far from the shooter (or sees
-    /// none of it).
-    fn new(shot: &Shot, e: usize) -> Option<Self> {
-        if !near(shot, e) {
-            return None;
-        }
-        let centre = shot.vertex_means[e];
-        // The kernel is taken at the centre, so it must stand for the whole element: not for
-        // an element as large as its distance (a floor element along a wall's foot), whose
-        // ends would crowd where its centre is nearest.
-        let distance = distance_to_polygon(centre, shot.shooter.normal, shot.shooter.corners());
-        if shot.element_radii[e] > SMALL * distance {
-            return None;
-        }
-        let table = shot.near_runs;
-        let (n, ns) = (shot.mesh.elements[e].normal.as_vec3(), shot.shooter.normal.as_vec3());
-        let p = (centre - table.origin).as_vec3();
-        let runs = table.runs;
-        // Four runs at a time in single precision, then summed in order: a near receiver of
-        // a wall patch weighed a hundred runs one by one in double precision, and that was
-        // a twentieth of a furnished room's solve.
-        let mut cumulative = [0.0; RUNS];
-        let mut total = 0.0;
-        let lanes = table.x.iter().zip(&table.y).zip(&table.z).zip(&table.share);
-        for (four, out) in lanes.zip(cumulative[..runs].chunks_mut(4)) {
-            let (((x, y), z), share) = four;
-            let d = [*x - Vec4::splat(p.x), *y - Vec4::splat(p.y), *z - Vec4::splat(p.z)];
-            let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-            let cos_r = (d[0] * n.x + d[1] * n.y + d[2] * n.z).max(Vec4::ZERO);
-            let cos_s = (-(d[0] * ns.x + d[1] * ns.y + d[2] * ns.z)).max(Vec4::ZERO);
-            let live = r2.cmpgt(Vec4::ZERO);
-            let terms = Vec4::select(
-                live,
-                *share * cos_r * cos_s / Vec4::select(live, r2 * r2, Vec4::ONE),
-                Vec4::ZERO,
-            );
-            for (c, t) in out.iter_mut().zip(terms.to_array()) {
-                total += f64::from(t);
-                *c = total;
-            }
-        }
-        (total > 0.0 && total.is_finite()).then_some(Self { cumulative, runs, per_run: table.per_run })
+    let centre = shot.vertex_means[e];
+    // The kernel is taken at the centre, so it must stand for the whole element: not for
+    // an element as large as its distance (a floor element along a wall's foot), whose
+    // ends would crowd where its centre is nearest.
+    let distance = distance_to_polygon(centre, shot.shooter.normal, shot.shooter.corners());
+    if shot.element_radii[e] > SMALL * distance {
+        return None;
     }
-
-    /// The range of the shooter's cumulative shares (see `ray_ends::shooter_point`) of the
-    /// run at `t` ∈ [0, 1) of the kernel's mass.
-    fn run(&self, t: f32, cdf: &[f64]) -> (f64, f64) {
-        let cumulative = &self.cumulative[..self.runs];
-        let at = f64::from(t) * cumulative[self.runs - 1];
-        let r = cumulative.partition_point(|&c| c <= at).min(self.runs - 1);
-        shares(cdf, r * self.per_run..((r + 1) * self.per_run).min(cdf.len()))
-    }
-}
-
-/// The cumulative shares below and at the end of the shooter elements `run` (not empty).
-fn shares(cdf: &[f64], run: std::ops::Range<usize>) -> (f64, f64) {
-    (if run.start == 0 { 0.0 } else { cdf[run.start - 1] }, cdf[run.end - 1])
+    shot.near_runs.weigh(centre, shot.mesh.elements[e].normal, shot.shooter.normal)
 }
 
 /// Draws element `e`'s `rays` to the shooter and hands each segment to `ray` with its
@@ -221,7 +116,7 @@ pub(super) fn draw(
     mut ray: impl FnMut(Vec3, Vec3, f32),
 ) {
     let (seed, key) = (shot.params.seed, e as u64);
-    let near = NearEnds::new(shot, e);
+    let near = near_ends(shot, e);
     let ends = Ends { shot, near: near.as_ref() };
     let (n, ns) = (shot.mesh.elements[e].normal.as_vec3(), shot.shooter.normal.as_vec3());
     let weighed = weighs_rays(shot, e);
@@ -453,49 +348,5 @@ fn draw_rays_from(
             point_on_f32(lifted, u, v).into()
         };
         ray(from, to);
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::solver::shot::unit_squares;
-
-    /// A shooter of more elements than [`RUNS`] is cut into runs of consecutive ones: each
-    /// run carries its elements' share of the unshot power and its middle element's centre,
-    /// the shares sum to the whole, and the lanes past the last run carry nothing.
-    #[test]
-    fn near_runs_carry_their_elements_shares_and_centres() {
-        let elements = unit_squares(25);
-        let n = elements.len();
-        // Uneven power: element k holds 1 + k % 3.
-        let mut cdf = Vec::with_capacity(n);
-        let mut acc = 0.0;
-        for k in 0..n {
-            acc += (1 + k % 3) as f64;
-            cdf.push(acc);
-        }
-        let cdf: Vec<f64> = cdf.iter().map(|c| c / acc).collect();
-        let origin = DVec3::new(12.0, 12.0, 0.0);
-        let mut table = NearRuns::default();
-        table.load(&elements, &cdf, origin);
-        assert_eq!(table.per_run, 3);
-        assert_eq!(table.runs, 209);
-        assert_eq!(table.share.len(), 53, "four runs to a lane group");
-        let mut total = 0.0;
-        for r in 0..table.runs {
-            let (g, lane) = (r / 4, r % 4);
-            let (first, end) = (3 * r, (3 * r + 3).min(n));
-            let power: f64 = (first..end).map(|k| (1 + k % 3) as f64).sum::<f64>() / acc;
-            assert!((f64::from(table.share[g][lane]) - power).abs() < 1e-6, "run {r}");
-            let centre = elements[(first + end) / 2].centre - origin;
-            let laid = DVec3::new(table.x[g][lane].into(), table.y[g][lane].into(), table.z[g][lane].into());
-            assert!(laid.distance(centre) < 1e-5, "run {r}: {laid} for {centre}");
-            total += f64::from(table.share[g][lane]);
-        }
-        assert!((total - 1.0).abs() < 1e-5, "{total}");
-        for lane in table.runs % 4..4 {
-            assert_eq!(table.share[table.runs / 4][lane], 0.0);
-        }
     }
 }

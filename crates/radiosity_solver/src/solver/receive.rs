@@ -4,13 +4,14 @@
 
 use glam::DVec3;
 use radiosity_accel::Segments4;
-use radiosity_mesh::{Mesh, Patch};
 
 use super::FormFactorMethod;
+use super::elements::{corners_of, element_facing};
+use super::near_field::in_near_field;
 use super::plans::PatchPlan;
 use super::quadrature::element_quadrature;
 use super::rays::{Packet, Rays, draw, near, patch_near, trace};
-use super::row::in_near_field;
+use super::received::{Received, Seen};
 use super::shot::Shot;
 use super::uneven::density_weight;
 use crate::form_factor::{
@@ -18,105 +19,6 @@ use crate::form_factor::{
     point_to_polygon_in_front_x4, point_to_polygon_x4, points_to_polygon_in_front_x4,
 };
 use crate::shaft::{FEW, Visibility};
-
-/// What one element learns from one shooter's first pass: its form factor without
-/// visibility, and its pilot rays.
-#[derive(Clone, Copy, Debug, Default)]
-pub(super) struct Received {
-    /// F_{e→shooter} without visibility (weighted for uneven shooters); 0 when it cannot
-    /// receive.
-    pub(super) unoccluded: f64,
-    /// The same before the uneven shooter's weighting (equal to `unoccluded` otherwise).
-    pub(super) unweighted: f64,
-    /// Unblocked rays among `traced`.
-    pub(super) visible: u32,
-    /// Rays traced; 0 when the pair needs none (nothing can block it).
-    pub(super) traced: u32,
-    /// Σ of the unblocked rays' kernel weights (see [`Seen`]).
-    pub(super) kernel_visible: f32,
-    /// Σ of the traced rays' kernel weights; 0 when the rays carry none (the visibility is
-    /// then the plain fraction `visible / traced`).
-    pub(super) kernel_traced: f32,
-}
-
-/// What an element's rays to the shooter saw: how many were unblocked of how many traced,
-/// and the same weighted by each ray's form factor kernel (see [`super::rays::draw`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub(super) struct Seen {
-    /// Unblocked rays.
-    pub(super) visible: u32,
-    /// Rays traced.
-    pub(super) traced: u32,
-    /// Σ kernel weight of the unblocked rays.
-    pub(super) kernel_visible: f32,
-    /// Σ kernel weight of all rays.
-    pub(super) kernel_traced: f32,
-}
-
-impl Seen {
-    /// One more ray of kernel weight `weight`, unblocked or not.
-    pub(super) fn add(&mut self, unblocked: bool, weight: f32) {
-        self.traced += 1;
-        self.kernel_traced += weight;
-        if unblocked {
-            self.visible += 1;
-            self.kernel_visible += weight;
-        }
-    }
-}
-
-impl std::ops::AddAssign<Seen> for Received {
-    fn add_assign(&mut self, seen: Seen) {
-        self.visible += seen.visible;
-        self.traced += seen.traced;
-        self.kernel_visible += seen.kernel_visible;
-        self.kernel_traced += seen.kernel_traced;
-    }
-}
-
-impl Received {
-    /// The element's form factor with visibility.
-    pub(super) fn factor(&self) -> f64 {
-        self.unoccluded * self.visibility()
-    }
-
-    /// The form factor with visibility, before the uneven shooter's weighting.
-    pub(super) fn unweighted_factor(&self) -> f64 {
-        self.unweighted * self.visibility()
-    }
-
-    /// The unblocked share of the transfer: each ray counted by its form factor kernel
-    /// (Σ K V / Σ K), or by one where the rays carry no weights.
-    fn visibility(&self) -> f64 {
-        if self.traced == 0 {
-            1.0
-        } else if self.kernel_traced > 0.0 {
-            f64::from(self.kernel_visible) / f64::from(self.kernel_traced)
-        } else {
-            f64::from(self.visible) / f64::from(self.traced)
-        }
-    }
-}
-
-/// Element `e`'s corners in a fixed array (the first `vertex_count` are its own).
-pub(super) fn corners_of(mesh: &Mesh, e: usize) -> [DVec3; 4] {
-    let mut pts = [DVec3::ZERO; 4];
-    for (k, p) in mesh.element_corners(e).enumerate() {
-        pts[k] = p;
-    }
-    pts
-}
-
-/// The element (corners `receiver`) and the shooter see each other whole: no clipping, no
-/// redrawn rays. A patch that meets the shooter's plane (a wall standing on the floor) has
-/// most of its elements off that plane: those, when no part of the shooter is behind them
-/// either, are such elements too. Same test as the patch's, same tolerance.
-pub(super) fn element_facing(shooter: &Patch, plan: &PatchPlan, receiver: &[DVec3]) -> bool {
-    let corner = shooter.corners()[0];
-    plan.facing
-        || (plan.shooter_ahead
-            && receiver.iter().all(|p| shooter.normal.dot(*p - corner) > 1e-9 * shooter.area.sqrt()))
-}
 
 /// Element `e`'s form factor to the shooter without visibility, before any weighting: what
 /// geometry alone gives, rounded to single precision so that a row computed from the kept
@@ -177,7 +79,7 @@ fn round(f: f64) -> f64 {
 /// The first pass for the elements of receiving patch `q` (`first` is its first element,
 /// `out` its slice): their unoccluded form factors (taken from `kept`, one per mesh element,
 /// when the shooter's geometry was kept), then their pilot rays (nothing when its group
-/// shares its visibility: the group is received whole, see `row::receive_shared`).
+/// shares its visibility: the group is received whole, see `patch_row::receive_shared`).
 #[inline]
 pub(super) fn receive_patch(
     shot: &Shot,

@@ -1,5 +1,6 @@
 //! What every receiver of one shot reads ([`Shot`]), and the per-shot scratch memory it is
-//! built in ([`ShotScratch`]).
+//! built in ([`ShotScratch`]). A patch's row (`patch_row`) and a group's (`clusters::row`)
+//! both fill the scratch; the rays and the receivers read the shot.
 
 use glam::{DVec3, Vec3, Vec3A};
 use radiosity_accel::RayQuery;
@@ -7,78 +8,15 @@ use radiosity_mesh::{Mesh, Patch};
 
 use super::SolverParams;
 use super::clusters::Clusters;
+use super::elements::ShooterElement;
+use super::near_runs::NearRuns;
 use super::plans::PatchPlan;
-use super::rays::NearRuns;
-use super::receive::Received;
+use super::received::Received;
 use super::shared::Sharing;
 use super::uneven::{Cluster, Uneven};
-use crate::form_factor::{point_to_point, point_to_polygon_x4};
 use crate::occluders::OccluderBoxes;
 use crate::sampling::Strata;
 use crate::shaft::Blockers;
-
-/// Corners of one element of the shooter, copied once per shot so ray ends need no lookups.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct ShooterElement {
-    pub(super) corners: [DVec3; 4],
-    pub(super) count: u8,
-    pub(super) centre: DVec3,
-    /// Circumradius about `centre`.
-    pub(super) radius: f64,
-    pub(super) area: f64,
-}
-
-impl ShooterElement {
-    /// Element `e` of `mesh`, whose circumradius is `radius`.
-    pub(super) fn new(mesh: &Mesh, e: usize, radius: f64) -> Self {
-        let mut corners = [DVec3::ZERO; 4];
-        for (slot, p) in corners.iter_mut().zip(mesh.element_corners(e)) {
-            *slot = p;
-        }
-        let el = &mesh.elements[e];
-        Self { corners, count: el.vertex_count, centre: el.centre, radius, area: el.area }
-    }
-
-    pub(super) fn corners(&self) -> &[DVec3] {
-        &self.corners[..self.count as usize]
-    }
-
-    /// Form factor from a differential area at `p` (normal `n`) to this element of a shooter
-    /// with normal `ns`: the exact polygon formula up close, else the point-to-point one,
-    /// cos θ cos θ' A / (π r²), which is within ~2 % beyond four radii (Cohen & Wallace
-    /// §4.9's "five times rule" is the same trade). An element wholly in front of the
-    /// receiver's tangent plane takes the formula in four f32 lanes (within 3e-7 absolute,
-    /// see `point_to_polygon_in_front_x4`; the near field keeps shares in f32, and this was
-    /// a tenth of the Cornell box's solve in f64); one the plane cuts is clipped in f64.
-    pub(super) fn factor_from(&self, p: DVec3, n: DVec3, ns: DVec3) -> f64 {
-        if self.centre.distance_squared(p) < 16.0 * self.radius * self.radius {
-            point_to_polygon_x4(p, n, self.corners())
-        } else {
-            point_to_point(p, n, self.centre, ns, self.area)
-        }
-    }
-}
-
-/// A `k × k` grid of unit squares in the plane z = 0, facing +z, row after row: a shooter's
-/// elements for the tests.
-#[cfg(test)]
-pub(super) fn unit_squares(k: usize) -> Vec<ShooterElement> {
-    let mut out = Vec::with_capacity(k * k);
-    for j in 0..k {
-        for i in 0..k {
-            let (x, y) = (i as f64, j as f64);
-            let corners = [
-                DVec3::new(x, y, 0.0),
-                DVec3::new(x + 1.0, y, 0.0),
-                DVec3::new(x + 1.0, y + 1.0, 0.0),
-                DVec3::new(x, y + 1.0, 0.0),
-            ];
-            let centre = DVec3::new(x + 0.5, y + 0.5, 0.0);
-            out.push(ShooterElement { corners, count: 4, centre, radius: 0.5f64.sqrt(), area: 1.0 });
-        }
-    }
-    out
-}
 
 /// What every receiver of one shot reads.
 pub(super) struct Shot<'a> {
@@ -94,7 +32,7 @@ pub(super) struct Shot<'a> {
     /// Their cumulative shares of its unshot power when its spread was last fixed (see
     /// `first_shots`).
     pub(super) cdf: &'a [f64],
-    /// The same, by runs, as near receivers weigh them (see `rays::NearEnds`).
+    /// The same, by runs, as near receivers weigh them (see `near_runs::NearEnds`).
     pub(super) near_runs: &'a NearRuns,
     /// Every element's vertex mean (see `MeshTables::vertex_means`).
     pub(super) vertex_means: &'a [DVec3],
@@ -202,4 +140,11 @@ impl ShotScratch {
             self.shooter_elements.push(ShooterElement::new(mesh, e as usize, element_radii[e as usize]));
         }
     }
+}
+
+/// Pilot rays from a bright shooter to a facet of a shooter group: a quarter of
+/// `visibility_rays`, at least `dim_rays`. On a 120 k-triangle room the facets took 84 % of
+/// the rays at the full count.
+pub(super) fn facet_rays(params: &SolverParams) -> u32 {
+    (params.visibility_rays / 4).max(params.dim_rays)
 }

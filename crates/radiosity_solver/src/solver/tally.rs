@@ -198,7 +198,7 @@ impl Tally {
             changed: Vec::new(),
         };
         if let Some(light) = luminaires {
-            light.add_to(&mut tally, mesh);
+            tally.add_luminaires(light, mesh);
         }
         for (p, patch) in mesh.patches.iter().enumerate() {
             tally.patch_unshot_power[p] = (patch.elements.start..patch.elements.end)
@@ -210,6 +210,27 @@ impl Tally {
         }
         tally.update_unshot_fraction();
         Ok(tally)
+    }
+
+    /// Puts the luminaires' `light` into the tally: B and ΔB gain ρ·E; the luminaires' power
+    /// counts as emitted, what the elements absorb of it as absorbed, and the rest as escaped
+    /// (or, if the sampled elements received more than the luminaires emit, as created).
+    fn add_luminaires(&mut self, light: &LuminaireLight, mesh: &Mesh) {
+        let mut received = Rgb::ZERO;
+        let mut absorbed = Rgb::ZERO;
+        for (e, h) in light.irradiance.iter().enumerate() {
+            let rho = mesh.element_material(e).reflectance;
+            let area = mesh.elements[e].area;
+            self.radiosity[e] += rho * *h;
+            self.unshot[e] += rho * *h;
+            received += *h * area;
+            absorbed += (Rgb::ONE - rho) * *h * area;
+        }
+        self.emitted += light.power;
+        self.absorbed += absorbed;
+        let gap = light.power - received;
+        self.escaped += gap.map(|g| g.max(0.0));
+        self.created += gap.map(|g| (-g).max(0.0));
     }
 
     /// Recomputes the unshot fraction from the patches' unshot power.

@@ -6,7 +6,7 @@
 
 use glam::{DVec3, Vec4};
 
-use super::shot::ShooterElement;
+use super::elements::ShooterElement;
 use crate::form_factor::{point_to_point, point_to_polygon_x4};
 use crate::shaft::bounds;
 
@@ -181,7 +181,7 @@ pub(super) fn density_weight(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::solver::shot::unit_squares;
+    use crate::solver::elements::unit_squares;
 
     /// Every element lands in exactly one cluster of at most [`CLUSTER`], each cluster's
     /// sphere holds its elements, and its area and density are its elements' sum and

@@ -2,6 +2,11 @@
 //! points, and when its spread has drifted far enough to fix it again.
 
 use super::*;
+use crate::sampling::{Rng, point_on};
+use crate::solver::SolverParams;
+use crate::solver::elements::corners_of;
+use crate::solver::first_shots::DRIFT;
+use crate::solver::mesh_tables::MeshTables;
 
 /// Bins per side of the grid that sorts a group's normals by their two minor components
 /// (the major one is the group's facing): 16 bins of about 20° each, so that the clamp of

@@ -28,27 +28,20 @@
 //! Members receive from their own group's other facets (a fold of the model lights itself),
 //! by the near field.
 //!
-//! Here: the groups and who shoots next; `frozen`: a group's spread fixed at its first shot;
-//! `row`: a group's row, far field, near field and visibility.
+//! Here: the groups and their tiles, as data (what `shared` and `shot` read of them);
+//! `power`: the groups' unshot power and who shoots next; `frozen`: a group's spread fixed at
+//! its first shot; `row`: a group's row, far field, near field and visibility. The last three
+//! read the tally, the first shots and the shot's scratch, which read the groups, so they are
+//! files of their own above those.
 
 use std::collections::BTreeMap;
-use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::{DVec3, Vec3, Vec4};
-use radiosity_accel::RayQuery;
 use radiosity_core::Rgb;
 use radiosity_mesh::Mesh;
 
-use super::SolverParams;
-use super::first_shots::DRIFT;
-use super::mesh_tables::MeshTables;
-use super::parallel::for_each_maybe_parallel;
-use super::receive::corners_of;
-use super::row::Row;
-use super::shot::ShotScratch;
-use crate::sampling::{Rng, point_on, point_on_f32};
-
 mod frozen;
+mod power;
 mod row;
 
 #[cfg(test)]
@@ -374,52 +367,6 @@ impl Clusters {
     /// Group `g`.
     pub(super) fn group(&self, g: usize) -> &Group {
         &self.groups[g]
-    }
-
-    /// Counts the patches' |unshot power| (`patch_abs`) afresh into the groups' sums.
-    pub(super) fn sum(&mut self, patch_abs: &[f64]) {
-        self.power.fill(0.0);
-        for (q, &g) in self.of_patch.iter().enumerate() {
-            if g != NONE {
-                self.power[g as usize] += patch_abs[q];
-            }
-        }
-        self.since_sum = 0;
-    }
-
-    /// Brings the groups' sums up to date with the patches a shot `changed` (patch, change
-    /// of its |unshot power|), and sums them afresh from `patch_abs` every
-    /// [`super::tally::RESUM`] shots, so rounding cannot pile up.
-    pub(super) fn update(&mut self, changed: &[(u32, f64)], patch_abs: &[f64]) {
-        self.since_sum += 1;
-        if self.since_sum >= super::tally::RESUM {
-            self.sum(patch_abs);
-            return;
-        }
-        for &(q, delta) in changed {
-            let g = self.of_patch[q as usize];
-            if g != NONE {
-                self.power[g as usize] += delta;
-            }
-        }
-    }
-
-    /// The shooter with the largest |unshot power| (summed over channels, `patch_abs`): a
-    /// patch on its own or a group, by the sum over its patches. Ties go to the patch, then
-    /// to the lower index.
-    pub(super) fn brightest(&self, patch_abs: &[f64]) -> Shooter {
-        let mut best = (Shooter::Patch(0), f64::NEG_INFINITY);
-        for &q in &self.singles {
-            if patch_abs[q as usize] > best.1 {
-                best = (Shooter::Patch(q as usize), patch_abs[q as usize]);
-            }
-        }
-        for (g, &v) in self.power.iter().enumerate() {
-            if v > best.1 {
-                best = (Shooter::Group(g), v);
-            }
-        }
-        best.0
     }
 }
 

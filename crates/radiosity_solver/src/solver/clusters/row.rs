@@ -1,12 +1,22 @@
 //! A group's row: its form factor to every receiving element, far field and near field,
 //! and the visibility rays aimed at its points.
 
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use radiosity_accel::RayQuery;
+
 use super::*;
+use crate::sampling::{Rng, point_on_f32};
+use crate::solver::SolverParams;
+use crate::solver::mesh_tables::MeshTables;
+use crate::solver::parallel::for_each_maybe_parallel;
+use crate::solver::row::Row;
+use crate::solver::shot::{ShotScratch, facet_rays};
 
 impl Clusters {
     /// Group `g`'s row (it must be frozen): every element's form factor to it, visibility
     /// included, for the patches that receive any; and the rays traced. Receiving groups
-    /// far from a dim group share their visibility (`sharing`, see [`super::super::shared`]).
+    /// far from a dim group share their visibility (`sharing`, see `solver::shared`).
     pub(in crate::solver) fn row(
         &self,
         g: usize,
@@ -27,7 +37,7 @@ impl Clusters {
             mesh,
             tables,
             accel,
-            rays: if frozen.bright { super::super::row::facet_rays(params) } else { params.dim_rays },
+            rays: if frozen.bright { facet_rays(params) } else { params.dim_rays },
             seed: params.seed,
             stream,
         };
