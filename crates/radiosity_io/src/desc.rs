@@ -85,10 +85,10 @@ pub(crate) struct SceneDesc {
     pub(crate) units: Option<Spanned<String>>,
     /// `[[luminaire]]` entries (photometric files placed in the scene).
     #[serde(default)]
-    pub(crate) luminaire: Vec<Spanned<crate::lighting_file::LuminaireDesc>>,
+    pub(crate) luminaire: Vec<Spanned<LuminaireDesc>>,
     /// `[[grid]]` entries (calculation grids).
     #[serde(default)]
-    pub(crate) grid: Vec<Spanned<crate::lighting_file::GridDesc>>,
+    pub(crate) grid: Vec<Spanned<GridDesc>>,
 }
 
 /// `[camera]`.
@@ -239,4 +239,64 @@ pub(crate) struct SolverDesc {
     pub(crate) max_shots: Option<Spanned<i64>>,
     /// Stop after this many seconds, > 0.
     pub(crate) time_limit: Option<Spanned<f64>>,
+}
+
+/// One `[[luminaire]]`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct LuminaireDesc {
+    /// Name in reports; default the file stem.
+    pub(crate) name: Option<String>,
+    /// IES (`.ies`) or EULUMDAT (`.ldt`) file, relative to the scene file's folder.
+    pub(crate) file: Spanned<String>,
+    /// Photometric centre of one luminaire.
+    #[serde(default, deserialize_with = "point_opt")]
+    pub(crate) position: Option<Spanned<[f64; 3]>>,
+    /// Photometric centres of a row of the same luminaire.
+    pub(crate) positions: Option<Spanned<Vec<[f64; 3]>>>,
+    /// Direction of the photometric nadir (γ = 0); default straight down.
+    #[serde(default, deserialize_with = "point_opt")]
+    pub(crate) aim: Option<Spanned<[f64; 3]>>,
+    /// Turn of the C0 plane about the nadir towards C90 (counter-clockwise seen from above a
+    /// downlight), degrees; default 0 (C0 towards +x).
+    pub(crate) rotation_deg: Option<Spanned<f64>>,
+    /// Luminous flux to scale each luminaire to, lm; default the file's.
+    pub(crate) lumens: Option<Spanned<f64>>,
+    /// Factor on the intensities (maintenance factor, dimming); default 1.
+    pub(crate) multiplier: Option<Spanned<f64>>,
+    /// Linear RGB colour of the light, scaled to luminance 1; default white.
+    #[serde(default, deserialize_with = "point_opt")]
+    pub(crate) colour: Option<Spanned<[f64; 3]>>,
+    /// Colour as a correlated colour temperature, K.
+    pub(crate) cct: Option<Spanned<f64>>,
+}
+
+/// One `[[grid]]`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct GridDesc {
+    /// Name in reports; default `grid N`.
+    pub(crate) name: Option<String>,
+    /// A corner of the rectangle.
+    #[serde(default, deserialize_with = "point_opt")]
+    pub(crate) origin: Option<Spanned<[f64; 3]>>,
+    /// First edge.
+    #[serde(default, deserialize_with = "point_opt")]
+    pub(crate) u: Option<Spanned<[f64; 3]>>,
+    /// Second edge.
+    #[serde(default, deserialize_with = "point_opt")]
+    pub(crate) v: Option<Spanned<[f64; 3]>>,
+    /// Instead of `origin`, `u` and `v`: the name of a four-cornered `polygon` object whose
+    /// front the grid covers.
+    pub(crate) surface: Option<Spanned<String>>,
+    /// Largest distance between points, scene units; default EN 12464-1's for the longer
+    /// side.
+    pub(crate) spacing: Option<Spanned<f64>>,
+    /// Cells along u and v.
+    pub(crate) divisions: Option<Spanned<[i64; 2]>>,
+    /// Direction the illuminance is measured facing; default up.
+    #[serde(default, deserialize_with = "point_opt")]
+    pub(crate) normal: Option<Spanned<[f64; 3]>>,
+    /// Offset of the points along the normal, scene units; default 0.
+    pub(crate) height: Option<Spanned<f64>>,
 }

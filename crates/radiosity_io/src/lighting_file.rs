@@ -11,11 +11,10 @@ use radiosity_core::{
     Grid, IntensityTable, LUMENS_PER_WATT, LengthUnit, Lighting, Luminaire, Material, Object, Rgb, Shape,
     Sides, UpAxis, colour_of_cct, unit_luminance,
 };
-use serde::Deserialize;
 use toml::Spanned;
 
 use crate::LoadError;
-use crate::desc::{MaterialDesc, SceneDesc, point_opt};
+use crate::desc::{MaterialDesc, SceneDesc};
 use crate::locate::Locator;
 use crate::photometric::load_photometry;
 
@@ -24,66 +23,6 @@ pub const MAX_LUMINAIRES: usize = 100_000;
 
 /// Most points in all the grids of a scene.
 pub const MAX_GRID_POINTS: u64 = 4_000_000;
-
-/// One `[[luminaire]]`.
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(crate) struct LuminaireDesc {
-    /// Name in reports; default the file stem.
-    name: Option<String>,
-    /// IES (`.ies`) or EULUMDAT (`.ldt`) file, relative to the scene file's folder.
-    file: Spanned<String>,
-    /// Photometric centre of one luminaire.
-    #[serde(default, deserialize_with = "point_opt")]
-    position: Option<Spanned<[f64; 3]>>,
-    /// Photometric centres of a row of the same luminaire.
-    positions: Option<Spanned<Vec<[f64; 3]>>>,
-    /// Direction of the photometric nadir (γ = 0); default straight down.
-    #[serde(default, deserialize_with = "point_opt")]
-    aim: Option<Spanned<[f64; 3]>>,
-    /// Turn of the C0 plane about the nadir towards C90 (counter-clockwise seen from above a
-    /// downlight), degrees; default 0 (C0 towards +x).
-    rotation_deg: Option<Spanned<f64>>,
-    /// Luminous flux to scale each luminaire to, lm; default the file's.
-    lumens: Option<Spanned<f64>>,
-    /// Factor on the intensities (maintenance factor, dimming); default 1.
-    multiplier: Option<Spanned<f64>>,
-    /// Linear RGB colour of the light, scaled to luminance 1; default white.
-    #[serde(default, deserialize_with = "point_opt")]
-    colour: Option<Spanned<[f64; 3]>>,
-    /// Colour as a correlated colour temperature, K.
-    cct: Option<Spanned<f64>>,
-}
-
-/// One `[[grid]]`.
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(crate) struct GridDesc {
-    /// Name in reports; default `grid N`.
-    name: Option<String>,
-    /// A corner of the rectangle.
-    #[serde(default, deserialize_with = "point_opt")]
-    origin: Option<Spanned<[f64; 3]>>,
-    /// First edge.
-    #[serde(default, deserialize_with = "point_opt")]
-    u: Option<Spanned<[f64; 3]>>,
-    /// Second edge.
-    #[serde(default, deserialize_with = "point_opt")]
-    v: Option<Spanned<[f64; 3]>>,
-    /// Instead of `origin`, `u` and `v`: the name of a four-cornered `polygon` object whose
-    /// front the grid covers.
-    surface: Option<Spanned<String>>,
-    /// Largest distance between points, scene units; default EN 12464-1's for the longer
-    /// side.
-    spacing: Option<Spanned<f64>>,
-    /// Cells along u and v.
-    divisions: Option<Spanned<[i64; 2]>>,
-    /// Direction the illuminance is measured facing; default up.
-    #[serde(default, deserialize_with = "point_opt")]
-    normal: Option<Spanned<[f64; 3]>>,
-    /// Offset of the points along the normal, scene units; default 0.
-    height: Option<Spanned<f64>>,
-}
 
 /// The scene's unit: `opts_units` (a command-line `--units`) over the file's `units` key.
 pub(crate) fn units(
