@@ -11,11 +11,15 @@ use crate::form_factor::{point_to_point, point_to_polygon_x4};
 /// Corners of one element of the shooter, copied once per shot so ray ends need no lookups.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct ShooterElement {
+    /// Its corners; the first `count` are its own.
     pub(super) corners: [DVec3; 4],
+    /// Its number of corners, 3 or 4.
     pub(super) count: u8,
+    /// Its centroid.
     pub(super) centre: DVec3,
     /// Circumradius about `centre`.
     pub(super) radius: f64,
+    /// Its area, unit².
     pub(super) area: f64,
 }
 
@@ -30,6 +34,7 @@ impl ShooterElement {
         Self { corners, count: el.vertex_count, centre: el.centre, radius, area: el.area }
     }
 
+    /// Its own corners.
     pub(super) fn corners(&self) -> &[DVec3] {
         &self.corners[..self.count as usize]
     }
