@@ -17,7 +17,7 @@ pub struct InfoArgs {
     pub scene: String,
     #[command(flatten)]
     pub mesh: MeshOpts,
-    /// Multiply every emission by this (the emitted power reported).
+    /// Multiply every emission and luminaire intensity by this (the emitted power reported).
     #[arg(long, allow_negative_numbers = true, default_value_t = 1.0)]
     pub light_scale: f64,
 }

@@ -4,7 +4,7 @@
 use std::time::Duration;
 
 use anyhow::Result;
-use radiosity_core::{MeshParams, Scene, UpAxis};
+use radiosity_core::{MeshParams, Rgb, Scene, UpAxis};
 use radiosity_solver::{Ambient, FormFactorMethod, Overshoot, SolverParams};
 
 use crate::errors::InputError;
@@ -237,7 +237,12 @@ fn check_light_scale(scene: &Scene, light_scale: f64) -> Result<()> {
             )));
         }
     }
-    let power = scene.emitted_power().max_channel() * light_scale;
+    // Luminaires are scaled too (`Scene::scale_emission`): their power, lm / 683 per channel
+    // of their unit-luminance colour, counts with the emitters'.
+    let luminaires: Rgb = (scene.lighting.luminaires.iter())
+        .map(|l| l.colour * (l.flux() / radiosity_core::LUMENS_PER_WATT))
+        .sum();
+    let power = (scene.emitted_power() + luminaires).max_channel() * light_scale;
     if !power.is_finite() {
         return Err(input(format!(
             "--light-scale {light_scale}: the scene's emitted power would be {power}; lower the scale or the emissions"

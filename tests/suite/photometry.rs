@@ -265,6 +265,23 @@ fn radiosity(args: &[&str], dir: &Path) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_radiosity")).args(args).current_dir(dir).output().unwrap()
 }
 
+/// `--light-scale` scales luminaires as it scales emitters: the same scene's grid reads
+/// exactly k times the lux (direct light only, over the black plane; linear throughout).
+#[test]
+fn light_scale_scales_luminaires() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("iso.ies"), ies(&[0.0, 180.0], &[400.0, 400.0])).unwrap();
+    std::fs::write(dir.path().join("scene.toml"), over_black_plane("iso.ies", 2.0)).unwrap();
+    let avg = |scale: &str| {
+        let o = radiosity(&["solve", "scene.toml", "--light-scale", scale, "--json", "-", "-q"], dir.path());
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let doc: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        doc["grids"][0]["avg"].as_f64().unwrap()
+    };
+    let (one, k) = (avg("1"), avg("2.5"));
+    assert!(one > 0.0 && (k / one - 2.5).abs() < 1e-9, "{one} lx, scaled {k} lx");
+}
+
 /// A broken photometric file is one line naming the file and the line, exit 2, and nothing is
 /// written.
 #[test]
