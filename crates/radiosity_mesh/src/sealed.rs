@@ -20,7 +20,12 @@
 //! Which side of the surface an emitter lies on is found by rays from points just in front
 //! of it: the first face a ray meets shows it its front or its back; a ray that meets none
 //! is outside, which is the front for a surface wound outwards (positive enclosed volume)
-//! and the back for one wound inwards (a room).
+//! and the back for one wound inwards (a room). A point luminaire is a light like any
+//! emitter here, placed at the point it lights from
+//! ([`radiosity_core::Luminaire::light_point`]: a recessed downlight's centre lies in its
+//! ceiling, the point just below it in the room), so a scene lit by luminaires alone is
+//! sealed, and turned, as one lit by emissive polygons.
+
 
 use rustc_hash::FxHashMap as HashMap;
 
@@ -63,8 +68,9 @@ pub struct Sealed {
 
 /// Makes one-sided every two-sided, non-emitting object of `scene` whose faces close up into
 /// one consistently wound surface, but for holes spanning at most [`MAX_HOLE_SHARE`] of its
-/// area, with no emitter on its back side, or with every emitter on it (then its faces are
-/// turned, so that the side the light is on is their front); returns them in scene order.
+/// area, with no light (emitter or luminaire) on its back side, or with every light on it
+/// (then its faces are turned, so that the side the light is on is their front); returns
+/// them in scene order.
 pub fn seal_closed_objects(scene: &mut Scene) -> Vec<Sealed> {
     let sides = emitter_points(scene);
     let mut sealed = Vec::new();
@@ -187,10 +193,12 @@ impl Holes {
 
 /// Points just in front of the scene's emitters (and behind those that emit from both
 /// sides), one group per emitting side of a polygon (at most [`MAX_EMITTER_SIDES`], spread
-/// over every emitting polygon in turn): its centre and the points halfway from it to each
-/// corner. One point per side was not enough: a pendant's rod standing on the middle of a
-/// ceiling panel held it, so the fixture seemed to enclose the lamp and was turned inside
-/// out, and its faces read 0 against the path tracer's 0.25.
+/// over every emitting polygon and luminaire in turn): its centre and the points halfway
+/// from it to each corner; a luminaire's group is its
+/// [`radiosity_core::Luminaire::light_point`]. One point per side was not enough: a
+/// pendant's rod standing on the middle of a ceiling panel held it, so the fixture seemed to
+/// enclose the lamp and was turned inside out, and its faces read 0 against the path
+/// tracer's 0.25.
 fn emitter_points(scene: &Scene) -> Vec<Vec<DVec3>> {
     let (lo, hi) = scene.bounds();
     let step = 1e-6 * lo.distance(hi).max(f64::MIN_POSITIVE);
@@ -207,6 +215,7 @@ fn emitter_points(scene: &Scene) -> Vec<Vec<DVec3>> {
             Shape::Mesh(m) => push_fronts(&mut sides, m.polygons(), both, step),
         }
     }
+    sides.extend(scene.lighting.luminaires.iter().map(|l| vec![l.light_point(step)]));
     if sides.len() > MAX_EMITTER_SIDES {
         let stride = sides.len().div_ceil(MAX_EMITTER_SIDES);
         sides = sides.into_iter().step_by(stride).collect();
@@ -311,7 +320,7 @@ fn ray_triangle(p: DVec3, d: DVec3, t: &[DVec3; 3]) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use radiosity_core::{Facing, Material, Object, PolygonMesh, Sphere};
+    use radiosity_core::{Facing, Luminaire, Material, Object, PolygonMesh, Sphere};
     use radiosity_core::{Rgb, box_faces};
 
     fn lamp(at: DVec3, down: bool) -> Object {
@@ -535,6 +544,51 @@ mod tests {
         for flip in [false, true] {
             assert!(seal_closed_objects(&mut open(2, flip)).is_empty(), "flipped: {flip}");
         }
+    }
+
+    /// A downlight: a cosine distribution over the lower hemisphere, aimed down.
+    fn downlight(at: DVec3) -> Luminaire {
+        let gammas: Vec<f64> = (0..=90).step_by(5).map(f64::from).collect();
+        let cd: Vec<f64> = gammas.iter().map(|g| 100.0 * g.to_radians().cos()).collect();
+        let table = std::sync::Arc::new(radiosity_core::IntensityTable::symmetric(gammas, cd).unwrap());
+        Luminaire::aimed("downlight", at, DVec3::NEG_Y, 0.0, table, 1.0, Rgb::ONE)
+    }
+
+    /// `objects` lit by `luminaires` alone: no material emits.
+    fn lit_by(objects: Vec<Object>, luminaires: Vec<Luminaire>) -> Scene {
+        let materials = vec![
+            Material::try_new("unused", Rgb::ZERO, Rgb::ZERO).unwrap(),
+            Material::try_new("white", Rgb::splat(0.5), Rgb::ZERO).unwrap(),
+        ];
+        let mut s = Scene::try_new_unlit("luminaires", None, materials, objects).unwrap();
+        s.lighting.luminaires = luminaires;
+        s
+    }
+
+    /// Luminaires count as lights: a scene lit by them alone seals a closed box they are
+    /// outside of, and turns one wound outwards around them (a room with its normals out),
+    /// even when the downlight's centre lies in the box's ceiling (recessed): it lights from
+    /// just below.
+    #[test]
+    fn luminaires_alone_decide_the_lit_side() {
+        for as_mesh in [false, true] {
+            let mut s =
+                lit_by(vec![boxed(Facing::Outward, as_mesh)], vec![downlight(DVec3::new(0.5, 3.0, 0.5))]);
+            assert_eq!(
+                seal_closed_objects(&mut s),
+                vec![Sealed { object: 0, hole_share: 0.0, turned: false }]
+            );
+            for y in [0.9, 1.0] {
+                let mut s =
+                    lit_by(vec![boxed(Facing::Outward, as_mesh)], vec![downlight(DVec3::new(0.5, y, 0.5))]);
+                let got = seal_closed_objects(&mut s);
+                assert_eq!(got, vec![Sealed { object: 0, hole_share: 0.0, turned: true }], "y {y}");
+            }
+        }
+        // One luminaire outside, one inside: light on both sides, both kept.
+        let both = vec![downlight(DVec3::new(0.5, 3.0, 0.5)), downlight(DVec3::new(0.5, 0.9, 0.5))];
+        let mut s = lit_by(vec![boxed(Facing::Inward, true)], both);
+        assert!(seal_closed_objects(&mut s).is_empty());
     }
 
     /// Emitters, one-sided objects and balls are left as they are.
