@@ -94,6 +94,15 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
         ))?;
     }
     let up = up.unwrap_or_default();
+    // On the scene as given: sealing may turn a solid around the only light inside out.
+    let trapped =
+        spinning("finding luminaires inside solids", || radiosity_mesh::luminaires_in_solids(&scene));
+    for t in &trapped.enclosed {
+        crate::output::note(format_args!(
+            "warning: luminaire '{}' is inside the closed object '{}': its light meets only the back of that object's faces and stays inside it; move the luminaire out (a fitting's photometric centre belongs just outside its body)",
+            scene.lighting.luminaires[t.luminaire].name, scene.objects[t.object].name
+        ))?;
+    }
     if o.mesh.sides.is_none() {
         let sealed = spinning("finding closed models", || radiosity_mesh::seal_closed_objects(&mut scene));
         let names = |keep: fn(&radiosity_mesh::Sealed) -> bool| {

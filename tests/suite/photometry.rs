@@ -282,6 +282,59 @@ fn light_scale_scales_luminaires() {
     assert!(one > 0.0 && (k / one - 2.5).abs() < 1e-9, "{one} lx, scaled {k} lx");
 }
 
+/// A luminaire whose photometric centre lies inside a closed object (a fitting's body
+/// modelled as a block) is one warning line naming both; the one outside it is not named.
+/// A scene whose only luminaire lights nothing says so, not "give a material an emission".
+#[test]
+fn a_luminaire_inside_a_solid_warns() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("iso.ies"), ies(&[0.0, 180.0], &[400.0, 400.0])).unwrap();
+    let scene = |positions: &str| {
+        format!(
+            r#"
+units = "m"
+[[material]]
+name = "grey"
+reflectance = [0.5, 0.5, 0.5]
+[[object]]
+name = "floor"
+type = "polygon"
+vertices = [[-2, 0, -2], [-2, 0, 2], [2, 0, 2], [2, 0, -2]]
+material = "grey"
+[[object]]
+name = "housing"
+type = "box"
+min = [-0.2, 2.0, -0.2]
+max = [0.2, 2.2, 0.2]
+material = "grey"
+[[luminaire]]
+name = "lamp"
+file = "iso.ies"
+positions = {positions}
+[mesh]
+patch_size = 1
+element_size = 0.5
+"#
+        )
+    };
+    std::fs::write(dir.path().join("scene.toml"), scene("[[0, 2.1, 0], [1, 2.1, 0]]")).unwrap();
+    let o = radiosity(&["info", "scene.toml"], dir.path());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    let warnings: Vec<&str> = err.lines().filter(|l| l.contains("inside the closed object")).collect();
+    assert_eq!(warnings.len(), 1, "{err}");
+    assert!(
+        warnings[0].starts_with("warning: luminaire 'lamp #1'") && warnings[0].contains("'housing'"),
+        "{err}"
+    );
+
+    std::fs::write(dir.path().join("scene.toml"), scene("[[0, 2.1, 0]]")).unwrap();
+    let o = radiosity(&["solve", "scene.toml", "--json", "-", "-q"], dir.path());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("none of the scene's 1 luminaire(s) lights any surface"), "{err}");
+}
+
 /// A broken photometric file is one line naming the file and the line, exit 2, and nothing is
 /// written.
 #[test]
