@@ -15,7 +15,7 @@ use radiosity_image::{GridParams, Renderer, grid_illuminance, grid_statistics};
 use radiosity_solver::{Problem, SolverParams};
 
 /// An IES LM-63-2002 file of a rotationally symmetric distribution I(γ), absolute photometry.
-fn ies(gammas: &[f64], candela: &[f64]) -> String {
+pub(crate) fn ies(gammas: &[f64], candela: &[f64]) -> String {
     let join = |v: &[f64]| v.iter().map(|x| format!("{x}")).collect::<Vec<_>>().join(" ");
     format!(
         "IESNA:LM-63-2002\n[TEST] closed form\nTILT=NONE\n1 -1 1 {} 1 1 2 0 0 0\n1 1 0\n{}\n0\n{}\n",
@@ -26,7 +26,7 @@ fn ies(gammas: &[f64], candela: &[f64]) -> String {
 }
 
 /// Writes `files` into a fresh folder and loads `scene` (a TOML text) from it.
-fn load(scene: &str, files: &[(&str, String)]) -> (tempfile::TempDir, Scene) {
+pub(crate) fn load(scene: &str, files: &[(&str, String)]) -> (tempfile::TempDir, Scene) {
     let dir = tempfile::tempdir().unwrap();
     for (name, text) in files {
         std::fs::write(dir.path().join(name), text).unwrap();
