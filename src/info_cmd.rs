@@ -17,7 +17,7 @@ pub struct InfoArgs {
     pub scene: String,
     #[command(flatten)]
     pub mesh: MeshOpts,
-    /// Multiply every emission by this (the emitted power reported).
+    /// Multiply every emission and luminaire intensity by this (the emitted power reported).
     #[arg(long, allow_negative_numbers = true, default_value_t = 1.0)]
     pub light_scale: f64,
 }
@@ -72,6 +72,10 @@ pub fn run(a: InfoArgs) -> Result<()> {
     let emitted: Rgb =
         (0..mesh.elements.len()).map(|e| mesh.element_material(e).emission * mesh.elements[e].area).sum();
     let _ = writeln!(out, "emitted    [{:.6e}, {:.6e}, {:.6e}] W", emitted.r, emitted.g, emitted.b);
+    if !scene.lighting.luminaires.is_empty() {
+        let (count, flux) = (scene.lighting.luminaires.len(), scene.lighting.luminaire_flux());
+        let _ = writeln!(out, "luminaires {count}, {flux:.6e} lm in all");
+    }
     let mut warnings = Vec::new();
     let has_light = no_light.is_none();
     if let Some(e) = no_light {
@@ -96,7 +100,10 @@ pub fn run(a: InfoArgs) -> Result<()> {
     // Large flat surfaces that no light is in front of, summed per object.
     let total = mesh.total_area();
     let mut away = vec![0.0; mesh.object_names.len()];
-    for (surface, area) in mesh.surfaces.iter().zip(mesh.area_facing_away_from_light()) {
+    let (lo, hi) = mesh.bounds();
+    let step = 1e-6 * lo.distance(hi);
+    let luminaires: Vec<_> = scene.lighting.luminaires.iter().map(|l| l.light_point(step)).collect();
+    for (surface, area) in mesh.surfaces.iter().zip(mesh.area_facing_away_from_light(&luminaires)) {
         if area > 0.05 * total {
             away[surface.object as usize] += area;
         }

@@ -4,7 +4,7 @@
 use std::time::Duration;
 
 use anyhow::Result;
-use radiosity_core::{MeshParams, Scene, UpAxis};
+use radiosity_core::{MeshParams, Rgb, Scene, UpAxis};
 use radiosity_solver::{Ambient, FormFactorMethod, Overshoot, SolverParams};
 
 use crate::errors::InputError;
@@ -94,6 +94,15 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
         ))?;
     }
     let up = up.unwrap_or_default();
+    // On the scene as given: sealing may turn a solid around the only light inside out.
+    let trapped =
+        spinning("finding luminaires inside solids", || radiosity_mesh::luminaires_in_solids(&scene));
+    for t in &trapped.enclosed {
+        crate::output::note(format_args!(
+            "warning: luminaire '{}' is inside the closed object '{}': its light meets only the back of that object's faces and stays inside it; move the luminaire out (a fitting's photometric centre belongs just outside its body)",
+            scene.lighting.luminaires[t.luminaire].name, scene.objects[t.object].name
+        ))?;
+    }
     if o.mesh.sides.is_none() {
         let sealed = spinning("finding closed models", || radiosity_mesh::seal_closed_objects(&mut scene));
         let names = |keep: fn(&radiosity_mesh::Sealed) -> bool| {
@@ -237,7 +246,12 @@ fn check_light_scale(scene: &Scene, light_scale: f64) -> Result<()> {
             )));
         }
     }
-    let power = scene.emitted_power().max_channel() * light_scale;
+    // Luminaires are scaled too (`Scene::scale_emission`): their power, lm / 683 per channel
+    // of their unit-luminance colour, counts with the emitters'.
+    let luminaires: Rgb = (scene.lighting.luminaires.iter())
+        .map(|l| l.colour * (l.flux() / radiosity_core::LUMENS_PER_WATT))
+        .sum();
+    let power = (scene.emitted_power() + luminaires).max_channel() * light_scale;
     if !power.is_finite() {
         return Err(input(format!(
             "--light-scale {light_scale}: the scene's emitted power would be {power}; lower the scale or the emissions"

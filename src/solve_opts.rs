@@ -104,7 +104,7 @@ pub struct SolveOpts {
     /// Stop after this many seconds of solving, in (0, 1e9].
     #[arg(long, allow_negative_numbers = true)]
     pub time_limit: Option<f64>,
-    /// Multiply every emission by this (the light intensity).
+    /// Multiply every emission and every luminaire's intensity by this (the light intensity).
     #[arg(long, allow_negative_numbers = true, default_value_t = 1.0)]
     pub light_scale: f64,
     /// Worker threads, 1 to 1024 (default: all cores).

@@ -15,7 +15,7 @@ use radiosity_image::{GridParams, Renderer, grid_illuminance, grid_statistics};
 use radiosity_solver::{Problem, SolverParams};
 
 /// An IES LM-63-2002 file of a rotationally symmetric distribution I(γ), absolute photometry.
-fn ies(gammas: &[f64], candela: &[f64]) -> String {
+pub(crate) fn ies(gammas: &[f64], candela: &[f64]) -> String {
     let join = |v: &[f64]| v.iter().map(|x| format!("{x}")).collect::<Vec<_>>().join(" ");
     format!(
         "IESNA:LM-63-2002\n[TEST] closed form\nTILT=NONE\n1 -1 1 {} 1 1 2 0 0 0\n1 1 0\n{}\n0\n{}\n",
@@ -26,7 +26,7 @@ fn ies(gammas: &[f64], candela: &[f64]) -> String {
 }
 
 /// Writes `files` into a fresh folder and loads `scene` (a TOML text) from it.
-fn load(scene: &str, files: &[(&str, String)]) -> (tempfile::TempDir, Scene) {
+pub(crate) fn load(scene: &str, files: &[(&str, String)]) -> (tempfile::TempDir, Scene) {
     let dir = tempfile::tempdir().unwrap();
     for (name, text) in files {
         std::fs::write(dir.path().join(name), text).unwrap();
@@ -263,6 +263,76 @@ material = "black"
 
 fn radiosity(args: &[&str], dir: &Path) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_radiosity")).args(args).current_dir(dir).output().unwrap()
+}
+
+/// `--light-scale` scales luminaires as it scales emitters: the same scene's grid reads
+/// exactly k times the lux (direct light only, over the black plane; linear throughout).
+#[test]
+fn light_scale_scales_luminaires() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("iso.ies"), ies(&[0.0, 180.0], &[400.0, 400.0])).unwrap();
+    std::fs::write(dir.path().join("scene.toml"), over_black_plane("iso.ies", 2.0)).unwrap();
+    let avg = |scale: &str| {
+        let o = radiosity(&["solve", "scene.toml", "--light-scale", scale, "--json", "-", "-q"], dir.path());
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let doc: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        doc["grids"][0]["avg"].as_f64().unwrap()
+    };
+    let (one, k) = (avg("1"), avg("2.5"));
+    assert!(one > 0.0 && (k / one - 2.5).abs() < 1e-9, "{one} lx, scaled {k} lx");
+}
+
+/// A luminaire whose photometric centre lies inside a closed object (a fitting's body
+/// modelled as a block) is one warning line naming both; the one outside it is not named.
+/// A scene whose only luminaire lights nothing says so, not "give a material an emission".
+#[test]
+fn a_luminaire_inside_a_solid_warns() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("iso.ies"), ies(&[0.0, 180.0], &[400.0, 400.0])).unwrap();
+    let scene = |positions: &str| {
+        format!(
+            r#"
+units = "m"
+[[material]]
+name = "grey"
+reflectance = [0.5, 0.5, 0.5]
+[[object]]
+name = "floor"
+type = "polygon"
+vertices = [[-2, 0, -2], [-2, 0, 2], [2, 0, 2], [2, 0, -2]]
+material = "grey"
+[[object]]
+name = "housing"
+type = "box"
+min = [-0.2, 2.0, -0.2]
+max = [0.2, 2.2, 0.2]
+material = "grey"
+[[luminaire]]
+name = "lamp"
+file = "iso.ies"
+positions = {positions}
+[mesh]
+patch_size = 1
+element_size = 0.5
+"#
+        )
+    };
+    std::fs::write(dir.path().join("scene.toml"), scene("[[0, 2.1, 0], [1, 2.1, 0]]")).unwrap();
+    let o = radiosity(&["info", "scene.toml"], dir.path());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    let warnings: Vec<&str> = err.lines().filter(|l| l.contains("inside the closed object")).collect();
+    assert_eq!(warnings.len(), 1, "{err}");
+    assert!(
+        warnings[0].starts_with("warning: luminaire 'lamp #1'") && warnings[0].contains("'housing'"),
+        "{err}"
+    );
+
+    std::fs::write(dir.path().join("scene.toml"), scene("[[0, 2.1, 0]]")).unwrap();
+    let o = radiosity(&["solve", "scene.toml", "--json", "-", "-q"], dir.path());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("none of the scene's 1 luminaire(s) lights any surface"), "{err}");
 }
 
 /// A broken photometric file is one line naming the file and the line, exit 2, and nothing is

@@ -344,6 +344,40 @@ impl Luminaire {
         self.scale * self.table.flux()
     }
 
+    /// Where its light goes on the whole: the flux-weighted mean of the directions it shines
+    /// in, ∫ I(ω) ω dω / ∫ I(ω) dω, a vector of length 0 (as much light every way: an
+    /// isotropic lamp) to 1 (all of it along one direction). The nadir's length for a
+    /// Lambertian downlight is 2/3. Midpoint rule on a 10° × 5° grid of C and γ: coarse, but
+    /// this says which side of the lamp the light is on, not how much arrives.
+    pub fn mean_light_direction(&self) -> DVec3 {
+        let (nc, ng) = (36, 36);
+        let (dc, dg) = (2.0 * PI / f64::from(nc), PI / f64::from(ng));
+        let (mut weighted, mut total) = (DVec3::ZERO, 0.0);
+        for j in 0..ng {
+            let gamma = (f64::from(j) + 0.5) * dg;
+            // The solid angle of the cell: sin γ dγ dC.
+            let cell = gamma.sin() * dg * dc;
+            for i in 0..nc {
+                let c = (f64::from(i) + 0.5) * dc;
+                let sideways = self.c0 * c.cos() + self.c90 * c.sin();
+                let dir = self.nadir * gamma.cos() + sideways * gamma.sin();
+                let candela = self.table.candela(c.to_degrees(), gamma.to_degrees()) * cell;
+                weighted += dir * candela;
+                total += candela;
+            }
+        }
+        if total > 0.0 { weighted / total } else { DVec3::ZERO }
+    }
+
+    /// The point it lights from, for deciding which side of a surface its light is on: its
+    /// photometric centre moved `step` (scene units) along [`Luminaire::mean_light_direction`]
+    /// when that is clearly one way (length ≥ 0.1), else the centre itself. A recessed
+    /// downlight's centre lies in its ceiling's plane; the point just below it is in the room.
+    pub fn light_point(&self, step: f64) -> DVec3 {
+        let mean = self.mean_light_direction();
+        if mean.length() >= 0.1 { self.position + mean.normalize() * step } else { self.position }
+    }
+
     /// Irradiance (W/unit²) at `p` with unit normal `n` when nothing is in the way.
     pub fn irradiance_unblocked(&self, p: DVec3, n: DVec3) -> Rgb {
         let w = self.position - p;
@@ -497,6 +531,32 @@ mod tests {
         assert!((l.candela_towards(DVec3::X) - 1.0).abs() < 1e-9);
         assert!((l.candela_towards(l.c90) - 2.0).abs() < 1e-9);
         assert!((l.candela_towards(-DVec3::X) - 3.0).abs() < 1e-9);
+    }
+
+    /// A cosine downlight's light goes down on the whole, 2/3 of the way (∫cos²γ sin γ /
+    /// ∫cos γ sin γ over the lower hemisphere); an isotropic lamp's nowhere, so it lights from
+    /// its centre.
+    #[test]
+    fn mean_light_direction_follows_the_distribution() {
+        let gammas: Vec<f64> = (0..=90).map(f64::from).collect();
+        let cd: Vec<f64> = gammas.iter().map(|g| g.to_radians().cos()).collect();
+        let table = Arc::new(IntensityTable::symmetric(gammas, cd).unwrap());
+        let down = Luminaire::aimed("l", DVec3::Y, -DVec3::Y, 0.0, table, 1.0, Rgb::ONE);
+        let mean = down.mean_light_direction();
+        // The 5° midpoint rule errs by well under 1 %.
+        assert!((mean - DVec3::NEG_Y * (2.0 / 3.0)).length() < 0.01, "{mean}");
+        assert!((down.light_point(0.01) - DVec3::new(0.0, 0.99, 0.0)).length() < 1e-12);
+        let iso = Luminaire::aimed(
+            "i",
+            DVec3::Y,
+            -DVec3::Y,
+            0.0,
+            Arc::new(IntensityTable::isotropic(5.0)),
+            1.0,
+            Rgb::ONE,
+        );
+        assert!(iso.mean_light_direction().length() < 1e-9);
+        assert_eq!(iso.light_point(0.01), DVec3::Y);
     }
 
     #[test]

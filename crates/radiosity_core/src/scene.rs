@@ -615,10 +615,16 @@ impl Scene {
         })
     }
 
-    /// Multiplies every emission by `scale` (the seed document's light intensity, S11).
+    /// Multiplies every light by `scale` (the seed document's light intensity, S11): every
+    /// material's emission and every luminaire's intensity ([`crate::Luminaire::scale`]), so
+    /// that `--light-scale` brightens a scene lit by photometric files as it does one lit by
+    /// emissive surfaces.
     pub fn scale_emission(&mut self, scale: f64) {
         for m in &mut self.materials {
             m.emission *= scale;
+        }
+        for l in &mut self.lighting.luminaires {
+            l.scale *= scale;
         }
     }
 
@@ -705,6 +711,25 @@ mod tests {
         assert!(matches!(e, SceneError::ReflectanceOutOfRange { .. }));
         assert!(e.to_string().contains("[0, 1)"));
         assert!(Material::try_new("w", Rgb::splat(f64::NAN), Rgb::ZERO).is_err());
+    }
+
+    #[test]
+    fn light_scale_scales_emitters_and_luminaires() {
+        let materials = vec![
+            Material::try_new("lamp", Rgb::ZERO, Rgb::splat(2.0)).unwrap(),
+            Material::try_new("grey", Rgb::splat(0.5), Rgb::ZERO).unwrap(),
+        ];
+        let quad = Polygon::try_new(vec![DVec3::ZERO, DVec3::X, DVec3::new(1.0, 0.0, 1.0), DVec3::Z]);
+        let objects = vec![Object::new("floor", 1, Shape::Polygons(vec![quad.unwrap()]))];
+        let mut scene = Scene::try_new_unlit("lit by a luminaire", None, materials, objects).unwrap();
+        let table = std::sync::Arc::new(crate::IntensityTable::isotropic(100.0));
+        let luminaire = crate::Luminaire::aimed("l", DVec3::Y, -DVec3::Y, 0.0, table, 1.5, Rgb::ONE);
+        let flux = luminaire.flux();
+        scene.lighting.luminaires.push(luminaire);
+        scene.scale_emission(3.0);
+        assert_eq!(scene.materials[0].emission, Rgb::splat(6.0));
+        assert_eq!(scene.lighting.luminaires[0].scale, 4.5);
+        assert!((scene.lighting.luminaire_flux() / (3.0 * flux) - 1.0).abs() < 1e-12);
     }
 
     #[test]

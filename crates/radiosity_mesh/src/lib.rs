@@ -54,5 +54,8 @@ pub use limits::{MAX_ELEMENTS, MeshError, estimate_elements, first_object_over_l
 pub use mesh::{Element, Mesh, Patch, Surface};
 pub use planar::distance_to_polygon;
 pub use refinement::Refinement;
-pub use sealed::{MAX_HOLE_SHARE, Sealed, seal_closed_objects};
+pub use sealed::{
+    EnclosedLuminaire, LuminaireEnclosures, MAX_HOLE_SHARE, MAX_WINDING_TRIANGLES, Sealed,
+    luminaires_in_solids, seal_closed_objects,
+};
 pub use smoothing::Smoothing;

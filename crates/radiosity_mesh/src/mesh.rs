@@ -158,18 +158,22 @@ impl Mesh {
         })
     }
 
-    /// Per surface, the area of its one-sided, non-emitting patches that no emitter lies in
-    /// front of (every corner of every emitting patch on or behind the patch's plane, some
-    /// strictly behind): they
+    /// Per surface, the area of its one-sided, non-emitting patches that no light lies in
+    /// front of (every corner of every emitting patch, and every point of `luminaires`, on
+    /// or behind the patch's plane, some strictly behind): they
     /// can receive only reflected light, never direct light, whatever is in between. A large
     /// flat surface like that usually has its normals the wrong way round (a room's walls
     /// modelled facing out); a curved object's far side is many small surfaces.
-    pub fn area_facing_away_from_light(&self) -> Vec<f64> {
+    /// `luminaires` are the points the scene's point luminaires light from
+    /// ([`radiosity_core::Luminaire::light_point`]).
+    pub fn area_facing_away_from_light(&self, luminaires: &[DVec3]) -> Vec<f64> {
         let mut away = vec![0.0; self.surfaces.len()];
         let emitting =
             |p: &Patch| self.materials[self.surfaces[p.surface as usize].material as usize].is_emitter();
-        let lamps: Vec<DVec3> =
-            self.patches.iter().filter(|p| emitting(p)).flat_map(|p| p.corners().to_vec()).collect();
+        let lamps: Vec<DVec3> = (self.patches.iter().filter(|p| emitting(p)))
+            .flat_map(|p| p.corners().to_vec())
+            .chain(luminaires.iter().copied())
+            .collect();
         let (lo, hi) = self.bounds();
         let margin = 1e-9 * (hi - lo).length();
         for p in self.patches.iter().filter(|p| !emitting(p)) {

@@ -506,7 +506,7 @@ fn walls_facing_away_from_every_emitter_are_found() {
     let params = MeshParams::try_new(0.5, 0.5).unwrap();
     let inward = box_faces(DVec3::ZERO, DVec3::ONE, Facing::Inward, 0.0).unwrap();
     let room = Mesh::build(&scene_of(Shape::Polygons(inward)), &params).unwrap();
-    assert_eq!(room.area_facing_away_from_light(), vec![0.0; 6]);
+    assert_eq!(room.area_facing_away_from_light(&[]), vec![0.0; 6]);
     let outward = box_faces(DVec3::ZERO, DVec3::ONE, Facing::Outward, 0.0).unwrap();
     let lamp = Material::try_new("lamp", Rgb::ZERO, Rgb::ONE).unwrap();
     let grey = Material::try_new("grey", Rgb::splat(0.5), Rgb::ZERO).unwrap();
@@ -528,12 +528,26 @@ fn walls_facing_away_from_every_emitter_are_found() {
     )
     .unwrap();
     let mesh = Mesh::build(&scene, &params).unwrap();
-    let away = mesh.area_facing_away_from_light();
+    let away = mesh.area_facing_away_from_light(&[]);
     // The lamp faces down (counter-clockwise from below is clockwise from above): the
     // walls' outward faces, one surface each, all have it behind them.
     assert_eq!(away.len(), 7);
     assert!(away[..6].iter().all(|a| (a - 1.0).abs() < 1e-9), "{away:?}");
     assert_eq!(away[6], 0.0, "emitters are not counted");
+    // A luminaire outside the box counts as a light too: in front of three walls.
+    let away = mesh.area_facing_away_from_light(&[DVec3::new(2.0, 2.0, 2.0)]);
+    let facing_it = away[..6].iter().filter(|&&a| a == 0.0).count();
+    assert_eq!(facing_it, 3, "{away:?}");
+    // Inside, lit by a luminaire alone: the room's inward walls all face it.
+    let unlit = Material::try_new("unused", Rgb::ZERO, Rgb::ZERO).unwrap();
+    let grey = Material::try_new("grey", Rgb::splat(0.5), Rgb::ZERO).unwrap();
+    let faces = box_faces(DVec3::ZERO, DVec3::ONE, Facing::Inward, 0.0).unwrap();
+    let objects = vec![Object::new("walls", 1, Shape::Polygons(faces))];
+    let room = Scene::try_new_unlit("luminaire", None, vec![unlit, grey], objects).unwrap();
+    let room = Mesh::build(&room, &params).unwrap();
+    assert_eq!(room.area_facing_away_from_light(&[DVec3::splat(0.5)]), vec![0.0; 6]);
+    let outside = room.area_facing_away_from_light(&[DVec3::new(0.5, 0.5, 3.0)]);
+    assert_eq!(outside.iter().filter(|&&a| a > 0.0).count(), 1, "the +z wall's back faces it: {outside:?}");
 }
 
 /// The point `k` quarters of the way along edge `p → q`, made once per edge.

@@ -8,6 +8,15 @@ pub enum SolverError {
     /// Nothing emits: there is no light to shoot.
     #[error("the scene emits no light (total emitted power is 0); give a material an emission > 0")]
     NoEmission,
+    /// Nothing emits and the scene's luminaires light no element: each is behind a surface
+    /// that faces away from it, inside a closed object, or aimed where nothing is.
+    #[error(
+        "none of the scene's {count} luminaire(s) lights any surface, and no material emits: each is behind a surface that faces away from it, inside a closed object, or aimed where nothing is; move or aim them"
+    )]
+    DarkLuminaires {
+        /// Luminaires in the scene.
+        count: usize,
+    },
     /// The mesh has no elements.
     #[error("the mesh has no elements")]
     EmptyMesh,

@@ -25,6 +25,8 @@ pub(super) struct LuminaireLight {
     pub(super) irradiance: Vec<Rgb>,
     /// The luminaires' total flux, W per channel (lm / 683 × colour).
     pub(super) power: Rgb,
+    /// How many luminaires shine.
+    pub(super) count: usize,
 }
 
 impl LuminaireLight {
@@ -42,7 +44,7 @@ impl LuminaireLight {
             .map(|e| element_irradiance(mesh, e, rays, luminaires, lift))
             .collect();
         let power = luminaires.iter().map(|l| l.colour * (l.flux() / LUMENS_PER_WATT)).sum();
-        Some(Self { irradiance, power })
+        Some(Self { irradiance, power, count: luminaires.len() })
     }
 
     /// Whether no light arrives anywhere.

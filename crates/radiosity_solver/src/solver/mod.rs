@@ -138,8 +138,8 @@ impl Solver {
     /// (see `luminaires`).
     ///
     /// # Errors
-    /// As [`Solver::new`]; [`SolverError::NoEmission`] only when nothing emits and no
-    /// luminaire lights any element.
+    /// As [`Solver::new`], but when nothing emits: [`SolverError::NoEmission`] only without
+    /// luminaires, [`SolverError::DarkLuminaires`] when none of them lights any element.
     pub fn with_luminaires(
         mesh: Arc<Mesh>,
         accel: Arc<dyn RayQuery>,

@@ -170,13 +170,20 @@ impl Tally {
     /// Shot 0: B = E and ΔB = E on every element, plus ρ times the luminaires' direct light.
     ///
     /// # Errors
-    /// [`SolverError::NoEmission`] when nothing emits and no luminaire lights anything.
+    /// [`SolverError::NoEmission`] when nothing emits and there is no luminaire,
+    /// [`SolverError::DarkLuminaires`] when nothing emits and no luminaire lights anything.
     pub(super) fn lit(mesh: &Mesh, luminaires: Option<&LuminaireLight>) -> Result<Self, SolverError> {
         let n = mesh.elements.len();
         let emission: Vec<Rgb> = (0..n).map(|e| mesh.element_material(e).emission).collect();
         let emitted: Rgb = mesh.elements.iter().zip(&emission).map(|(el, e)| *e * el.area).sum();
-        if emitted.sum() <= 0.0 && luminaires.is_none_or(LuminaireLight::is_dark) {
-            return Err(SolverError::NoEmission);
+        if emitted.sum() <= 0.0 {
+            match luminaires {
+                None => return Err(SolverError::NoEmission),
+                Some(light) if light.is_dark() => {
+                    return Err(SolverError::DarkLuminaires { count: light.count });
+                }
+                Some(_) => {}
+            }
         }
         let patch_unshot_emission = (mesh.patches.iter())
             .map(|p| p.elements.clone().map(|e| emission[e as usize] * mesh.elements[e as usize].area).sum())
