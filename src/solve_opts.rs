@@ -68,7 +68,8 @@ pub struct MeshOpts {
     #[arg(long, value_name = "true|false")]
     pub contacts: Option<bool>,
     /// Cut surfaces along the outlines of the penumbrae and umbrae that convex solids (a
-    /// block, a box) cast from the bright emitters, so shadow edges fall on element edges
+    /// block, a box) cast from the bright emitters and luminaires, so shadow edges fall on
+    /// element edges
     /// [default: the scene's `[mesh]` shadow_outlines, else true].
     #[arg(long, value_name = "true|false")]
     pub shadow_outlines: Option<bool>,

@@ -10,6 +10,7 @@ mod discretisation;
 mod export;
 mod fast_paths;
 mod grid_outputs;
+mod luminaire_shadows;
 mod lux_closed_forms;
 mod model_fuzz;
 mod models;

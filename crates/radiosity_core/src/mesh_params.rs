@@ -23,7 +23,7 @@ pub struct MeshParams {
     /// part out (see the `contacts` module). Default true.
     pub contacts: bool,
     /// Cut surfaces along the outlines of the penumbrae and umbrae that convex solids cast
-    /// from the bright emitters (see the `shadows` module). Default true.
+    /// from the bright emitters and point luminaires (see the `shadows` module). Default true.
     pub shadow_outlines: bool,
     /// How many times elements along inside corners (a wall meeting the floor, a block
     /// standing on it) are halved towards the corner, in [0, [`MAX_CORNER_REFINEMENT`]]; 0

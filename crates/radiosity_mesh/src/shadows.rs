@@ -16,9 +16,16 @@
 //! events) are not cut: the radiosity is smooth across them to first order, and cutting
 //! them all costs more elements than it buys.
 //!
-//! Emitters are the polygon lights carrying at least [`LIGHT_SHARE`] of the scene's emitted
-//! power (at most [`MAX_LIGHTS`]); a light object whose coplanar faces make one convex
-//! polygon (a quad given as two triangles) is one emitter. Solids are sets of polygons joined
+//! A point luminaire (`[[luminaire]]`) is an emitter with one corner, its photometric
+//! centre (the point the solver's shadow rays start from): its shadow has no penumbra, and
+//! its one outline is the umbra's, the hull of the solid's corners projected from that point
+//! onto the plane (the silhouette of a convex solid from a point, Heckbert 1992 §3).
+//!
+//! Emitters are the polygon lights and luminaires carrying at least [`LIGHT_SHARE`] of the
+//! scene's emitted power, polygons' and luminaires' together (a luminaire's flux Φ counts
+//! as Φ / 683 W, the solver's rule), at most [`MAX_LIGHTS`] of them, the brightest first; a
+//! light object whose coplanar faces make one convex polygon (a quad given as two
+//! triangles) is one emitter. Solids are sets of polygons joined
 //! at shared corners that make a convex solid (a box given face by face, as the Cornell box's
 //! blocks are): all their corners lie on or behind each face. Concave objects and tessellated
 //! models cast no outlines; they are left to adaptive subdivision.
@@ -29,7 +36,7 @@ use glam::{DVec2, DVec3};
 
 use crate::planar::{area, bounds, clean, clip, key, lexicographic, plane, split, tolerance};
 use crate::union_find::UnionFind;
-use radiosity_core::{Polygon, Scene, Shape};
+use radiosity_core::{LUMENS_PER_WATT, Luminaire, Polygon, Scene, Shape};
 
 /// Least share of the scene's emitted power an emitter needs to cast outlines: the dim ones'
 /// shadows are faint, and every outline costs elements.
@@ -53,12 +60,48 @@ const MAX_MAGNIFICATION: f64 = 20.0;
 /// surface (the same bound as for contacts): past it, an outline does not cut.
 const PIECE_COST: usize = 4;
 
-/// A convex emitter.
+/// A convex emitter: a polygon light, or a point luminaire (one corner).
 struct Light {
     corners: Vec<DVec3>,
-    /// Its front (emitting) side's normal and a point of it.
-    normal: DVec3,
-    centre: DVec3,
+    /// Which way it shines.
+    shine: Shine,
+}
+
+/// Where an emitter's light goes.
+enum Shine {
+    /// A polygon's front side: its normal and a point of it.
+    Front { normal: DVec3, centre: DVec3 },
+    /// A point luminaire's goniometric distribution.
+    Distribution(Box<Luminaire>),
+}
+
+impl Light {
+    /// Whether some light can reach the plane of `target` (a polygon light: some corner of
+    /// it lies in front). A luminaire may light any plane on the far side of a solid it lights.
+    fn reaches(&self, target: &Polygon) -> bool {
+        match &self.shine {
+            Shine::Front { normal, centre } => {
+                target.vertices().iter().any(|&q| normal.dot(q - *centre) > 0.0)
+            }
+            Shine::Distribution(_) => true,
+        }
+    }
+
+    /// Whether `solid` (its corners) is lit: some corner in front of a polygon light; for a
+    /// luminaire, some intensity towards a corner or the centre (a narrow spot on the middle
+    /// of a box misses its corners).
+    fn lights(&self, solid: &[DVec3]) -> bool {
+        match &self.shine {
+            Shine::Front { normal, centre } => solid.iter().any(|&q| normal.dot(q - *centre) > 0.0),
+            Shine::Distribution(l) => {
+                let middle = solid.iter().copied().sum::<DVec3>() / solid.len() as f64;
+                solid.iter().chain([&middle]).any(|&q| {
+                    let dir = (q - l.position).normalize_or_zero();
+                    dir != DVec3::ZERO && l.candela_towards(dir) > 0.0
+                })
+            }
+        }
+    }
 }
 
 /// The shadow outlines the scene's bright emitters cast through its convex solids.
@@ -83,14 +126,14 @@ impl ShadowOutlines {
         Self { lights: lights(scene), solids: solids(scene) }
     }
 
-    /// Whether no outline can be cast (no bright polygon emitter or no convex solid).
+    /// Whether no outline can be cast (no bright emitter or luminaire, or no convex solid).
     pub(crate) fn is_empty(&self) -> bool {
         self.lights.is_empty() || self.solids.is_empty()
     }
 
     /// The outlines cast on the plane of `target`, each convex and counter-clockwise about its
     /// normal: per emitter and solid, the penumbra's outline, then the umbra's where there is
-    /// one. Not clipped to `target`.
+    /// one (a point luminaire's shadow is all umbra: one outline). Not clipped to `target`.
     pub(crate) fn outlines(&self, target: &Polygon) -> Vec<Vec<DVec3>> {
         let (n, d) = plane(target);
         let eps = tolerance(target);
@@ -100,9 +143,7 @@ impl ShadowOutlines {
             let lit_heights: Vec<f64> = light.corners.iter().map(|&q| height(q)).collect();
             let lowest_light = lit_heights.iter().copied().fold(f64::INFINITY, f64::min);
             // The emitter wholly in front of the surface, and the surface partly in front of it.
-            if lowest_light <= eps
-                || target.vertices().iter().all(|&q| light.normal.dot(q - light.centre) <= 0.0)
-            {
+            if lowest_light <= eps || !light.reaches(target) {
                 continue;
             }
             for solid in &self.solids {
@@ -112,7 +153,7 @@ impl ShadowOutlines {
                 if hs.iter().any(|&h| h < -eps)
                     || highest <= eps
                     || highest >= lowest_light * (1.0 - 1.0 / MAX_MAGNIFICATION)
-                    || solid.iter().all(|&q| light.normal.dot(q - light.centre) <= 0.0)
+                    || !light.lights(solid)
                 {
                     continue;
                 }
@@ -133,6 +174,13 @@ impl ShadowOutlines {
                         hull(&cast, n)
                     })
                     .collect();
+                if let [point] = &shadows[..] {
+                    // From a point: the umbra is the whole shadow.
+                    if point.len() >= 3 {
+                        out.push(point.clone());
+                    }
+                    continue;
+                }
                 let all: Vec<DVec3> = shadows.iter().flatten().copied().collect();
                 let penumbra = hull(&all, n);
                 // Clipping repeats a corner where the shadows share one; the hull drops it (a
@@ -200,9 +248,18 @@ fn split_all(pieces: &[Polygon], outline: &[DVec3], target: &Polygon, tiny: f64)
     Some(out)
 }
 
-/// The bright convex emitters of `scene`, brightest first.
+/// Power of luminaire `l` in the solver's units (W; Φ / 683 · colour, colour at Y = 1), Y.
+fn luminaire_power(l: &Luminaire) -> f64 {
+    (l.colour * (l.flux() / LUMENS_PER_WATT)).luminance()
+}
+
+/// The bright convex emitters and point luminaires of `scene`, brightest first.
 fn lights(scene: &Scene) -> Vec<Light> {
-    let total = scene.emitted_power().luminance();
+    let luminaires = &scene.lighting.luminaires;
+    let mut total = scene.emitted_power().luminance();
+    if !luminaires.is_empty() {
+        total += luminaires.iter().map(luminaire_power).sum::<f64>();
+    }
     if total.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
         return Vec::new();
     }
@@ -215,7 +272,7 @@ fn lights(scene: &Scene) -> Vec<Light> {
         }
         let as_light = |corners: Vec<DVec3>, normal: DVec3| {
             let centre = corners.iter().copied().sum::<DVec3>() / corners.len() as f64;
-            Light { corners, normal, centre }
+            Light { corners, shine: Shine::Front { normal, centre } }
         };
         // Coplanar faces that tile one convex polygon (a quad as two triangles) are one light.
         let n = ps[0].normal();
@@ -236,6 +293,11 @@ fn lights(scene: &Scene) -> Vec<Light> {
             ),
         }
     }
+    // A luminaire casts from its photometric centre, where the solver's shadow rays start.
+    found.extend(luminaires.iter().map(|l| {
+        let light = Light { corners: vec![l.position], shine: Shine::Distribution(Box::new(l.clone())) };
+        (luminaire_power(l), light)
+    }));
     found.retain(|(power, _)| *power >= LIGHT_SHARE * total);
     // Brightest first; equal ones in a fixed order whatever the input's.
     found.sort_by(|a, b| b.0.total_cmp(&a.0).then_with(|| lexicographic(a.1.corners[0], b.1.corners[0])));
@@ -470,5 +532,122 @@ mod tests {
         assert_eq!(across(&cut), 0);
         let uncut = Mesh::build(&scene, &params.with_shadow_outlines(false)).unwrap();
         assert!(across(&uncut) > 50, "{} elements across without outlines", across(&uncut));
+    }
+
+    /// A 4 × 4 floor, an axis-aligned unit box on it over x, z ∈ [1.5, 2.5], and an isotropic
+    /// point luminaire at `LAMP` (no emitting polygon: `try_new_unlit`).
+    fn luminaire_box_floor() -> Scene {
+        let block =
+            box_faces(DVec3::new(1.5, 0.0, 1.5), DVec3::new(2.5, 1.0, 2.5), Facing::Outward, 0.0).unwrap();
+        let floor = Polygon::try_new(vec![
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(0.0, 0.0, 4.0),
+            DVec3::new(4.0, 0.0, 4.0),
+            DVec3::new(4.0, 0.0, 0.0),
+        ])
+        .unwrap();
+        let grey = Material::try_new("grey", Rgb::splat(0.5), Rgb::ZERO).unwrap();
+        let mut scene = Scene::try_new_unlit(
+            "a downlight over a box",
+            None,
+            vec![grey],
+            vec![
+                Object::new("floor", 0, Shape::Polygons(vec![floor])),
+                Object::new("block", 0, Shape::Polygons(block)),
+            ],
+        )
+        .unwrap();
+        let table = std::sync::Arc::new(radiosity_core::IntensityTable::isotropic(100.0));
+        scene.lighting.luminaires.push(Luminaire::aimed("lamp", LAMP, -DVec3::Y, 0.0, table, 1.0, Rgb::ONE));
+        scene
+    }
+
+    /// The luminaire's photometric centre in [`luminaire_box_floor`]: off the box's axis and at
+    /// a height that puts no shadow line on a round coordinate.
+    const LAMP: DVec3 = DVec3::new(1.05, 3.1, 1.3);
+
+    /// How much of the segment from `a` to `b` on the floor the edges of the floor's elements
+    /// cover (edges within 1e-6 of the segment's line, overlapping it), as a share of its
+    /// length.
+    fn covered(mesh: &Mesh, a: DVec3, b: DVec3) -> f64 {
+        let along = (b - a).normalize();
+        let length = a.distance(b);
+        let off = |p: DVec3| (p - a - along * along.dot(p - a)).length();
+        let mut spans: Vec<(f64, f64)> = Vec::new();
+        for e in (0..mesh.elements.len()).filter(|&e| mesh.element_object(e) == 0) {
+            let corners: Vec<DVec3> = mesh.element_corners(e).collect();
+            for k in 0..corners.len() {
+                let (p, q) = (corners[k], corners[(k + 1) % corners.len()]);
+                if off(p) <= 1e-6 && off(q) <= 1e-6 {
+                    let (s, t) = (along.dot(p - a), along.dot(q - a));
+                    spans.push((s.min(t).max(0.0), s.max(t).min(length)));
+                }
+            }
+        }
+        spans.sort_by(|x, y| x.0.total_cmp(&y.0));
+        let (mut total, mut reach) = (0.0, 0.0_f64);
+        for (s, t) in spans {
+            let s = s.max(reach);
+            if t > s {
+                total += t - s;
+                reach = t;
+            }
+        }
+        total / length
+    }
+
+    /// A point luminaire casts the box's hard shadow outline: the top's far corners projected
+    /// from the lamp onto the floor, x' = L + (x − L)·h_L / (h_L − h_x) (similar triangles),
+    /// bound the shadow by two straight lines, z = z' of the far top edge and x = x' of the
+    /// right one, and element edges run along both of them for their whole length. Meshed
+    /// without outlines, element edges cover less than half of either.
+    #[test]
+    fn a_point_luminaire_puts_element_edges_on_the_shadow_of_a_box() {
+        let scene = luminaire_box_floor();
+        let outlines = ShadowOutlines::new(&scene);
+        assert_eq!((outlines.lights.len(), outlines.solids.len()), (1, 1));
+        let Shape::Polygons(floor) = &scene.objects[0].shape else { unreachable!() };
+        assert_eq!(outlines.outlines(&floor[0]).len(), 1, "one umbra, no penumbra");
+        let cast = |x: f64, z: f64| {
+            let top = DVec3::new(x, 1.0, z);
+            let p = LAMP + (top - LAMP) * (LAMP.y / (LAMP.y - 1.0));
+            DVec3::new(p.x, 0.0, p.z)
+        };
+        // The far top edge's shadow (z = z' from x'(1.5) to x'(2.5)), and the right top
+        // edge's (x = x' from z'(1.5) to z'(2.5)).
+        let far = (cast(1.5, 2.5), cast(2.5, 2.5));
+        let right = (cast(2.5, 1.5), cast(2.5, 2.5));
+        let params = scene.mesh_params();
+        let cut = Mesh::build(&scene, &params).unwrap();
+        for (a, b) in [far, right] {
+            let share = covered(&cut, a, b);
+            assert!(share > 0.999, "{share} of the shadow line {a} – {b} on element edges");
+        }
+        let uncut = Mesh::build(&scene, &params.with_shadow_outlines(false)).unwrap();
+        for (a, b) in [far, right] {
+            let share = covered(&uncut, a, b);
+            assert!(share < 0.5, "{share} of {a} – {b} on element edges without outlines");
+        }
+    }
+
+    /// Luminaires share the emitters' budget: one whose flux is under [`LIGHT_SHARE`] of the
+    /// scene's light casts no outline, and no more than [`MAX_LIGHTS`] cast, the brightest first.
+    #[test]
+    fn dim_luminaires_cast_no_outlines_and_at_most_four_do() {
+        let mut scene = luminaire_box_floor();
+        let bright = scene.lighting.luminaires[0].clone();
+        let mut dim = bright.clone();
+        dim.scale = 0.05;
+        dim.position = DVec3::new(3.0, 3.0, 3.0);
+        scene.lighting.luminaires.push(dim);
+        assert_eq!(ShadowOutlines::new(&scene).lights.len(), 1, "the dim one left out");
+        for k in 0..6 {
+            let mut l = bright.clone();
+            l.position = DVec3::new(0.5 + 0.5 * f64::from(k), 3.0, 0.5);
+            scene.lighting.luminaires.push(l);
+        }
+        let lights = ShadowOutlines::new(&scene).lights;
+        assert_eq!(lights.len(), MAX_LIGHTS);
+        assert!(lights.iter().all(|l| l.corners.len() == 1));
     }
 }
