@@ -8,8 +8,7 @@
 //! inside a surface wound outwards, −1 inside one wound inwards, 0 outside.
 //!
 //! A fitting's body modelled as a closed block around the luminaire's photometric centre
-//! keeps all of its light inside; the loader reports such luminaires rather than solve a
-//! dark scene. Closed surfaces are found as [`crate::seal_closed_objects`] finds them,
+//! keeps all of its light inside; the command warns of such luminaires, before sealing. Closed surfaces are found as [`crate::seal_closed_objects`] finds them,
 //! small holes capped.
 
 use glam::DVec3;
