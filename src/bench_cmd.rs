@@ -330,7 +330,7 @@ pub fn run(a: BenchArgs) -> Result<()> {
 
 /// Cases (a)–(d).
 fn fixed_cases(a: &BenchArgs) -> Result<Vec<serde_json::Value>> {
-    let cornell = radiosity_core::cornell_box();
+    let cornell = radiosity_scenes::cornell_box();
     let mut cases = vec![occlusion_case(&cornell, a.dump_rays.as_deref(), a.force)?];
 
     // (b) The source document's case: ~100 facets, 1000 shots (it took about a minute).

@@ -85,7 +85,7 @@ pub fn load_settings(scene_arg: &str, o: &SolveOpts) -> Result<(Settings, Option
     // A building model from an architectural tool is mostly z up and would lie on its side:
     // say which flag stands it up, unless an up axis was declared.
     if up.is_none()
-        && let Some(guess) = scene.likely_up()
+        && let Some(guess) = radiosity_io::likely_up(&scene)
     {
         crate::output::note(format_args!(
             "note: the scene looks {up} up ({reason}) but is read +y up; if it lies on its side, add --up {up} (or up = \"{up}\" in a scene file)",

@@ -78,6 +78,7 @@ fn the_scene_loader_needs_no_solver_or_picture_files() {
 #[test]
 fn the_scene_vocabulary_and_the_mesher_stand_alone() {
     let workspace = [
+        "radiosity_scenes",
         "radiosity_accel",
         "radiosity_solver",
         "radiosity_image",

@@ -16,8 +16,9 @@
 //! the density weighting 3.2 % and 25 % (with 4 rays from every shooter). Bounds: 1.5 % and
 //! 8 %.
 
-use radiosity_core::{MeshParams, cornell_box};
+use radiosity_core::MeshParams;
 use radiosity_reference::{EstimateParams, PathBudget, Reference, Region};
+use radiosity_scenes::cornell_box;
 use radiosity_solver::{Problem, Solver, SolverParams};
 
 fn object_means(patch: f64, element: f64) -> Vec<(String, f64, [f64; 3])> {

@@ -23,7 +23,8 @@
 //! 1e-5 relative, except at most 0.5 % of elements, none of them off by more than 5 % of its
 //! own value or 0.5 % of its object's mean; per-object means within 1e-4.
 
-use radiosity_core::{MeshParams, Scene, furnace_box, two_plates, unit_cube_floor_light};
+use radiosity_core::{MeshParams, Scene};
+use radiosity_scenes::{furnace_box, two_plates, unit_cube_floor_light};
 use radiosity_solver::{Problem, Solution, SolverParams};
 
 fn solve(problem: &Problem, reference_path: bool, max_shots: u64) -> Solution {

@@ -5,10 +5,11 @@
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::Path;
 
-use radiosity_core::{Rgb, cornell_box};
+use radiosity_core::Rgb;
 use radiosity_export::{VertexColours, glb_bytes};
 use radiosity_io::{ModelFormat, Transform, parse_model};
 use radiosity_mesh::Mesh;
+use radiosity_scenes::cornell_box;
 use radiosity_solver::Solution;
 
 use radiosity_core::random::XorShift64;

@@ -6,6 +6,10 @@
 //! Read from the source, not the compiler: every `crate::…` and `super::…` path outside the
 //! files' test modules, every `use` of a child module, and names used through the crate
 //! root's re-exports (`use crate::{Mesh, …}`) resolved to the file that defines them.
+//!
+//! Files and the vocabulary stay small: no Rust file of the workspace is over
+//! [`MAX_FILE_LINES`] lines (a longer one holds more than one idea, to be split by idea), and
+//! `radiosity_core`, which every crate builds on, is at most [`MAX_CORE_LINES`] in all.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -13,6 +17,13 @@ use std::path::{Path, PathBuf};
 /// Circles that are known and left as they are, each with why. None now: a circle that has
 /// to stay for a while is listed here, with the reason and the way to end it.
 const KNOWN_CIRCLES: &[(&str, &[&str])] = &[];
+
+/// Most lines in one Rust file (source, tests, benches, examples) of the workspace.
+const MAX_FILE_LINES: usize = 800;
+
+/// Most lines in `radiosity_core`'s source, tests included: the vocabulary every crate
+/// builds on stays small, so that it changes seldom.
+const MAX_CORE_LINES: usize = 2_500;
 
 /// A crate's modules: module path ("" for the root, "a::b") → its file.
 fn modules(src: &Path) -> BTreeMap<String, PathBuf> {
@@ -363,4 +374,56 @@ fn print_layers() {
             println!("  {m:<24} → {}", deps.into_iter().collect::<Vec<_>>().join(", "));
         }
     }
+}
+
+/// Every `.rs` file under `dir`, build outputs left out.
+fn rust_files(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(dir) = stack.pop() {
+        for entry in std::fs::read_dir(&dir).expect("readable folder") {
+            let path = entry.expect("a folder entry").path();
+            if path.is_dir() {
+                if path.file_name().is_none_or(|n| n != "target") {
+                    stack.push(path);
+                }
+            } else if path.extension().is_some_and(|e| e == "rs") {
+                out.push(path);
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+/// Lines in `file`, as `wc -l` counts them.
+fn lines_of(file: &Path) -> usize {
+    std::fs::read_to_string(file).expect("readable source file").lines().count()
+}
+
+#[test]
+fn no_file_is_over_800_lines() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let files: Vec<PathBuf> =
+        ["src", "tests", "crates"].iter().flat_map(|d| rust_files(&root.join(d))).collect();
+    assert!(files.len() > 100, "too few files found: {}", files.len());
+    let long: Vec<String> = files
+        .iter()
+        .map(|f| (f, lines_of(f)))
+        .filter(|&(_, n)| n > MAX_FILE_LINES)
+        .map(|(f, n)| format!("{}: {n} lines", f.strip_prefix(root).unwrap_or(f).display()))
+        .collect();
+    assert!(long.is_empty(), "files over {MAX_FILE_LINES} lines (split them by idea):\n{}", long.join("\n"));
+}
+
+#[test]
+fn the_vocabulary_stays_small() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("crates/radiosity_core/src");
+    let total: usize = rust_files(&src).iter().map(|f| lines_of(f)).sum();
+    assert!(total > 500, "radiosity_core not found: {total} lines");
+    assert!(
+        total <= MAX_CORE_LINES,
+        "radiosity_core is {total} lines, over {MAX_CORE_LINES}: what is not the scene model, colour, \
+         random streams, planar geometry or camera rays belongs in a crate above it"
+    );
 }

@@ -1,13 +1,13 @@
 //! Vocabulary of the `radiosity` renderer: linear colour ([`Rgb`]), validated scenes
 //! ([`Scene`], [`Material`], [`Object`]), how finely to mesh them ([`MeshParams`]; the mesher
-//! is the `radiosity_mesh` crate), camera rays, seeded random streams and the canonical scenes.
+//! is the `radiosity_mesh` crate), camera rays and seeded random streams. The canonical test scenes are the
+//! `radiosity_scenes` crate.
 //!
 //! Units: positions in scene units (any length unit, used consistently), radiosity and
 //! emission in W per unit², power in W.
 #![warn(missing_docs)]
 #![forbid(unsafe_code)]
 
-mod canonical;
 mod color;
 mod film;
 mod limits;
@@ -20,10 +20,6 @@ mod scene_error;
 mod srgb;
 mod up;
 
-pub use canonical::{
-    cornell_box, furnace_box, furnace_sphere, two_plates, two_sided_plate, unit_cube_floor_light,
-    uv_sphere_mesh,
-};
 pub use color::Rgb;
 pub use film::CameraRays;
 pub use limits::{MAX_COORDINATE, MAX_POLYGON_VERTICES, MAX_TIME_LIMIT_SECONDS};
@@ -43,7 +39,7 @@ pub use scene::{
 };
 pub use scene_error::SceneError;
 pub use srgb::{encode_srgb, srgb_decode, srgb_encode};
-pub use up::{UpAxis, UpGuess};
+pub use up::UpAxis;
 
 /// Re-export of the vector maths used in the public API.
 pub use glam;

@@ -4,13 +4,14 @@
 
 use std::sync::Arc;
 
-use radiosity_core::{Rgb, cornell_box};
+use radiosity_core::Rgb;
 use radiosity_export::{
     LIGHTMAP_CELL_TEXELS, Texels, VertexColours, glb_bytes, gltf_text, lightmaps, ply_bytes, vertex_colours,
     write_lightmaps,
 };
 use radiosity_image::{ToneOperator, ToneParams};
 use radiosity_mesh::Mesh;
+use radiosity_scenes::cornell_box;
 use radiosity_solver::{Problem, Solution, SolverParams};
 
 /// The Cornell box after 150 shots: enough light everywhere for the values to be distinct.
@@ -200,7 +201,7 @@ fn lightmaps_hold_vertex_radiosity_at_chart_corners() {
 fn gathered_lightmaps_of_the_furnace_hold_its_radiosity() {
     use radiosity_image::{Gather, RenderParams, Renderer};
     let (rho, emission) = (0.5, 1.0);
-    let scene = radiosity_core::furnace_box(rho, emission);
+    let scene = radiosity_scenes::furnace_box(rho, emission);
     let problem = Problem::new(&scene, &scene.mesh_params()).unwrap();
     let mut solver = problem.solver(SolverParams::default()).unwrap();
     solver.solve();

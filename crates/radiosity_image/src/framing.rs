@@ -240,7 +240,7 @@ fn hit_polygon(p: &Polygon, origin: DVec3, dir: DVec3) -> Option<(f64, bool)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use radiosity_core::{cornell_box, furnace_box, two_plates};
+    use radiosity_scenes::{cornell_box, furnace_box, two_plates};
 
     /// A closed box lit from inside is seen from inside: every probe ray meets a lit face
     /// (the framing view from outside would see only the backs of its walls).

@@ -4,7 +4,8 @@
 //! radiance.
 //!
 //! ```
-//! use radiosity_core::{Camera, furnace_box, glam::DVec3};
+//! use radiosity_core::{Camera, glam::DVec3};
+//! use radiosity_scenes::furnace_box;
 //! use radiosity_image::{Exposure, RenderParams, Renderer, ToneParams, ToneOperator, tone_map_image};
 //! use radiosity_solver::{Problem, SolverParams};
 //!

@@ -2,7 +2,8 @@
 //! `docs/ARCHITECTURE.md` and `DESIGN.md`, "Scene file"), model files (OBJ + MTL, glTF / GLB:
 //! [`load_model`], or `type = "mesh"` objects of a scene file), and the built-in scenes. Every
 //! scene loader ([`load_scene`], [`parse_scene`], [`resolve_scene`]) returns a [`LoadedScene`]:
-//! the scene and the loader's warnings. Lit meshes go out through `radiosity_export`.
+//! the scene and the loader's warnings. A model that does not say which way is up gets a
+//! guess ([`likely_up`]) for a note to the user. Lit meshes go out through `radiosity_export`.
 //!
 //! Loading has two stages. First the text becomes plain serde data (`SceneDesc`, private)
 //! with unknown keys rejected; then that data becomes a core [`Scene`] through the core's
@@ -38,6 +39,7 @@ mod obj;
 mod photometric;
 mod scene_file;
 mod scene_settings;
+mod up_guess;
 
 pub use builtin::{BUILTIN_SCENES, builtin_scene, resolve_scene, resolve_scene_with};
 pub use error::LoadError;
@@ -48,5 +50,6 @@ pub use photometric::{
     MAX_ANGLES, MAX_PHOTOMETRIC_BYTES, PhotometricFormat, Photometry, load_photometry, parse_photometry,
 };
 pub use scene_file::{LoadOptions, LoadedScene, load_scene, load_scene_with, parse_scene, parse_scene_with};
+pub use up_guess::{UpGuess, likely_up};
 
 use radiosity_core::Scene;

@@ -57,7 +57,7 @@ pub struct LoadedScene {
     /// `up` key), already applied: the scene is in the renderer's +y-up frame, and
     /// [`UpAxis::from_y_up`] takes its coordinates back to the file's. `None` when nothing
     /// declared one and the file was taken as +y up (OBJ has no convention; glTF's is +y),
-    /// which is when [`Scene::likely_up`] is worth asking.
+    /// which is when [`likely_up`](crate::likely_up) is worth asking.
     pub up: Option<UpAxis>,
 }
 

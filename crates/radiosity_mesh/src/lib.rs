@@ -23,7 +23,8 @@
 //! elements to quarter; `smoothing` is the table of vertices pooled across surfaces and
 //! `pooling` builds it; `build` puts it all
 //! together into a [`Mesh`] (`mesh`), within the `limits`; `sealed` makes closed models
-//! one-sided before meshing.
+//! one-sided before meshing, and `enclosed_luminaires` (above `sealed`, whose hole caps it
+//! uses) finds luminaires shut inside solids.
 //!
 //! [`PolygonMesh`]: radiosity_core::PolygonMesh
 #![warn(missing_docs)]
@@ -33,6 +34,7 @@ mod bisection;
 mod build;
 mod builder;
 mod contacts;
+mod enclosed_luminaires;
 mod grading;
 mod lattice;
 mod limits;
@@ -50,12 +52,12 @@ mod union_find;
 #[cfg(test)]
 mod tests;
 
+pub use enclosed_luminaires::{
+    EnclosedLuminaire, LuminaireEnclosures, MAX_WINDING_TRIANGLES, luminaires_in_solids,
+};
 pub use limits::{MAX_ELEMENTS, MeshError, estimate_elements, first_object_over_limit};
 pub use mesh::{Element, Mesh, Patch, Surface};
 pub use planar::distance_to_polygon;
 pub use refinement::Refinement;
-pub use sealed::{
-    EnclosedLuminaire, LuminaireEnclosures, MAX_HOLE_SHARE, MAX_WINDING_TRIANGLES, Sealed,
-    luminaires_in_solids, seal_closed_objects,
-};
+pub use sealed::{MAX_HOLE_SHARE, Sealed, seal_closed_objects};
 pub use smoothing::Smoothing;

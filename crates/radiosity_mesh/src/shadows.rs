@@ -509,7 +509,7 @@ mod tests {
     /// one side of each), while the floor meshed without outlines has elements across them.
     #[test]
     fn no_cornell_floor_element_lies_across_a_shadow_outline() {
-        let scene = radiosity_core::cornell_box();
+        let scene = radiosity_scenes::cornell_box();
         let params = scene.mesh_params();
         let Shape::Polygons(floor) = &scene.objects[0].shape else { unreachable!() };
         let outlines = ShadowOutlines::new(&scene).outlines(&floor[0]);

@@ -246,7 +246,7 @@ fn absurd_subdivision_is_an_error_not_a_hang() {
 fn smoothing_joins_facets_below_the_crease_angle_only() {
     let params = MeshParams::try_new(10.0, 10.0).unwrap();
     let sphere =
-        Mesh::build(&scene_of(Shape::Mesh(radiosity_core::uv_sphere_mesh(DVec3::ZERO, 1.0, 24))), &params)
+        Mesh::build(&scene_of(Shape::Mesh(radiosity_scenes::uv_sphere_mesh(DVec3::ZERO, 1.0, 24))), &params)
             .unwrap();
     assert!(sphere.surfaces.len() > 100, "one surface per facet");
     // Every facet corner meets 3 or 4 other facets of the sphere (the poles 23).
@@ -262,14 +262,14 @@ fn smoothing_joins_facets_below_the_crease_angle_only() {
     let cube = Mesh::build(&scene_of(Shape::Polygons(faces)), &params).unwrap();
     assert_eq!(cube.smoothing, Smoothing::default(), "a box's edges stay sharp");
     let flat = Mesh::build(
-        &scene_of(Shape::Mesh(radiosity_core::uv_sphere_mesh(DVec3::ZERO, 1.0, 24))),
+        &scene_of(Shape::Mesh(radiosity_scenes::uv_sphere_mesh(DVec3::ZERO, 1.0, 24))),
         &params.with_crease_angle(0.0).unwrap(),
     )
     .unwrap();
     assert_eq!(flat.smoothing, Smoothing::default());
     // 4 segments make an octahedron: 70.5° between neighbouring facets, above 40°.
     let coarse =
-        Mesh::build(&scene_of(Shape::Mesh(radiosity_core::uv_sphere_mesh(DVec3::ZERO, 1.0, 4))), &params)
+        Mesh::build(&scene_of(Shape::Mesh(radiosity_scenes::uv_sphere_mesh(DVec3::ZERO, 1.0, 4))), &params)
             .unwrap();
     assert_eq!(coarse.smoothing, Smoothing::default());
     assert!(params.with_crease_angle(180.0).is_err() && params.with_crease_angle(f64::NAN).is_err());
@@ -377,7 +377,7 @@ fn elements_under_a_board_are_quartered_down_to_the_distance() {
 
 #[test]
 fn graded_cornell_surfaces_stay_conforming() {
-    let scene = radiosity_core::cornell_box();
+    let scene = radiosity_scenes::cornell_box();
     let params = scene.mesh_params();
     // Graded corners and one level near other geometry (the blocks near the walls).
     let graded = Mesh::build(&scene, &params.with_proximity_refinement(1).unwrap()).unwrap();
@@ -397,7 +397,7 @@ fn graded_cornell_surfaces_stay_conforming() {
 /// stays a disc without T-vertices. A second level quarters the first level's elements.
 #[test]
 fn a_refinement_quarters_the_elements_it_names() {
-    let scene = radiosity_core::cornell_box();
+    let scene = radiosity_scenes::cornell_box();
     let params = scene.mesh_params();
     let mesh = Mesh::build(&scene, &params).unwrap();
     let floor = mesh.object_names.iter().position(|n| n == "floor").unwrap();
@@ -442,7 +442,7 @@ fn a_refinement_quarters_the_elements_it_names() {
 /// area is the floor's), and nothing else is cut. Without contacts the floor is whole.
 #[test]
 fn the_cornell_floor_is_cut_around_the_blocks() {
-    let scene = radiosity_core::cornell_box();
+    let scene = radiosity_scenes::cornell_box();
     let params = scene.mesh_params();
     let floor_of = |mesh: &Mesh| {
         let o = mesh.object_names.iter().position(|n| n == "floor").unwrap();

@@ -13,7 +13,7 @@
 //! many give identical numbers.
 //!
 //! ```
-//! use radiosity_core::furnace_box;
+//! use radiosity_scenes::furnace_box;
 //! use radiosity_reference::{EstimateParams, PathBudget, Reference};
 //!
 //! // The furnace: B = E / (1 − ρ) = 2 everywhere.

@@ -3,11 +3,10 @@
 //! 0.3 % event per check at worst — and with fixed seeds it either always passes or always
 //! fails.
 
+use radiosity_core::Camera;
 use radiosity_core::glam::DVec3;
-use radiosity_core::{
-    Camera, furnace_box, furnace_sphere, two_plates, two_sided_plate, unit_cube_floor_light,
-};
 use radiosity_reference::{Estimate, EstimateParams, PathBudget, PictureParams, Reference, Region};
+use radiosity_scenes::{furnace_box, furnace_sphere, two_plates, two_sided_plate, unit_cube_floor_light};
 
 /// Howell C-11, unit squares one apart.
 const F_C11: f64 = 0.199825;

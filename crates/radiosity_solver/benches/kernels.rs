@@ -10,7 +10,8 @@ use std::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{DVec3, Vec3};
 use radiosity_accel::{Bvh, CandidateTriangles, RayQuery, Segments4};
-use radiosity_core::{MeshParams, furnace_box};
+use radiosity_core::MeshParams;
+use radiosity_scenes::furnace_box;
 use radiosity_solver::form_factor::{
     Rule, for_each_point, point_to_polygon, point_to_polygon_in_front, point_to_polygon_in_front_x4,
     points_to_polygon_in_front_x4,

@@ -1,6 +1,7 @@
 //! Times a fine furnace box solve: `cargo run --release -p radiosity_solver --example furnace_speed -- 0.02`.
 
-use radiosity_core::{MeshParams, furnace_box};
+use radiosity_core::MeshParams;
+use radiosity_scenes::furnace_box;
 use radiosity_solver::{Problem, SolverParams};
 
 fn main() {

@@ -4,7 +4,7 @@
 //! loop:
 //!
 //! ```
-//! use radiosity_core::furnace_box;
+//! use radiosity_scenes::furnace_box;
 //! use radiosity_solver::{Problem, SolverParams, StepBudget};
 //!
 //! let scene = furnace_box(0.5, 1.0);

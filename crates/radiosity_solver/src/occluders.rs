@@ -92,7 +92,7 @@ impl OccluderBoxes {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use radiosity_core::{furnace_box, furnace_sphere, two_plates};
+    use radiosity_scenes::{furnace_box, furnace_sphere, two_plates};
 
     #[test]
     fn enclosures_and_open_plates_have_no_blockers() {

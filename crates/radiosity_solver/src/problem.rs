@@ -104,7 +104,7 @@ fn steep_elements(mesh: &Mesh, radiosity: &[Rgb], min_area: f64) -> Vec<(usize, 
 /// params, a restart) without meshing again.
 ///
 /// ```
-/// use radiosity_core::furnace_box;
+/// use radiosity_scenes::furnace_box;
 /// use radiosity_solver::{Problem, SolverParams};
 ///
 /// let scene = furnace_box(0.5, 1.0);
@@ -259,7 +259,7 @@ impl std::fmt::Debug for Problem {
 mod tests {
     use super::*;
     use crate::Ambient;
-    use radiosity_core::furnace_box;
+    use radiosity_scenes::furnace_box;
 
     /// The problem's solver gives what the hand-built mesh and BVH give, bit for bit: the
     /// same mesh and the same BVH build.
@@ -282,7 +282,7 @@ mod tests {
     /// included, and mid-solve (unshot power left for the ambient term to stand for).
     #[test]
     fn object_means_without_a_snapshot_are_the_snapshots() {
-        let scene = radiosity_core::cornell_box();
+        let scene = radiosity_scenes::cornell_box();
         for ambient in [Ambient::Off, Ambient::On] {
             let params = SolverParams { max_shots: Some(30), ambient, ..SolverParams::preview() };
             let problem = Problem::new(&scene, &scene.mesh_params()).unwrap();

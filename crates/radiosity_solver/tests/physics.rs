@@ -2,11 +2,9 @@
 
 use std::sync::Arc;
 
-use radiosity_core::{
-    MeshParams, Rgb, Scene, Sides, furnace_box, furnace_sphere, two_plates, two_sided_plate,
-    unit_cube_floor_light,
-};
+use radiosity_core::{MeshParams, Rgb, Scene, Sides};
 use radiosity_mesh::Mesh;
+use radiosity_scenes::{furnace_box, furnace_sphere, two_plates, two_sided_plate, unit_cube_floor_light};
 use radiosity_solver::{Overshoot, Problem, SolverParams, StepBudget, StopReason, occluder_triangles};
 
 mod common;
@@ -386,7 +384,7 @@ fn a_mesh_with_patches_out_of_order_is_refused() {
 #[test]
 fn a_closed_cornell_box_keeps_its_light() {
     use radiosity_core::{Object, Polygon, Shape};
-    let mut scene = radiosity_core::cornell_box();
+    let mut scene = radiosity_scenes::cornell_box();
     let front = Polygon::try_new(
         [[0.0, 0.0, 0.0], [552.8, 0.0, 0.0], [556.0, 548.8, 0.0], [0.0, 548.8, 0.0]]
             .iter()

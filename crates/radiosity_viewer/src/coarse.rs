@@ -257,7 +257,7 @@ mod tests {
     /// cells lost along the face edges.
     #[test]
     fn a_fine_box_shrinks_to_the_budget_and_keeps_its_area() {
-        let scene = radiosity_core::furnace_box(0.5, 0.5);
+        let scene = radiosity_scenes::furnace_box(0.5, 0.5);
         let mesh = mesh_of(&scene, 0.25, 0.02);
         let triangles = oriented_triangles(&mesh);
         assert!(triangles.len() > 20_000, "{} triangles", triangles.len());
@@ -302,7 +302,7 @@ mod tests {
     /// vertices and the bottom's from the bottom's, though both sides share the cells.
     #[test]
     fn each_side_of_a_thin_slab_keeps_its_own_colours() {
-        let mut scene = radiosity_core::furnace_box(0.5, 0.5);
+        let mut scene = radiosity_scenes::furnace_box(0.5, 0.5);
         let slab =
             box_faces(DVec3::new(0.1, 0.5, 0.1), DVec3::new(0.9, 0.502, 0.9), Facing::Outward, 0.0).unwrap();
         scene.objects.push(Object::new("slab", 0, Shape::Polygons(slab)));
@@ -329,7 +329,7 @@ mod tests {
     /// A mesh already within the budget comes back whole.
     #[test]
     fn a_small_mesh_keeps_every_triangle() {
-        let scene = radiosity_core::furnace_box(0.5, 0.5);
+        let scene = radiosity_scenes::furnace_box(0.5, 0.5);
         let mesh = mesh_of(&scene, 0.5, 0.25);
         let triangles = oriented_triangles(&mesh);
         let coarse = coarse_mesh(&mesh, &triangles, triangles.len()).unwrap();

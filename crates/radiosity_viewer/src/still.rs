@@ -101,8 +101,9 @@ pub(crate) fn still_size(view: [u32; 2]) -> [u32; 2] {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use radiosity_core::MeshParams;
     use radiosity_core::glam::DVec3;
-    use radiosity_core::{MeshParams, furnace_box};
+    use radiosity_scenes::furnace_box;
     use radiosity_solver::{Problem, SolverParams, StepBudget};
 
     #[test]

@@ -557,7 +557,7 @@ fn build_problem(job: &SolveJob) -> Result<Problem, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use radiosity_core::furnace_box;
+    use radiosity_scenes::furnace_box;
 
     const LONG: Duration = Duration::from_secs(60);
 

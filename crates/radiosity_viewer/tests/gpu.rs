@@ -5,8 +5,9 @@
 use std::path::PathBuf;
 
 use eframe::wgpu;
-use radiosity_core::{MeshParams, Rgb, cornell_box, srgb_encode};
+use radiosity_core::{MeshParams, Rgb, srgb_encode};
 use radiosity_image::{ToneOperator, ToneParams, tone_map};
+use radiosity_scenes::cornell_box;
 use radiosity_solver::{Problem, Solution, SolverParams, StepBudget};
 use radiosity_viewer::render::{false_colour, shader_operator};
 use radiosity_viewer::{

@@ -24,7 +24,7 @@ use radiosity_core::{Facing, Material, MeshParams, Object, Polygon, Scene, Shape
 /// record's irradiance.
 #[test]
 fn a_sample_that_gathers_alone_covers_the_whole_hemisphere() {
-    let scene = radiosity_core::cornell_box();
+    let scene = radiosity_scenes::cornell_box();
     let problem = radiosity_solver::Problem::new(&scene, &scene.mesh_params()).unwrap();
     let mut solver = problem.solver(radiosity_solver::SolverParams::preview()).unwrap();
     solver.solve();

@@ -6,8 +6,9 @@ use crate::common;
 use std::f64::consts::PI;
 
 use radiosity_core::glam::DVec3;
-use radiosity_core::{Camera, Material, Object, Polygon, Rgb, Scene, Shape, Sides, furnace_box};
+use radiosity_core::{Camera, Material, Object, Polygon, Rgb, Scene, Shape, Sides};
 use radiosity_image::{Gather, RenderError, RenderParams, Renderer, object_mean_radiance};
+use radiosity_scenes::furnace_box;
 use radiosity_solver::{Solution, SolverParams};
 
 /// Inside the furnace (every face emits E and reflects ρ) B = E/(1 − ρ) everywhere, so a
@@ -61,7 +62,7 @@ fn direct_gather_needs_the_direct_part() {
 /// cache: +0.04 to +0.42 %).
 #[test]
 fn gathered_cornell_box_agrees_with_the_mesh_per_object() {
-    let scene = radiosity_core::cornell_box();
+    let scene = radiosity_scenes::cornell_box();
     let (mesh, solution) = common::solve(&scene, SolverParams::default());
     let camera = radiosity_image::camera_or_framing(&scene);
     let renderer = Renderer::new(mesh.clone());
@@ -134,7 +135,7 @@ fn gathered_texels_give_the_furnace_radiosity() {
 /// of penumbra points, the lit floor has little to begin with).
 #[test]
 fn penumbra_points_take_more_shadow_rays_without_bias() {
-    let scene = radiosity_core::cornell_box();
+    let scene = radiosity_scenes::cornell_box();
     let (mesh, solution) = common::solve(&scene, SolverParams::default());
     let floor = mesh.object_names.iter().position(|n| n == "floor").unwrap();
     let points: Vec<(usize, DVec3)> = (0..mesh.elements.len())
@@ -179,7 +180,7 @@ fn penumbra_points_take_more_shadow_rays_without_bias() {
 /// `direct` within 5 % on average (measured 0.99; with the record on the edge, 0.66).
 #[test]
 fn a_record_on_a_corner_edge_is_not_dark() {
-    let scene = radiosity_core::cornell_box();
+    let scene = radiosity_scenes::cornell_box();
     let (mesh, solution) = common::solve(&scene, SolverParams::default());
     let renderer = Renderer::new(mesh);
     let eye = radiosity_image::camera_or_framing(&scene).position;

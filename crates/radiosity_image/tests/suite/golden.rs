@@ -69,7 +69,7 @@ fn out_dir() -> PathBuf {
 
 /// The small Cornell render: default solver settings (seed 0), the scene's own mesh and camera.
 fn render_small_cornell(solver_seed: u64) -> (Vec<String>, Rendering) {
-    let scene = radiosity_core::cornell_box();
+    let scene = radiosity_scenes::cornell_box();
     let (mesh, solution) =
         common::solve(&scene, SolverParams { seed: solver_seed, ..SolverParams::default() });
     let params =

@@ -7,10 +7,9 @@ use std::f64::consts::PI;
 use std::sync::Arc;
 
 use radiosity_core::glam::DVec3;
-use radiosity_core::{
-    Camera, Facing, Material, MeshParams, Object, Polygon, Rgb, Scene, Shape, Sphere, furnace_box,
-};
+use radiosity_core::{Camera, Facing, Material, MeshParams, Object, Polygon, Rgb, Scene, Shape, Sphere};
 use radiosity_image::{Gather, RenderParams, Renderer, Shading};
+use radiosity_scenes::furnace_box;
 use radiosity_solver::SolverParams;
 
 /// Inside a closed box where every face emits E and reflects ρ, radiosity is B = E / (1 − ρ)
@@ -228,7 +227,7 @@ fn a_solution_for_another_mesh_is_an_error() {
 /// ray query meets first must not matter), and the faces differ by their lamps' ratio, 2.
 #[test]
 fn each_face_of_a_two_sided_plate_shows_its_own_radiosity() {
-    let scene = radiosity_core::two_sided_plate(0.5, 1.0, 2.0);
+    let scene = radiosity_scenes::two_sided_plate(0.5, 1.0, 2.0);
     let (mesh, solution) = common::solve(&scene, SolverParams::default());
     let objects = solution.object_radiosity(&mesh);
     let (front, back) = (objects[1].radiosity.r, objects[1].radiosity_back.unwrap().r);
@@ -278,7 +277,7 @@ fn a_tessellated_sphere_shades_without_facets() {
         let ball = if exact {
             Shape::Sphere(Sphere::try_new(DVec3::ZERO, 1.0, Facing::Outward).unwrap())
         } else {
-            Shape::Mesh(radiosity_core::uv_sphere_mesh(DVec3::ZERO, 1.0, 24))
+            Shape::Mesh(radiosity_scenes::uv_sphere_mesh(DVec3::ZERO, 1.0, 24))
         };
         let objects =
             vec![Object::new("lamp", 0, Shape::Polygons(vec![lamp(half)])), Object::new("ball", 1, ball)];
@@ -332,7 +331,7 @@ fn a_tessellated_sphere_shades_without_facets() {
 
 /// The Cornell box solved, its renderer, its camera and the lamp's object index.
 fn solved_cornell() -> (Renderer, radiosity_solver::Solution, radiosity_core::Camera, u32) {
-    let scene = radiosity_core::cornell_box();
+    let scene = radiosity_scenes::cornell_box();
     let (mesh, solution) = crate::common::solve(&scene, radiosity_solver::SolverParams::default());
     let lamp = mesh.object_names.iter().position(|n| n == "light").expect("the lamp") as u32;
     (Renderer::new(mesh), solution, radiosity_image::camera_or_framing(&scene), lamp)

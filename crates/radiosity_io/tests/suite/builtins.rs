@@ -32,12 +32,12 @@ fn builtins_equal_their_files_on_disk() {
 
 #[test]
 fn furnace_equals_the_canonical_scene() {
-    assert_eq!(builtin_scene("furnace").unwrap(), radiosity_core::furnace_box(0.5, 1.0));
+    assert_eq!(builtin_scene("furnace").unwrap(), radiosity_scenes::furnace_box(0.5, 1.0));
 }
 
 #[test]
 fn two_plates_equals_the_canonical_scene() {
-    assert_eq!(builtin_scene("two-plates").unwrap(), radiosity_core::two_plates(1.0, 1.0, 0.5, 1.0));
+    assert_eq!(builtin_scene("two-plates").unwrap(), radiosity_scenes::two_plates(1.0, 1.0, 0.5, 1.0));
 }
 
 /// `scenes/cornell.toml` and the library's Cornell box are one scene: tests and benches that
@@ -45,8 +45,8 @@ fn two_plates_equals_the_canonical_scene() {
 #[test]
 fn cornell_equals_the_canonical_scene() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
-    assert_eq!(load_scene(&dir.join("cornell.toml")).unwrap().scene, radiosity_core::cornell_box());
-    assert_eq!(builtin_scene("cornell").unwrap(), radiosity_core::cornell_box());
+    assert_eq!(load_scene(&dir.join("cornell.toml")).unwrap().scene, radiosity_scenes::cornell_box());
+    assert_eq!(builtin_scene("cornell").unwrap(), radiosity_scenes::cornell_box());
 }
 
 #[test]

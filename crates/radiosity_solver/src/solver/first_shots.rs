@@ -203,8 +203,9 @@ fn near_square(n: u32) -> u32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use radiosity_core::{Rgb, two_plates};
+    use radiosity_core::Rgb;
     use radiosity_mesh::Mesh;
+    use radiosity_scenes::two_plates;
 
     /// Penumbra rays follow the shooter's share of the emitted power: all of them from half
     /// of it up, a part in proportion below, never under the least (nor over the most), and

@@ -228,7 +228,7 @@ pub(super) fn patch_radius(patch: &Patch) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use radiosity_core::furnace_box;
+    use radiosity_scenes::furnace_box;
 
     /// In a box meshed into quads, an element inside a face has four edge neighbours, one at
     /// a face's corner two (vertices are not shared across surfaces), and the relation is

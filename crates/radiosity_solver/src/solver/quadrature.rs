@@ -55,8 +55,8 @@ pub(super) fn element_quadrature(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use radiosity_core::furnace_box;
     use radiosity_mesh::Mesh;
+    use radiosity_scenes::furnace_box;
 
     /// Far: one midpoint; near: Gauss cells of radius below a quarter of the gap, capped at
     /// `max`; the count never falls as the gap shrinks.

@@ -1,7 +1,8 @@
 //! Tests of the view renderer: offscreen frames, colours, detail levels.
 
 use super::*;
-use radiosity_core::{MeshParams, furnace_box};
+use radiosity_core::MeshParams;
+use radiosity_scenes::furnace_box;
 
 /// The furnace in plain 2 × 2-element patches (ungraded), whose outlines the tests count.
 fn furnace_mesh() -> Mesh {
@@ -68,7 +69,7 @@ fn auto_exposure_of_a_uniform_scene_maps_its_radiance_to_middle_grey() {
 #[test]
 fn auto_exposure_agrees_with_the_cpu_renderer() {
     use radiosity_solver::{Problem, SolverParams, StepBudget};
-    let scene = radiosity_core::cornell_box();
+    let scene = radiosity_scenes::cornell_box();
     let problem = Problem::new(&scene, &scene.mesh_params()).unwrap();
     let mesh = problem.mesh();
     let mut solver = problem.solver(SolverParams::preview()).unwrap();

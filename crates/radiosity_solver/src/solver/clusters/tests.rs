@@ -4,7 +4,8 @@ use super::row::unoccluded;
 use super::*;
 use crate::solver::SolverParams;
 use crate::solver::mesh_tables::MeshTables;
-use radiosity_core::{Material, MeshParams, Object, PolygonMesh, Scene, Shape, Sides, cornell_box};
+use radiosity_core::{Material, MeshParams, Object, PolygonMesh, Scene, Shape, Sides};
+use radiosity_scenes::cornell_box;
 
 /// A latitude–longitude sphere of `rings × segments` planar quads (triangles at the
 /// poles), facing outwards: every facet its own surface.

@@ -1,10 +1,18 @@
-//! Canonical test scenes with closed-form answers, shared by tests, benches and the built-in
-//! scene names (see `shared/references/closed_forms.md`).
+//! Canonical test scenes with closed-form answers, shared by tests, benches and examples; the
+//! built-in scene names load the same scenes from `scenes/` (a test checks that they agree).
+//! See `shared/references/closed_forms.md` for the closed forms.
+//!
+//! Kept apart from the scene vocabulary (`radiosity_core`), which every crate builds on, so
+//! that a change to a test scene rebuilds only what uses it.
+#![warn(missing_docs)]
+#![forbid(unsafe_code)]
 
 use glam::DVec3;
 
-use crate::scene::{Facing, Object, Polygon, PolygonMesh, Scene, Shape, SolverSettings, Sphere, box_faces};
-use crate::{Camera, Material, MeshParams, Rgb};
+use radiosity_core::{
+    Camera, Facing, Material, MeshParams, Object, Polygon, PolygonMesh, Rgb, Scene, Shape, Sides,
+    SolverSettings, Sphere, box_faces,
+};
 
 fn material(name: &str, rho: f64, emission: f64) -> Material {
     Material::try_new(name, Rgb::splat(rho), Rgb::splat(emission)).expect("canonical material in range")
@@ -21,12 +29,7 @@ pub fn furnace_box(rho: f64, emission: f64) -> Scene {
         "Furnace box",
         None,
         vec![material("furnace", rho, emission)],
-        vec![Object {
-            name: "box".into(),
-            material: 0,
-            shape: Shape::Polygons(faces),
-            sides: crate::Sides::One,
-        }],
+        vec![Object { name: "box".into(), material: 0, shape: Shape::Polygons(faces), sides: Sides::One }],
     )
     .expect("furnace scene is valid");
     s.mesh = Some(MeshParams::try_new(0.5, 0.125).expect("sizes > 0"));
@@ -44,12 +47,7 @@ pub fn furnace_sphere(rho: f64, emission: f64) -> Scene {
         "Furnace sphere",
         None,
         vec![material("furnace", rho, emission)],
-        vec![Object {
-            name: "dome".into(),
-            material: 0,
-            shape: Shape::Sphere(sphere),
-            sides: crate::Sides::One,
-        }],
+        vec![Object { name: "dome".into(), material: 0, shape: Shape::Sphere(sphere), sides: Sides::One }],
     )
     .expect("furnace scene is valid");
     s.mesh = Some(MeshParams::try_new(0.4, 0.4).expect("sizes > 0"));
@@ -73,7 +71,7 @@ pub fn unit_cube_floor_light(rho: f64) -> Scene {
             name: n.into(),
             material: usize::from(i != 0),
             shape: Shape::Polygons(vec![f]),
-            sides: crate::Sides::One,
+            sides: Sides::One,
         })
         .collect();
     let mut s = Scene::try_new(
@@ -116,13 +114,13 @@ pub fn two_plates(size: f64, distance: f64, rho: f64, emission: f64) -> Scene {
                 name: "emitter".into(),
                 material: 0,
                 shape: Shape::Polygons(vec![lower]),
-                sides: crate::Sides::One,
+                sides: Sides::One,
             },
             Object {
                 name: "receiver".into(),
                 material: 1,
                 shape: Shape::Polygons(vec![upper]),
-                sides: crate::Sides::One,
+                sides: Sides::One,
             },
         ],
     )
@@ -158,10 +156,7 @@ pub fn two_sided_plate(rho: f64, e_below: f64, e_above: f64) -> Scene {
         vec![material("below", 0.0, e_below), material("above", 0.0, e_above), material("grey", rho, 0.0)],
         vec![
             Object::new("below", 0, square(0.0, true)),
-            Object {
-                sides: crate::Sides::Two { emits_back: false },
-                ..Object::new("plate", 2, square(1.0, false))
-            },
+            Object { sides: Sides::Two { emits_back: false }, ..Object::new("plate", 2, square(1.0, false)) },
             Object::new("above", 1, square(2.0, false)),
         ],
     )
@@ -230,7 +225,7 @@ pub fn cornell_box() -> Scene {
         name: name.into(),
         material,
         shape: Shape::Polygons(faces.iter().map(|f| polygon(f)).collect()),
-        sides: crate::Sides::One,
+        sides: Sides::One,
     };
     let objects = vec![
         o("floor", white, &[&[[552.8, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 559.2], [549.6, 0.0, 559.2]]]),
