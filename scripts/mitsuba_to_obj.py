@@ -12,10 +12,13 @@ program reads OBJ/MTL and glTF, so such a room is merged first:
 What is read:
 
 * Shapes: `<shape type="ply">`, `<shape type="obj">` (Mitsuba 0.6 / 3) and `<mesh type="ply">`
-  (the minpt dialect), each with `<string name="filename">` relative to the XML's folder.
+  (the minpt dialect), each with `<string name="filename">` relative to the XML's folder; and
+  Mitsuba's built-in `rectangle` ([-1, 1]² at z = 0, facing +z), `disk` (the unit disk at
+  z = 0, facing +z, as a 32-sided polygon) and `cube` ([-1, 1]³, facing out), through their
+  transform. A rectangle is how most of these scenes write their area lights (and some walls).
 * Transforms: `<transform name="toWorld">` or `name="to_world"` holding `<matrix value="16
-  numbers, row major">`, `<translate x y z>`, `<scale value | x y z>`; other steps
-  (rotate, lookat) are refused by name, so a wrong placement cannot pass unnoticed.
+  numbers, row major">`, `<translate x y z>`, `<scale value | x y z>`, `<rotate x y z
+  angle>` (degrees); other steps (lookat) are refused by name, so a wrong placement cannot pass unnoticed.
 * PLY: ascii and binary (little or big endian), any scalar vertex property types (only x, y,
   z are kept), faces as a list property named vertex_indices or vertex_index.
 * Materials: a diffuse BSDF's `reflectance` / `albedo` as `<rgb value>` becomes that Kd; a
@@ -80,6 +83,20 @@ def read_transform(elem, where):
                     v = [float(step.get(k, 1)) for k in "xyz"]
                 for i in range(3):
                     s[i][i] = v[i]
+            elif step.tag == "rotate":
+                # Rodrigues' rotation about the unit axis (x, y, z) by `angle` degrees.
+                import math
+                ax = [float(step.get(k, 0)) for k in "xyz"]
+                norm = math.sqrt(sum(a * a for a in ax))
+                if norm == 0:
+                    raise SceneError(f"{where}: <rotate> needs a non-zero axis")
+                x, y, z = (a / norm for a in ax)
+                t = math.radians(float(step.get("angle", 0)))
+                c, sn, k = math.cos(t), math.sin(t), 1 - math.cos(t)
+                s = identity()
+                s[0][:3] = [c + x * x * k, x * y * k - z * sn, x * z * k + y * sn]
+                s[1][:3] = [y * x * k + z * sn, c + y * y * k, y * z * k - x * sn]
+                s[2][:3] = [z * x * k - y * sn, z * y * k + x * sn, c + z * z * k]
             else:
                 raise SceneError(f"{where}: transform step <{step.tag}> is not supported")
             # Mitsuba applies the steps in the order written: later ones act on the result.
@@ -181,6 +198,28 @@ def read_obj(path):
     return verts, faces
 
 
+def builtin_shape(kind, m):
+    """Corners and faces of Mitsuba's built-in `rectangle`, `disk` and `cube` in local
+    coordinates, wound so that the cross product of the *transformed* corners faces the way
+    Mitsuba's transformed normal does (a transform that mirrors turns the winding over)."""
+    if kind == "rectangle":
+        verts = [(-1.0, -1.0, 0.0), (1.0, -1.0, 0.0), (1.0, 1.0, 0.0), (-1.0, 1.0, 0.0)]
+        faces = [[0, 1, 2, 3]]
+    elif kind == "disk":
+        import math
+        verts = [(math.cos(2 * math.pi * k / 32), math.sin(2 * math.pi * k / 32), 0.0) for k in range(32)]
+        faces = [list(range(32))]
+    else:  # cube: one quad per side, counter-clockwise seen from outside
+        verts = [(x, y, z) for z in (-1.0, 1.0) for y in (-1.0, 1.0) for x in (-1.0, 1.0)]
+        faces = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]]
+    det = (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+           - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+           + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]))
+    if det < 0:
+        faces = [f[::-1] for f in faces]
+    return verts, faces
+
+
 def bsdf_colour(bsdf, grey):
     """Kd for a BSDF element: its diffuse reflectance when it is a plain colour, else grey."""
     if bsdf is None:
@@ -212,6 +251,8 @@ def main():
     ap.add_argument("--grey", type=float, default=0.5,
                     help="Kd for textured, non-diffuse or unspecified materials (default 0.5)")
     ap.add_argument("--force", action="store_true", help="overwrite existing output files")
+    ap.add_argument("--skip-missing", action="store_true",
+                    help="leave out shapes whose mesh file is missing (noted), instead of stopping")
     args = ap.parse_args()
     if not 0.0 <= args.grey < 1.0:
         sys.exit(f"--grey {args.grey}: a reflectance must be in [0, 1)")
@@ -241,15 +282,23 @@ def main():
                 continue
             kind = shape.get("type")
             fn_elem = shape.find("string[@name='filename']")
-            if kind not in ("ply", "obj") or fn_elem is None:
+            if kind in ("rectangle", "disk", "cube"):
+                fn = f"{shape.get('id') or kind}.{kind}"
+                path = f"{args.scene}: {kind}"
+                m = read_transform(shape, f"{args.scene}: shape {kind}")
+                verts, faces = builtin_shape(kind, m)
+            elif kind not in ("ply", "obj") or fn_elem is None:
                 notes.setdefault(f"a {kind} shape skipped", 0)
                 notes[f"a {kind} shape skipped"] += 1
                 continue
-            fn = fn_elem.get("value")
-            where = f"{args.scene}: shape {fn}"
-            path = os.path.join(base, fn)
-            verts, faces = (read_ply if kind == "ply" else read_obj)(path)
-            m = read_transform(shape, where)
+            else:
+                fn = fn_elem.get("value")
+                path = os.path.join(base, fn)
+                if args.skip_missing and not os.path.exists(path):
+                    notes[f"shape left out, its file is missing: {fn}"] = 1
+                    continue
+                verts, faces = (read_ply if kind == "ply" else read_obj)(path)
+                m = read_transform(shape, f"{args.scene}: shape {fn}")
             bsdf = shape.find("bsdf")
             ref = shape.find("ref")
             if bsdf is None and ref is not None:
