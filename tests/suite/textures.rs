@@ -18,7 +18,7 @@ const PIXELS_PER_SQUARE: u32 = 16;
 /// down 1.5 above its centre, with the floor's material `floor_mtl`.
 fn write_scene(dir: &Path, floor_mtl: &str) -> std::path::PathBuf {
     let texels = (0..SQUARES * SQUARES)
-        .map(|i| if (i % SQUARES + i / SQUARES) % 2 == 0 { [255; 3] } else { [0; 3] })
+        .map(|i| if (i % SQUARES + i / SQUARES).is_multiple_of(2) { [255; 3] } else { [0; 3] })
         .collect();
     write_png(&dir.join("checker.png"), &SrgbImage { width: SQUARES, height: SQUARES, pixels: texels })
         .unwrap();

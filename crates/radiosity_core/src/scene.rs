@@ -231,16 +231,16 @@ impl PolygonMesh {
 
     /// The same mesh with every face lit from its other side ([`Polygon::flipped`]).
     pub fn flipped(&self) -> Self {
-        fn reversed<T: Clone>(f: &Vec<T>) -> Vec<T> {
-            let mut f = f.clone();
+        fn reversed<T: Clone>(f: &[T]) -> Vec<T> {
+            let mut f = f.to_vec();
             f[1..].reverse();
             f
         }
         Self {
             positions: self.positions.clone(),
-            faces: self.faces.iter().map(reversed).collect(),
+            faces: self.faces.iter().map(|f| reversed(f)).collect(),
             polygons: self.polygons.iter().map(Polygon::flipped).collect(),
-            uvs: self.uvs.iter().map(reversed).collect(),
+            uvs: self.uvs.iter().map(|f| reversed(f)).collect(),
         }
     }
 

@@ -302,9 +302,7 @@ pub(crate) fn parse_gltf(
                             let sampler = tex.texture().sampler();
                             kept = Some(image.texture(reflectance, [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())]));
                             placed = Some(placement(&tex));
-                            for c in 0..3 {
-                                reflectance[c] *= image.mean[c];
-                            }
+                            reflectance = [0, 1, 2].map(|c| reflectance[c] * image.mean[c]);
                         }
                         None if !images.is_empty() => warnings.push(format!(
                             "{origin}: material '{name}': base colour texture format not averaged; factor used alone"
