@@ -5,9 +5,12 @@
 //! * OBJ/MTL: `Kd` (× the mean of the `map_Kd` texture, decoded from sRGB) → reflectance,
 //!   `Ke` → emission (emitted radiosity, W per unit², the same quantity as `emission` in a
 //!   scene file). A missing MTL file, an unknown `usemtl` or an unreadable texture gives the
-//!   default grey (ρ = 0.5) or `Kd` alone, and a warning. Vertex normals and texture
-//!   coordinates are ignored: facets are flat for the solve. Every part is two-sided
-//!   ([`ModelPart::sides`]).
+//!   default grey (ρ = 0.5) or `Kd` alone, and a warning. Vertex normals are ignored:
+//!   facets are flat for the solve. Every part is two-sided ([`ModelPart::sides`]).
+//! * Textures: the decoded image is kept on the material (`Material::texture`, for pictures)
+//!   and the texture coordinates per face corner on the mesh (`PolygonMesh::uvs`), mapped by
+//!   `map_Kd`'s options or `KHR_texture_transform` (`texture_map.rs`) and with v running
+//!   down the image.
 //! * glTF: `baseColorFactor` (times the mean of the base colour texture, decoded from sRGB,
 //!   when the texture's pixels can be read) → reflectance; `emissiveFactor` ×
 //!   `KHR_materials_emissive_strength` → emission; node transforms; the first perspective
