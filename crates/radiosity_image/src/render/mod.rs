@@ -121,7 +121,14 @@ impl Renderer {
         let Some(textures) = &self.textures else { return b };
         let material = self.mesh.element_material(e);
         let Some(image) = &material.texture else { return b };
-        let Some(uv) = textures.uv(object, ray.0, ray.1, distance) else { return b };
+        // A ray along an edge between two model faces may slip between them in the BVH's
+        // single precision: once more, a thousandth of the way towards the element's centre.
+        let uv = textures.uv(object, ray.0, ray.1, distance).or_else(|| {
+            let p = ray.0 + ray.1 * distance;
+            let q = p + (self.mesh.elements[e].centre - p) * 1e-3;
+            textures.uv(object, ray.0, (q - ray.0).normalize_or_zero(), (q - ray.0).length())
+        });
+        let Some(uv) = uv else { return b };
         let emitted = if per_sr { material.emission / std::f64::consts::PI } else { material.emission };
         texture::shown(b, emitted, texture::ratio(material, image, uv))
     }
