@@ -248,3 +248,30 @@ fn a_gltf_base_colour_texture_shows_through_its_transform_and_sampler() {
     let textured = picture(&Renderer::new(problem.mesh().clone()).with_textures(&scene), &solution);
     checkered(&textured, &flat, SQUARES / 2);
 }
+
+#[test]
+fn map_kd_options_place_the_texture_and_corners_keep_their_coordinates() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene =
+        load(&write_scene(dir.path(), "Kd 0.9 0.9 0.9\nmap_Kd -o 0.25 0 -s 2 2 -clamp on checker.png"));
+    let floor = scene.objects.iter().find(|o| o.name == "floor").unwrap();
+    let texture = scene.materials[floor.material].texture.clone().expect("the floor keeps its texture");
+    assert_eq!(texture.wrap, [radiosity_core::Wrap::ClampToEdge; 2]);
+    let radiosity_core::Shape::Mesh(mesh) = &floor.shape else { panic!("the floor is a mesh") };
+    // `vt 1 1` at (2, 0, 2): u′ = 1·2 + 0.25, v′ = 1·2 + 0, turned to run down: 1 − 2.
+    let corner_of = |mesh: &radiosity_core::PolygonMesh, p: DVec3| {
+        let (f, k) = (mesh.faces().iter().enumerate())
+            .find_map(|(f, face)| {
+                face.iter().position(|&i| mesh.positions()[i as usize] == p).map(|k| (f, k))
+            })
+            .unwrap();
+        mesh.uvs()[f][k]
+    };
+    let far = DVec3::new(2.0, 0.0, 2.0);
+    assert_eq!(corner_of(mesh, far), [2.25, -1.0]);
+    // Turned over (as closed models whose light is behind them are), each corner keeps its
+    // coordinates.
+    let flipped = mesh.flipped();
+    assert_eq!(corner_of(&flipped, far), [2.25, -1.0]);
+    assert_eq!(corner_of(&flipped, DVec3::ZERO), corner_of(mesh, DVec3::ZERO));
+}
