@@ -192,7 +192,10 @@ pub fn run(a: RenderArgs) -> Result<()> {
     // as large as the picture's inputs.
     drop(solver);
     let start = Instant::now();
-    let renderer = spinning("preparing the renderer", || Renderer::new(prepared.problem.mesh().clone()));
+    // The solve used each material's mean reflectance; the picture shows its texture.
+    let renderer = spinning("preparing the renderer", || {
+        Renderer::new(prepared.problem.mesh().clone()).with_textures(&prepared.scene)
+    });
     // The irradiance cache is gathered before the first row: say so, and keep the line
     // ticking meanwhile, so a long gather does not look like a hang.
     let what = if params.gather == Gather::Full { "rendering (irradiance cache first)" } else { "rendering" };

@@ -21,6 +21,7 @@ mod public_models;
 mod readme;
 mod rooms;
 mod surface_grids;
+mod textures;
 mod up_axis;
 mod verify;
 mod viewer;

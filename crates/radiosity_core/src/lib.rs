@@ -18,6 +18,7 @@ pub mod random;
 mod scene;
 mod scene_error;
 mod srgb;
+mod texture;
 mod up;
 
 pub use color::Rgb;
@@ -39,6 +40,7 @@ pub use scene::{
 };
 pub use scene_error::SceneError;
 pub use srgb::{encode_srgb, srgb_decode, srgb_encode};
+pub use texture::{Texture, Wrap};
 pub use up::UpAxis;
 
 /// Re-export of the vector maths used in the public API.

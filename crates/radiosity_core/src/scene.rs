@@ -17,6 +17,9 @@ pub struct Material {
     pub reflectance: Rgb,
     /// Emitted radiosity (exitance) E per channel, W/m² (scene units² for area), each ≥ 0.
     pub emission: Rgb,
+    /// Albedo per texel (a model's colour texture), for pictures only: `reflectance` is its
+    /// mean, which is what diffuse transfer needs.
+    pub texture: Option<std::sync::Arc<crate::Texture>>,
 }
 
 impl Material {
@@ -35,7 +38,7 @@ impl Material {
         if !e.iter().all(|&v| v.is_finite() && v >= 0.0) {
             return Err(SceneError::EmissionOutOfRange { material: name.to_owned(), value: e });
         }
-        Ok(Self { name: name.to_owned(), reflectance, emission })
+        Ok(Self { name: name.to_owned(), reflectance, emission, texture: None })
     }
 
     /// True when the material emits in some channel.
@@ -181,6 +184,8 @@ pub struct PolygonMesh {
     positions: Vec<DVec3>,
     faces: Vec<Vec<u32>>,
     polygons: Vec<Polygon>,
+    /// Texture coordinates per face corner, or empty.
+    uvs: Vec<Vec<[f64; 2]>>,
 }
 
 impl PolygonMesh {
@@ -211,22 +216,31 @@ impl PolygonMesh {
                 .map_err(|e| SceneError::BadMeshFace { face, source: Box::new(e) })?;
             polygons.push(polygon);
         }
-        Ok(Self { positions, faces, polygons })
+        Ok(Self { positions, faces, polygons, uvs: Vec::new() })
+    }
+
+    /// The mesh with texture coordinates `uvs` per face corner (as [`PolygonMesh::uvs`]);
+    /// left without them when `uvs` does not match the faces corner for corner.
+    pub fn with_uvs(mut self, uvs: Vec<Vec<[f64; 2]>>) -> Self {
+        let matches =
+            uvs.len() == self.faces.len() && uvs.iter().zip(&self.faces).all(|(u, f)| u.len() == f.len());
+        self.uvs =
+            if matches && uvs.iter().flatten().flatten().all(|v| v.is_finite()) { uvs } else { Vec::new() };
+        self
     }
 
     /// The same mesh with every face lit from its other side ([`Polygon::flipped`]).
     pub fn flipped(&self) -> Self {
-        let faces = (self.faces.iter())
-            .map(|f| {
-                let mut f = f.clone();
-                f[1..].reverse();
-                f
-            })
-            .collect();
+        fn reversed<T: Clone>(f: &[T]) -> Vec<T> {
+            let mut f = f.to_vec();
+            f[1..].reverse();
+            f
+        }
         Self {
             positions: self.positions.clone(),
-            faces,
+            faces: self.faces.iter().map(|f| reversed(f)).collect(),
             polygons: self.polygons.iter().map(Polygon::flipped).collect(),
+            uvs: self.uvs.iter().map(|f| reversed(f)).collect(),
         }
     }
 
@@ -236,6 +250,7 @@ impl PolygonMesh {
             positions: self.positions.iter().map(|&p| f(p)).collect(),
             faces: self.faces.clone(),
             polygons: self.polygons.iter().map(|p| p.mapped_exactly(f)).collect(),
+            uvs: self.uvs.clone(),
         }
     }
 
@@ -252,6 +267,13 @@ impl PolygonMesh {
     /// Faces as validated polygons (normal, area), in the order of [`PolygonMesh::faces`].
     pub fn polygons(&self) -> &[Polygon] {
         &self.polygons
+    }
+
+    /// Texture coordinates (u, v) per corner of each face, in the order of
+    /// [`PolygonMesh::faces`] (v down from the image's top, as [`crate::Texture`]); empty
+    /// when the model gives none.
+    pub fn uvs(&self) -> &[Vec<[f64; 2]>] {
+        &self.uvs
     }
 
     /// Total area, scene units².

@@ -11,13 +11,14 @@ use std::path::Path;
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 use radiosity_core::glam::{DMat4, DVec3};
-use radiosity_core::{Camera, Material, Rgb, Sides, unique_names};
+use radiosity_core::{Camera, Material, Rgb, Sides, Wrap, unique_names};
 
 use crate::LoadError;
 use crate::model::{
-    DEFAULT_GREY, Model, ModelPart, PartBuilder, Transform, clamp_reflectance, model_error, model_material,
-    specular_warning,
+    DEFAULT_GREY, DecodedImage, Model, ModelPart, PartBuilder, Transform, clamp_reflectance, model_error,
+    model_material, specular_warning,
 };
+use crate::texture_map::UvTransform;
 
 /// Checks that `accessor` can be read as `dims` of one of `types` without leaving its buffer.
 fn check_accessor(
@@ -75,15 +76,60 @@ fn check_accessor(
     Ok(())
 }
 
-/// Mean linear colour of an 8-bit sRGB image, or `None` for other pixel formats.
-fn mean_linear_colour(image: &gltf::image::Data) -> Option<[f64; 3]> {
+/// An 8-bit sRGB image decoded, or `None` for other pixel formats.
+fn decoded(image: &gltf::image::Data) -> Option<DecodedImage> {
     use gltf::image::Format;
     let channels = match image.format {
         Format::R8G8B8 => 3,
         Format::R8G8B8A8 => 4,
         _ => return None,
     };
-    crate::model::mean_linear_colour(&image.pixels, channels)
+    DecodedImage::from_srgb8(&image.pixels, channels, image.width, image.height)
+}
+
+/// A sampler's wrap mode as the renderer's.
+fn wrap(mode: gltf::texture::WrappingMode) -> Wrap {
+    use gltf::texture::WrappingMode;
+    match mode {
+        WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+        WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+        WrappingMode::Repeat => Wrap::Repeat,
+    }
+}
+
+/// Where a base colour texture lies: its texture coordinate set and the
+/// `KHR_texture_transform` that maps them.
+fn placement(info: &gltf::texture::Info) -> (u32, UvTransform) {
+    match info.texture_transform() {
+        Some(t) => {
+            let transform = UvTransform {
+                offset: t.offset().map(f64::from),
+                scale: t.scale().map(f64::from),
+                rotation: f64::from(t.rotation()),
+            };
+            (t.tex_coord().unwrap_or(info.tex_coord()), transform)
+        }
+        None => (info.tex_coord(), UvTransform::default()),
+    }
+}
+
+/// Texture coordinates of the welded triangle corners `triangles` (indices into the
+/// primitive's vertices) from set `set`, mapped by `transform`; `None` when the primitive has
+/// no such set or it cannot be read (the part then shows its mean colour).
+fn triangle_uvs(
+    prim: &gltf::Primitive,
+    buffers: &[gltf::buffer::Data],
+    set: u32,
+    transform: &UvTransform,
+    triangles: &[[u32; 3]],
+) -> Option<Vec<[[f64; 2]; 3]>> {
+    let accessor = prim.get(&gltf::Semantic::TexCoords(set))?;
+    check_accessor(&accessor, Dimensions::Vec2, &[DataType::F32, DataType::U8, DataType::U16], buffers)
+        .ok()?;
+    let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+    let uvs: Vec<[f32; 2]> = reader.read_tex_coords(set)?.into_f32().collect();
+    let uv = |i: u32| uvs.get(i as usize).map(|uv| transform.apply(uv.map(f64::from)));
+    triangles.iter().map(|t| Some([uv(t[0])?, uv(t[1])?, uv(t[2])?])).collect()
 }
 
 /// Splits a GLB container into its JSON chunk and optional BIN chunk. Done here rather than by
@@ -220,11 +266,15 @@ pub(crate) fn parse_gltf(
     };
 
     let mut materials: Vec<Material> = Vec::new();
-    let mut material_of: HashMap<Option<usize>, usize> = HashMap::new();
-    let mut material_index = |m: gltf::Material, warnings: &mut Vec<String>| -> Result<usize, LoadError> {
+    // Each material's index in `materials` and, when it keeps a texture, where it lies.
+    type Placed = (usize, Option<(u32, UvTransform)>);
+    let mut material_of: HashMap<Option<usize>, Placed> = HashMap::new();
+    let mut material_index = |m: gltf::Material, warnings: &mut Vec<String>| -> Result<Placed, LoadError> {
         if let Some(&i) = material_of.get(&m.index()) {
             return Ok(i);
         }
+        let mut kept = None;
+        let mut placed = None;
         let material = match m.index() {
             None => {
                 warnings.push(format!(
@@ -247,11 +297,12 @@ pub(crate) fn parse_gltf(
                 let f = pbr.base_color_factor();
                 let mut reflectance = [f[0] as f64, f[1] as f64, f[2] as f64];
                 if let Some(tex) = pbr.base_color_texture() {
-                    match images.get(tex.texture().source().index()).and_then(mean_linear_colour) {
-                        Some(mean) => {
-                            for c in 0..3 {
-                                reflectance[c] *= mean[c];
-                            }
+                    match images.get(tex.texture().source().index()).and_then(decoded) {
+                        Some(image) => {
+                            let sampler = tex.texture().sampler();
+                            kept = Some(image.texture(reflectance, [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())]));
+                            placed = Some(placement(&tex));
+                            reflectance = [0, 1, 2].map(|c| reflectance[c] * image.mean[c]);
                         }
                         None if !images.is_empty() => warnings.push(format!(
                             "{origin}: material '{name}': base colour texture format not averaged; factor used alone"
@@ -275,8 +326,11 @@ pub(crate) fn parse_gltf(
                 }
                 let strength = m.emissive_strength().unwrap_or(1.0) as f64;
                 let emission = m.emissive_factor().map(|v| v as f64 * strength);
-                Material::try_new(&name, Rgb::from_array(reflectance), Rgb::from_array(emission))
-                    .map_err(|e| err(format!("material {i}: {e}")))?
+                let mut material =
+                    Material::try_new(&name, Rgb::from_array(reflectance), Rgb::from_array(emission))
+                        .map_err(|e| err(format!("material {i}: {e}")))?;
+                material.texture = kept;
+                material
             }
         };
         let mut names: Vec<String> = materials.iter().map(|m| m.name.clone()).collect();
@@ -285,8 +339,8 @@ pub(crate) fn parse_gltf(
         let mut material = material;
         material.name = names.pop().unwrap_or_default();
         materials.push(material);
-        material_of.insert(m.index(), materials.len() - 1);
-        Ok(materials.len() - 1)
+        material_of.insert(m.index(), (materials.len() - 1, placed));
+        Ok((materials.len() - 1, placed))
     };
 
     let scene = document.default_scene().or_else(|| document.scenes().next());
@@ -409,6 +463,9 @@ pub(crate) fn parse_gltf(
                     indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect()
                 }
             };
+            let (material, placed) = material_index(prim.material(), &mut warnings)?;
+            let uvs =
+                placed.and_then(|(set, transform)| triangle_uvs(prim, &buffers, set, &transform, &triangles));
             for (t, tri) in triangles.iter().enumerate() {
                 let mut face = Vec::with_capacity(3);
                 for &i in tri {
@@ -420,10 +477,10 @@ pub(crate) fn parse_gltf(
                     };
                     face.push(v);
                 }
-                b.face(face).map_err(|m| err(format!("{what}: triangle {t}: {m}")))?;
+                let uv = uvs.as_ref().map(|uvs| uvs[t].to_vec());
+                b.face_with_uvs(face, uv).map_err(|m| err(format!("{what}: triangle {t}: {m}")))?;
             }
             dropped += b.dropped;
-            let material = material_index(prim.material(), &mut warnings)?;
             let sides =
                 if prim.material().double_sided() { Sides::Two { emits_back: true } } else { Sides::One };
             // Several primitives of one node are told apart by material (named below, once

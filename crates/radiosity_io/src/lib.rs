@@ -39,6 +39,7 @@ mod obj;
 mod photometric;
 mod scene_file;
 mod scene_settings;
+mod texture_map;
 mod up_guess;
 
 pub use builtin::{BUILTIN_SCENES, builtin_scene, resolve_scene, resolve_scene_with};

@@ -5,9 +5,12 @@
 //! * OBJ/MTL: `Kd` (× the mean of the `map_Kd` texture, decoded from sRGB) → reflectance,
 //!   `Ke` → emission (emitted radiosity, W per unit², the same quantity as `emission` in a
 //!   scene file). A missing MTL file, an unknown `usemtl` or an unreadable texture gives the
-//!   default grey (ρ = 0.5) or `Kd` alone, and a warning. Vertex normals and texture
-//!   coordinates are ignored: facets are flat for the solve. Every part is two-sided
-//!   ([`ModelPart::sides`]).
+//!   default grey (ρ = 0.5) or `Kd` alone, and a warning. Vertex normals are ignored:
+//!   facets are flat for the solve. Every part is two-sided ([`ModelPart::sides`]).
+//! * Textures: the decoded image is kept on the material (`Material::texture`, for pictures)
+//!   and the texture coordinates per face corner on the mesh (`PolygonMesh::uvs`), mapped by
+//!   `map_Kd`'s options or `KHR_texture_transform` (`texture_map.rs`) and with v running
+//!   down the image.
 //! * glTF: `baseColorFactor` (times the mean of the base colour texture, decoded from sRGB,
 //!   when the texture's pixels can be read) → reflectance; `emissiveFactor` ×
 //!   `KHR_materials_emissive_strength` → emission; node transforms; the first perspective
@@ -29,7 +32,10 @@ use rustc_hash::FxHashMap as HashMap;
 use std::path::Path;
 
 use radiosity_core::glam::{DMat4, DQuat, DVec3};
-use radiosity_core::{Camera, Material, Polygon, PolygonMesh, Rgb, SceneError, Sides, srgb_decode};
+use radiosity_core::{
+    Camera, Material, Polygon, PolygonMesh, Rgb, SceneError, Sides, Texture, Wrap, srgb_decode,
+};
+use std::sync::Arc;
 
 use crate::LoadError;
 use radiosity_core::escape_controls;
@@ -200,35 +206,65 @@ pub(crate) fn specular_warning(origin: &str, name: &str, why: &str) -> String {
     format!("material '{name}' ({origin}) is specular/transmissive ({why}); treated as diffuse")
 }
 
-/// Mean linear colour of 8-bit sRGB pixels of `channels` bytes each, red, green and blue
-/// first (RGB, RGBA), or `None` without a pixel or with fewer than three channels: what a
-/// texture contributes to a flat element's reflectance, as the mean of what it reflects.
-pub(crate) fn mean_linear_colour(pixels: &[u8], channels: usize) -> Option<[f64; 3]> {
-    if channels < 3 {
-        return None;
-    }
-    let lut: Vec<f64> = (0..256).map(|v| srgb_decode(v as f64 / 255.0)).collect();
-    let mut sum = [0.0; 3];
-    let mut n = 0usize;
-    for px in pixels.chunks_exact(channels) {
-        for c in 0..3 {
-            sum[c] += lut[px[c] as usize];
-        }
-        n += 1;
-    }
-    (n > 0).then(|| sum.map(|s| s / n as f64))
+/// A colour texture read from a file: its 8-bit sRGB texels and their mean linear colour.
+pub(crate) struct DecodedImage {
+    width: u32,
+    height: u32,
+    texels: Vec<[u8; 3]>,
+    /// Mean linear colour: what the texture contributes to a flat element's reflectance, as
+    /// the mean of what it reflects.
+    pub(crate) mean: [f64; 3],
 }
 
-/// Mean linear colour of the image file at `path` (PNG or JPEG, 8-bit sRGB after decoding).
+impl DecodedImage {
+    /// 8-bit sRGB pixels of `channels` bytes each, red, green and blue first (RGB, RGBA),
+    /// `width` per row, top row first; `None` without a pixel, with fewer than three
+    /// channels, or when the sizes disagree.
+    pub(crate) fn from_srgb8(pixels: &[u8], channels: usize, width: u32, height: u32) -> Option<Self> {
+        let count = width as usize * height as usize;
+        if channels < 3 || count == 0 || pixels.len() != count * channels {
+            return None;
+        }
+        let lut: Vec<f64> = (0..256).map(|v| srgb_decode(v as f64 / 255.0)).collect();
+        let mut sum = [0.0; 3];
+        let texels: Vec<[u8; 3]> = pixels
+            .chunks_exact(channels)
+            .map(|px| {
+                for c in 0..3 {
+                    sum[c] += lut[px[c] as usize];
+                }
+                [px[0], px[1], px[2]]
+            })
+            .collect();
+        Some(Self { width, height, texels, mean: sum.map(|s| s / count as f64) })
+    }
+
+    /// The texture the renderer samples: these texels times `factor`, wrapped by `wrap`.
+    pub(crate) fn texture(&self, factor: [f64; 3], wrap: [Wrap; 2]) -> Arc<Texture> {
+        Arc::new(Texture {
+            width: self.width,
+            height: self.height,
+            texels: self.texels.clone(),
+            factor,
+            wrap,
+        })
+    }
+}
+
+/// The image file at `path` (PNG or JPEG, 8-bit sRGB after decoding).
 ///
 /// # Errors
 /// Why it cannot be read or decoded, one line without the path.
-pub(crate) fn texture_mean(path: &Path) -> Result<[f64; 3], String> {
+pub(crate) fn read_texture(path: &Path) -> Result<DecodedImage, String> {
     let bytes = read_input_file(path, MAX_MODEL_BYTES)?;
     let image = image::load_from_memory(&bytes).map_err(|e| e.to_string())?;
     let rgb = image.to_rgb8();
-    mean_linear_colour(rgb.as_raw(), 3).ok_or_else(|| "the image has no pixels".to_owned())
+    DecodedImage::from_srgb8(rgb.as_raw(), 3, rgb.width(), rgb.height())
+        .ok_or_else(|| "the image has no pixels".to_owned())
 }
+
+/// A face corner: its welded index and texture coordinates.
+type Corner = (u32, [f64; 2]);
 
 /// Collects the faces of one part: welds positions, drops degenerate faces (counted), and
 /// splits faces that are not planar convex polygons.
@@ -238,6 +274,8 @@ pub(crate) struct PartBuilder {
     positions: Vec<DVec3>,
     index_of: HashMap<[u64; 3], u32>,
     faces: Vec<Vec<u32>>,
+    /// Texture coordinates per corner of each face in `faces`, where the file gave them.
+    uvs: Vec<Option<Vec<[f64; 2]>>>,
     /// Faces dropped because they had no area.
     pub(crate) dropped: usize,
 }
@@ -251,6 +289,7 @@ impl PartBuilder {
             positions: Vec::new(),
             index_of: HashMap::default(),
             faces: Vec::new(),
+            uvs: Vec::new(),
             dropped: 0,
         }
     }
@@ -281,33 +320,48 @@ impl PartBuilder {
     /// Adds a face of welded indices, counter-clockwise in model space.
     ///
     /// # Errors
+    /// As [`PartBuilder::face_with_uvs`].
+    #[cfg(test)]
+    pub(crate) fn face(&mut self, f: Vec<u32>) -> Result<(), String> {
+        self.face_with_uvs(f, None)
+    }
+
+    /// Adds a face of welded indices, counter-clockwise in model space, with texture
+    /// coordinates per corner (ignored unless one per corner); they follow the corners
+    /// through the splits below.
+    ///
+    /// # Errors
     /// The message for a face of more than [`radiosity_core::MAX_POLYGON_VERTICES`] corners
     /// (before anything is triangulated: ear clipping is quadratic in the corners).
-    pub(crate) fn face(&mut self, mut f: Vec<u32>) -> Result<(), String> {
+    pub(crate) fn face_with_uvs(&mut self, f: Vec<u32>, uvs: Option<Vec<[f64; 2]>>) -> Result<(), String> {
         if f.len() > radiosity_core::MAX_POLYGON_VERTICES {
             let e =
                 SceneError::TooManyVertices { count: f.len(), limit: radiosity_core::MAX_POLYGON_VERTICES };
             return Err(e.to_string());
         }
+        let uvs = uvs.filter(|u| u.len() == f.len());
+        let textured = uvs.is_some();
+        let mut corners: Vec<Corner> =
+            f.iter().enumerate().map(|(k, &v)| (v, uvs.as_ref().map_or([0.0; 2], |u| u[k]))).collect();
         if self.mirrored {
-            f.reverse();
+            corners.reverse();
         }
         // Consecutive repeats (welded points) carry no area.
-        f.dedup();
-        while f.len() > 1 && f.first() == f.last() {
-            f.pop();
+        corners.dedup_by_key(|c| c.0);
+        while corners.len() > 1 && corners.first().map(|c| c.0) == corners.last().map(|c| c.0) {
+            corners.pop();
         }
-        if f.len() < 3 {
+        if corners.len() < 3 {
             self.dropped += 1;
             return Ok(());
         }
-        let pts: Vec<DVec3> = f.iter().map(|&i| self.positions[i as usize]).collect();
+        let pts: Vec<DVec3> = corners.iter().map(|c| self.positions[c.0 as usize]).collect();
         match Polygon::try_new(pts.clone()) {
-            Ok(_) => self.faces.push(f),
+            Ok(_) => self.push(&corners, textured),
             Err(SceneError::NonPlanarPolygon { .. }) => {
                 // Convex but bent: a fan keeps every triangle inside the outline.
-                for k in 1..f.len() - 1 {
-                    self.triangle([f[0], f[k], f[k + 1]]);
+                for k in 1..corners.len() - 1 {
+                    self.triangle([corners[0], corners[k], corners[k + 1]], textured);
                 }
             }
             Err(SceneError::NonConvexPolygon { .. }) => {
@@ -318,7 +372,7 @@ impl PartBuilder {
                     self.dropped += 1;
                 }
                 for t in ears {
-                    self.triangle(t.map(|k| f[k]));
+                    self.triangle(t.map(|k| corners[k]), textured);
                 }
             }
             Err(_) => self.dropped += 1,
@@ -326,10 +380,15 @@ impl PartBuilder {
         Ok(())
     }
 
-    fn triangle(&mut self, t: [u32; 3]) {
-        let pts = t.map(|i| self.positions[i as usize]).to_vec();
+    fn push(&mut self, corners: &[Corner], textured: bool) {
+        self.faces.push(corners.iter().map(|c| c.0).collect());
+        self.uvs.push(textured.then(|| corners.iter().map(|c| c.1).collect()));
+    }
+
+    fn triangle(&mut self, t: [Corner; 3], textured: bool) {
+        let pts = t.map(|c| self.positions[c.0 as usize]).to_vec();
         if Polygon::try_new(pts).is_ok() {
-            self.faces.push(t.to_vec());
+            self.push(&t, textured);
         } else {
             self.dropped += 1;
         }
@@ -346,7 +405,14 @@ impl PartBuilder {
     /// The core's message (cannot happen for faces that passed [`PartBuilder::face`], kept
     /// as an error rather than a panic).
     pub(crate) fn build(self) -> Result<PolygonMesh, String> {
-        PolygonMesh::try_new(self.positions, self.faces).map_err(|e| e.to_string())
+        // Texture coordinates are kept only when every face has them: a picture shows a
+        // texture on all of a part or on none of it.
+        let uvs: Option<Vec<Vec<[f64; 2]>>> = self.uvs.into_iter().collect();
+        let mesh = PolygonMesh::try_new(self.positions, self.faces).map_err(|e| e.to_string())?;
+        Ok(match uvs {
+            Some(uvs) => mesh.with_uvs(uvs),
+            None => mesh,
+        })
     }
 }
 

@@ -17,8 +17,9 @@ use radiosity_core::{Sides, unique_names};
 use crate::LoadError;
 use crate::model::{
     DEFAULT_GREY, MAX_TEXT_BYTES, Model, ModelPart, PartBuilder, Transform, clamp_reflectance, model_error,
-    model_material, read_input_file, specular_warning, texture_mean,
+    model_material, read_input_file, read_texture, specular_warning,
 };
+use crate::texture_map::{UvTransform, parse_map_kd};
 
 /// Sides of every OBJ part: the format says nothing, and modellers and Blender show its faces
 /// from both sides (the normals of many files face every which way). The emission stays on the
@@ -307,79 +308,91 @@ pub(crate) fn parse_obj(
 
     // Our materials: those the parts use, in order of first use, plus the grey default.
     let mut out_materials: Vec<radiosity_core::Material> = Vec::new();
-    let mut material_of: HashMap<Option<usize>, usize> = HashMap::default();
-    let mut resolve = |id: Option<usize>, warnings: &mut Vec<String>| -> Result<usize, LoadError> {
-        if let Some(&m) = material_of.get(&id) {
-            return Ok(m);
-        }
-        let material = match id.and_then(|i| materials.get(i)) {
-            Some(m) => {
-                let found =
-                    mtl_texts.iter().find_map(|(f, t)| mtl_line(t, &m.name, "newmtl").map(|_| (f, t)));
-                let (mtl_origin, line_of) = match found {
-                    Some((f, t)) => (f.as_str(), Some(t.as_str())),
-                    None => (origin, None),
-                };
-                let line = |key: &str| line_of.and_then(|t| mtl_line(t, &m.name, key));
-                // A texture is read from the MTL's folder; its mean colour scales Kd, as glTF's
-                // base colour texture scales its factor.
-                let texture = m.diffuse_texture.as_deref().and_then(|file| {
-                    let folder = Path::new(mtl_origin).parent().filter(|_| line_of.is_some())?;
-                    match texture_mean(&folder.join(file)) {
-                        Ok(mean) => Some(mean),
-                        Err(e) => {
-                            warnings.push(format!(
+    let mut material_of: HashMap<Option<usize>, (usize, UvTransform)> = HashMap::default();
+    let mut resolve =
+        |id: Option<usize>, warnings: &mut Vec<String>| -> Result<(usize, UvTransform), LoadError> {
+            if let Some(&m) = material_of.get(&id) {
+                return Ok(m);
+            }
+            let mut uv_transform = UvTransform::default();
+            let mut kept = None;
+            let material = match id.and_then(|i| materials.get(i)) {
+                Some(m) => {
+                    let found =
+                        mtl_texts.iter().find_map(|(f, t)| mtl_line(t, &m.name, "newmtl").map(|_| (f, t)));
+                    let (mtl_origin, line_of) = match found {
+                        Some((f, t)) => (f.as_str(), Some(t.as_str())),
+                        None => (origin, None),
+                    };
+                    let line = |key: &str| line_of.and_then(|t| mtl_line(t, &m.name, key));
+                    // A texture is read from the MTL's folder; its mean colour scales Kd, as glTF's
+                    // base colour texture scales its factor.
+                    // The image is kept for pictures, placed by the `map_Kd` options.
+                    let map = m.diffuse_texture.as_deref().map(parse_map_kd);
+                    let texture = map.as_ref().and_then(|map| {
+                        let file = &map.file;
+                        let folder = Path::new(mtl_origin).parent().filter(|_| line_of.is_some())?;
+                        match read_texture(&folder.join(file)) {
+                            Ok(image) => {
+                                uv_transform = map.transform;
+                                kept = Some(image.texture(m.diffuse.unwrap_or([1.0; 3]), [map.wrap; 2]));
+                                Some(image.mean)
+                            }
+                            Err(e) => {
+                                warnings.push(format!(
                                 "{mtl_origin}: material '{}': texture '{file}' not read ({e}); Kd alone used",
                                 m.name
                             ));
-                            None
+                                None
+                            }
                         }
+                    });
+                    let reflectance = match (m.diffuse, texture) {
+                        (Some(kd), Some(mean)) => [kd[0] * mean[0], kd[1] * mean[1], kd[2] * mean[2]],
+                        (Some(kd), None) => kd,
+                        // The texture alone is what a viewer shows.
+                        (None, Some(mean)) => mean,
+                        (None, None) => {
+                            warnings.push(format!(
+                                "{mtl_origin}: material '{}' has no Kd; it is default grey ({DEFAULT_GREY})",
+                                m.name
+                            ));
+                            [DEFAULT_GREY; 3]
+                        }
+                    };
+                    let reflectance = clamp_reflectance(mtl_origin, &m.name, reflectance, warnings);
+                    if let Some(why) = specular_reason(m) {
+                        warnings.push(specular_warning(mtl_origin, &m.name, &why));
                     }
-                });
-                let reflectance = match (m.diffuse, texture) {
-                    (Some(kd), Some(mean)) => [kd[0] * mean[0], kd[1] * mean[1], kd[2] * mean[2]],
-                    (Some(kd), None) => kd,
-                    // The texture alone is what a viewer shows.
-                    (None, Some(mean)) => mean,
-                    (None, None) => {
-                        warnings.push(format!(
-                            "{mtl_origin}: material '{}' has no Kd; it is default grey ({DEFAULT_GREY})",
-                            m.name
-                        ));
-                        [DEFAULT_GREY; 3]
-                    }
-                };
-                let reflectance = clamp_reflectance(mtl_origin, &m.name, reflectance, warnings);
-                if let Some(why) = specular_reason(m) {
-                    warnings.push(specular_warning(mtl_origin, &m.name, &why));
+                    let emission = m.emissive.unwrap_or([0.0; 3]);
+                    // Name the line of the value at fault: Kd unless only the emission is wrong.
+                    let bad_kd = !reflectance.iter().all(|v| v.is_finite() && (0.0..1.0).contains(v));
+                    let key_line = if bad_kd { line("Kd") } else { line("Ke") };
+                    let key_line = if key_line.is_some() { key_line } else { line("newmtl") };
+                    let mut material = model_material(mtl_origin, key_line, &m.name, reflectance, emission)?;
+                    material.texture = kept;
+                    material
                 }
-                let emission = m.emissive.unwrap_or([0.0; 3]);
-                // Name the line of the value at fault: Kd unless only the emission is wrong.
-                let bad_kd = !reflectance.iter().all(|v| v.is_finite() && (0.0..1.0).contains(v));
-                let key_line = if bad_kd { line("Kd") } else { line("Ke") };
-                let key_line = if key_line.is_some() { key_line } else { line("newmtl") };
-                model_material(mtl_origin, key_line, &m.name, reflectance, emission)?
-            }
-            None => {
-                if let Some(i) = id {
-                    warnings.push(format!(
+                None => {
+                    if let Some(i) = id {
+                        warnings.push(format!(
                         "{origin}: material #{i} is not in any material library; its faces are default grey"
                     ));
+                    }
+                    model_material(origin, None, "default", [DEFAULT_GREY; 3], [0.0; 3])?
                 }
-                model_material(origin, None, "default", [DEFAULT_GREY; 3], [0.0; 3])?
-            }
+            };
+            let name = material.name.clone();
+            // Two MTL files may define the same name; the second one becomes `name#2`.
+            let mut names: Vec<String> = out_materials.iter().map(|m| m.name.clone()).collect();
+            names.push(name);
+            unique_names(&mut names);
+            let mut material = material;
+            material.name = names.pop().unwrap_or_default();
+            out_materials.push(material);
+            material_of.insert(id, (out_materials.len() - 1, uv_transform));
+            Ok((out_materials.len() - 1, uv_transform))
         };
-        let name = material.name.clone();
-        // Two MTL files may define the same name; the second one becomes `name#2`.
-        let mut names: Vec<String> = out_materials.iter().map(|m| m.name.clone()).collect();
-        names.push(name);
-        unique_names(&mut names);
-        let mut material = material;
-        material.name = names.pop().unwrap_or_default();
-        out_materials.push(material);
-        material_of.insert(id, out_materials.len() - 1);
-        Ok(out_materials.len() - 1)
-    };
 
     let total_faces: usize = models
         .iter()
@@ -397,7 +410,16 @@ pub(crate) fn parse_obj(
         Path::new(origin).file_stem().map_or_else(|| "model".into(), |s| s.to_string_lossy().into_owned());
     for model in &models {
         let mesh = &model.mesh;
-        let material = resolve(mesh.material_id, &mut warnings)?;
+        let (material, uv_transform) = resolve(mesh.material_id, &mut warnings)?;
+        // Texture coordinates per corner, where every corner of the object has one: mapped
+        // by the `map_Kd` options, and v turned to run down the image as the renderer's does.
+        let textured = !mesh.texcoord_indices.is_empty() && mesh.texcoord_indices.len() == mesh.indices.len();
+        let uv_of = |k: usize| -> Option<[f64; 2]> {
+            let t = *mesh.texcoord_indices.get(k)? as usize;
+            let uv = [*mesh.texcoords.get(2 * t)?, *mesh.texcoords.get(2 * t + 1)?];
+            let [u, v] = uv_transform.apply(uv);
+            Some([u, 1.0 - v])
+        };
         let mut b = PartBuilder::new(transform.matrix());
         let mut welded = Vec::with_capacity(mesh.positions.len() / 3);
         for (k, p) in mesh.positions.chunks_exact(3).enumerate() {
@@ -414,6 +436,8 @@ pub(crate) fn parse_obj(
         let mut start = 0;
         for arity in arities {
             face_number += 1;
+            let uvs: Option<Vec<[f64; 2]>> =
+                textured.then(|| (start..start + arity).map(uv_of).collect()).flatten();
             let Some(ids) = mesh.indices.get(start..start + arity) else {
                 return Err(model_error(
                     origin,
@@ -437,7 +461,7 @@ pub(crate) fn parse_obj(
                 };
                 face.push(v);
             }
-            b.face(face).map_err(|m| {
+            b.face_with_uvs(face, uvs).map_err(|m| {
                 model_error(origin, face_line(face_number - 1), format!("face {face_number}: {m}"))
             })?;
         }

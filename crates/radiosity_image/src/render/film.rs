@@ -178,22 +178,30 @@ impl Renderer {
                 for i in 0..n {
                     let dir = rays.jittered_direction(x as u32, y as u32, i, n, &mut rng);
                     if let Some(hit) = self.trace_unchecked(solution, camera.position, dir, p.shading) {
+                        let ray = (camera.position, dir);
+                        let seen = |b: Rgb, per_sr: bool| {
+                            self.textured(b, per_sr, hit.element as usize, hit.object, ray, hit.distance)
+                        };
                         sum += match p.gather {
+                            Gather::None if hit.front_facing => seen(hit.radiance, true),
                             Gather::None => hit.radiance,
                             _ if !hit.front_facing => Rgb::ZERO,
                             gather => {
                                 let e = hit.element as usize;
                                 let cached = cache.as_ref().map(|c| (c, x, y));
-                                self.gathered_sample(
-                                    solution,
-                                    e,
-                                    hit.p_world,
-                                    gather,
-                                    p,
-                                    effort,
-                                    Stratum { index: strata[i as usize], rotation },
-                                    cached,
-                                    &mut rng,
+                                seen(
+                                    self.gathered_sample(
+                                        solution,
+                                        e,
+                                        hit.p_world,
+                                        gather,
+                                        p,
+                                        effort,
+                                        Stratum { index: strata[i as usize], rotation },
+                                        cached,
+                                        &mut rng,
+                                    ),
+                                    false,
                                 ) / PI
                             }
                         };

@@ -33,6 +33,7 @@ mod params;
 mod primary;
 #[cfg(test)]
 mod tests;
+mod texture;
 
 pub use params::{RenderError, RenderParams, Shading};
 
@@ -90,9 +91,48 @@ pub struct Renderer {
     /// Per vertex, the normal a final gather shades with (see `primary::shading_normals`); empty
     /// when every vertex's is its own surface's normal (no smoothing across facets).
     shading_normals: Vec<DVec3>,
+    /// The scene's textured faces ([`Renderer::with_textures`]); `None`: every surface shows
+    /// its material's mean colour.
+    textures: Option<texture::Textures>,
 }
 
 impl Renderer {
+    /// The renderer showing the colour textures of `scene`'s materials, which must be the
+    /// scene `mesh` was built from: where a ray meets a textured face, the light it reflects
+    /// is scaled by the texel's albedo over the material's mean reflectance (which the solve
+    /// used). Surfaces without a texture render exactly as without this.
+    pub fn with_textures(mut self, scene: &radiosity_core::Scene) -> Self {
+        self.textures = texture::Textures::new(scene);
+        self
+    }
+
+    /// Light `b` (radiosity, or radiance when `per_sr`) seen at element `e` of `object`
+    /// along the ray from `origin` along unit `dir` at `distance`, as its texture shows it:
+    /// `b` itself, to the bit, where there is none.
+    fn textured(
+        &self,
+        b: Rgb,
+        per_sr: bool,
+        e: usize,
+        object: u32,
+        ray: (DVec3, DVec3),
+        distance: f64,
+    ) -> Rgb {
+        let Some(textures) = &self.textures else { return b };
+        let material = self.mesh.element_material(e);
+        let Some(image) = &material.texture else { return b };
+        // A ray along an edge between two model faces may slip between them in the BVH's
+        // single precision: once more, a thousandth of the way towards the element's centre.
+        let uv = textures.uv(object, ray.0, ray.1, distance).or_else(|| {
+            let p = ray.0 + ray.1 * distance;
+            let q = p + (self.mesh.elements[e].centre - p) * 1e-3;
+            textures.uv(object, ray.0, (q - ray.0).normalize_or_zero(), (q - ray.0).length())
+        });
+        let Some(uv) = uv else { return b };
+        let emitted = if per_sr { material.emission / std::f64::consts::PI } else { material.emission };
+        texture::shown(b, emitted, texture::ratio(material, image, uv))
+    }
+
     /// The mesh being drawn.
     pub fn mesh(&self) -> &Arc<Mesh> {
         &self.mesh

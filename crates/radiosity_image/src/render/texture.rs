@@ -1,0 +1,171 @@
+//! Textures in pictures. The solve spreads each material's mean reflectance, which is what
+//! diffuse transfer needs; a picture shows the texture by scaling the light a point reflects
+//! by the texel's albedo over that mean, per channel: L = (E + (B − E)·ρ(uv)/ρ̄) / π.
+//!
+//! The mesh the solver meshed no longer follows the model's faces (coplanar faces are meshed
+//! afresh as one surface), so a hit's texture coordinates come from the model's own faces:
+//! the same ray is traced against a BVH of the textured faces, and the face it meets at the
+//! same distance on the same object gives them, interpolated by its barycentric weights.
+//! Texels are filtered bilinearly, in linear light, after wrapping (glTF's three modes).
+
+use std::sync::Arc;
+
+use glam::DVec3;
+use radiosity_accel::{Bvh, RayQuery};
+use radiosity_core::{Material, Rgb, Scene, Shape, Texture, Wrap, srgb_decode};
+
+/// The textured faces of a scene, as triangles a ray can meet.
+pub(super) struct Textures {
+    bvh: Bvh,
+    /// Per BVH triangle: its object and the texture coordinates of its corners.
+    faces: Vec<(u32, [[f64; 2]; 3])>,
+    /// How far along the ray the face may lie from the element's hit and still be its face:
+    /// the two are the same plane up to the BVH's single precision.
+    tolerance: f64,
+}
+
+impl Textures {
+    /// The faces of `scene`'s mesh objects whose material has a texture and which have
+    /// texture coordinates (fanned into triangles: faces are convex), or `None` when none.
+    pub(super) fn new(scene: &Scene) -> Option<Self> {
+        let mut triangles = Vec::new();
+        let mut faces = Vec::new();
+        for (o, object) in scene.objects.iter().enumerate() {
+            let Shape::Mesh(mesh) = &object.shape else { continue };
+            if scene.materials[object.material].texture.is_none() || mesh.uvs().is_empty() {
+                continue;
+            }
+            for (face, uvs) in mesh.faces().iter().zip(mesh.uvs()) {
+                for k in 1..face.len() - 1 {
+                    let corner = |i: usize| mesh.positions()[face[i] as usize].as_vec3();
+                    triangles.push([corner(0), corner(k), corner(k + 1)]);
+                    faces.push((o as u32, [uvs[0], uvs[k], uvs[k + 1]]));
+                }
+            }
+        }
+        if faces.is_empty() {
+            return None;
+        }
+        let (lo, hi) = scene.bounds();
+        Some(Self { bvh: Bvh::new(&triangles), faces, tolerance: 1e-4 * (hi - lo).length() })
+    }
+
+    /// Texture coordinates where the ray from `origin` along unit `dir` meets `object` at
+    /// `distance`, or `None` when no textured face of it lies there.
+    pub(super) fn uv(&self, object: u32, origin: DVec3, dir: DVec3, distance: f64) -> Option<[f64; 2]> {
+        let reach = (distance + self.tolerance) as f32;
+        let hit = self.bvh.closest_hit(origin.as_vec3(), dir.as_vec3(), reach)?;
+        let (owner, uvs) = self.faces[hit.triangle as usize];
+        if owner != object || (f64::from(hit.t) - distance).abs() > self.tolerance {
+            return None;
+        }
+        let w = [1.0 - f64::from(hit.u) - f64::from(hit.v), f64::from(hit.u), f64::from(hit.v)];
+        Some([0, 1].map(|c| uvs[0][c] * w[0] + uvs[1][c] * w[1] + uvs[2][c] * w[2]))
+    }
+}
+
+/// Texel `i` of a row or column of `n` after wrapping by `wrap`.
+pub(super) fn wrapped(i: i64, n: u32, wrap: Wrap) -> usize {
+    let n = i64::from(n.max(1));
+    let i = match wrap {
+        Wrap::Repeat => i.rem_euclid(n),
+        Wrap::ClampToEdge => i.clamp(0, n - 1),
+        Wrap::MirroredRepeat => {
+            let m = i.rem_euclid(2 * n);
+            if m < n { m } else { 2 * n - 1 - m }
+        }
+    };
+    i as usize
+}
+
+/// The albedo of `texture` at `uv`: the four nearest texels decoded from sRGB, weighted
+/// bilinearly, times the texture's factor.
+pub(super) fn albedo(texture: &Texture, uv: [f64; 2]) -> Rgb {
+    let decode = |v: u8| srgb_decode(f64::from(v) / 255.0);
+    // Texel centres lie at half-integers: (u·w − ½) is the texel coordinate.
+    let x = uv[0] * f64::from(texture.width) - 0.5;
+    let y = uv[1] * f64::from(texture.height) - 0.5;
+    let (x0, y0) = (x.floor(), y.floor());
+    let (fx, fy) = (x - x0, y - y0);
+    let (x0, y0) = (x0 as i64, y0 as i64);
+    let mut sum = [0.0; 3];
+    for (dy, wy) in [(0, 1.0 - fy), (1, fy)] {
+        let row = wrapped(y0 + dy, texture.height, texture.wrap[1]);
+        for (dx, wx) in [(0, 1.0 - fx), (1, fx)] {
+            let column = wrapped(x0 + dx, texture.width, texture.wrap[0]);
+            let texel = texture.texels[row * texture.width as usize + column];
+            for c in 0..3 {
+                sum[c] += wx * wy * decode(texel[c]);
+            }
+        }
+    }
+    Rgb::from_array([0, 1, 2].map(|c| sum[c] * texture.factor[c]))
+}
+
+/// Per channel, the albedo at `uv` over `material`'s mean reflectance (1 where the mean is
+/// 0: nothing is reflected there to scale).
+pub(super) fn ratio(material: &Material, texture: &Arc<Texture>, uv: [f64; 2]) -> Rgb {
+    let texel = albedo(texture, uv).to_array();
+    let mean = material.reflectance.to_array();
+    Rgb::from_array([0, 1, 2].map(|c| if mean[c] > 0.0 { texel[c] / mean[c] } else { 1.0 }))
+}
+
+/// Light `b` leaving a point (radiosity, or radiance) as its texture shows it: the emitted
+/// part `emitted` (in the same quantity) as it is, the reflected part scaled by `ratio`.
+pub(super) fn shown(b: Rgb, emitted: Rgb, ratio: Rgb) -> Rgb {
+    emitted + (b - emitted) * ratio
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wrap_modes_bring_texels_back_into_the_image() {
+        // A row of 4 texels: −1 is the last (repeat), the first (clamp), the first again
+        // (mirrored: … 1 0 | 0 1 2 3 | 3 2 …).
+        let row = |wrap| [-5, -1, 0, 3, 4, 7, 9].map(|i| wrapped(i, 4, wrap));
+        assert_eq!(row(Wrap::Repeat), [3, 3, 0, 3, 0, 3, 1]);
+        assert_eq!(row(Wrap::ClampToEdge), [0, 0, 0, 3, 3, 3, 3]);
+        assert_eq!(row(Wrap::MirroredRepeat), [3, 0, 0, 3, 3, 0, 1]);
+    }
+
+    #[test]
+    fn bilinear_albedo_is_exact_at_texel_centres_and_blends_between() {
+        // Black | white, two texels in a row, white's factor halving green.
+        let t = Texture {
+            width: 2,
+            height: 1,
+            texels: vec![[0; 3], [255; 3]],
+            factor: [1.0, 0.5, 1.0],
+            wrap: [Wrap::ClampToEdge; 2],
+        };
+        let at = |u: f64| albedo(&t, [u, 0.5]).to_array();
+        assert_eq!(at(0.25), [0.0; 3]);
+        assert_eq!(at(0.75), [1.0, 0.5, 1.0]);
+        // Halfway between the centres: half of each, in linear light.
+        assert!((at(0.5)[0] - 0.5).abs() < 1e-12, "{:?}", at(0.5));
+        // Clamped past the edge; repeated, the far side of u = 0 is white again.
+        assert_eq!(at(-3.0), [0.0; 3]);
+        let repeat = Texture { wrap: [Wrap::Repeat; 2], ..t };
+        assert!((albedo(&repeat, [0.0, 0.5]).to_array()[0] - 0.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_ratio_keeps_emission_and_guards_a_black_mean() {
+        let mut m = Material::try_new("m", Rgb::new(0.5, 0.0, 0.25), Rgb::new(1.0, 0.0, 0.0)).unwrap();
+        let t = Arc::new(Texture {
+            width: 1,
+            height: 1,
+            texels: vec![[255; 3]],
+            factor: [0.9, 0.9, 0.5],
+            wrap: [Wrap::Repeat; 2],
+        });
+        m.texture = Some(t.clone());
+        let r = ratio(&m, &t, [0.5, 0.5]).to_array();
+        assert!((r[0] - 1.8).abs() < 1e-12 && r[1] == 1.0 && (r[2] - 2.0).abs() < 1e-12, "{r:?}");
+        // B = E + reflected: only the reflected 2 doubles.
+        let b = shown(Rgb::new(3.0, 0.0, 0.0), m.emission, Rgb::new(2.0, 1.0, 1.0));
+        assert_eq!(b.to_array(), [5.0, 0.0, 0.0]);
+    }
+}
