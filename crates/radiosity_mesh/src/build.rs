@@ -55,6 +55,8 @@ fn refine_near(
 struct Cutters<'a, 'b> {
     contacts: Option<&'a Contacts<'b>>,
     shadows: Option<&'a ShadowOutlines>,
+    /// The polygon's object is two-sided: what meets its back cuts it too.
+    both_sides: bool,
 }
 
 impl Mesh {
@@ -101,9 +103,11 @@ impl Mesh {
         let mut dark_back = HashMap::default();
         for (oi, o) in scene.objects.iter().enumerate() {
             let first_surface = mesh.surfaces.len() as u32;
+            let two_sided = matches!(o.sides, Sides::Two { .. });
             // A polygon of this object, cut around what stands on it, graded and refined.
             let cut = |mesh: &mut Mesh, p: &Polygon, id: Option<PolygonId>| {
-                let cutters = Cutters { contacts: contacts.as_ref(), shadows: shadows.as_ref() };
+                let cutters =
+                    Cutters { contacts: contacts.as_ref(), shadows: shadows.as_ref(), both_sides: two_sided };
                 mesh.mesh_cut_polygon(cutters, p, id, oi, o.material, params, refinement);
             };
             match &o.shape {
@@ -157,7 +161,7 @@ impl Mesh {
                                     let seams = contacts
                                         .as_ref()
                                         .filter(|_| params.contacts)
-                                        .map(|c| c.seams(ts, normal, None))
+                                        .map(|c| c.seams(ts, normal, None, two_sided))
                                         .unwrap_or_default();
                                     if seams.is_empty() {
                                         mesh_triangles(&mut b, ts, normal, params);
@@ -236,7 +240,7 @@ impl Mesh {
     #[allow(clippy::too_many_arguments)]
     fn mesh_cut_polygon(
         &mut self,
-        Cutters { contacts, shadows }: Cutters,
+        Cutters { contacts, shadows, both_sides }: Cutters,
         p: &Polygon,
         id: Option<PolygonId>,
         object: usize,
@@ -247,13 +251,18 @@ impl Mesh {
         let large = is_large(p, params);
         let cut = contacts
             .filter(|_| large && params.contacts)
-            .and_then(|c| c.cut(p, id, |q| estimate_polygon_elements(q, params)));
-        let pieces = match &cut {
-            Some(cut) => {
+            .and_then(|c| c.cut(p, id, both_sides, |q| estimate_polygon_elements(q, params)));
+        // A small face is cut only where other faces pass through it (see
+        // `Contacts::small_face_cut`).
+        let crossed =
+            contacts.filter(|_| !large && params.contacts).and_then(|c| c.small_face_cut(p, id, both_sides));
+        let pieces = match (&cut, &crossed) {
+            (Some(cut), _) => {
                 self.hidden_area[object] += cut.hidden;
                 &cut.pieces[..]
             }
-            None => std::slice::from_ref(p),
+            (None, Some(crossed)) => &crossed[..],
+            (None, None) => std::slice::from_ref(p),
         };
         let shadowed = shadows
             .filter(|_| large)

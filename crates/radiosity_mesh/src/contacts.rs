@@ -374,6 +374,7 @@ impl<'a> Contacts<'a> {
         &self,
         target: &Polygon,
         id: Option<PolygonId>,
+        both_sides: bool,
         estimate: impl Fn(&Polygon) -> usize,
     ) -> Option<Cut> {
         let n = target.normal();
@@ -381,7 +382,7 @@ impl<'a> Contacts<'a> {
         let tiny = 1e-9 * whole;
         // Seams first (lines across the surface), then the footprints out of their pieces.
         let mut seamed = vec![target.vertices().to_vec()];
-        for seam in self.seams(std::slice::from_ref(&target.vertices()), n, id) {
+        for seam in self.seams(std::slice::from_ref(&target.vertices()), n, id, both_sides) {
             seamed = seams::cut_pieces(seamed, &seam, n, tiny);
         }
         let footprints = self.footprints(target, id);

@@ -19,7 +19,8 @@
 use glam::DVec3;
 
 use super::{Contacts, PolygonId, slab_box};
-use crate::planar::{area, bounds, clip};
+use crate::planar::{area, bounds, clean, clip};
+use radiosity_core::Polygon;
 
 /// Most seams cutting one surface, the longest first: each doubles at most the pieces.
 const MAX_SEAMS: usize = 8;
@@ -104,11 +105,63 @@ impl Contacts<'_> {
     /// The seams of the surface covering the convex polygons `region` (corners on one plane
     /// of unit normal `n`; the surface's own polygon is `id` when it is one), longest first,
     /// at most [`MAX_SEAMS`].
+    /// With `both_sides` (a two-sided surface), faces meeting its back cut it too.
     pub(crate) fn seams<P: AsRef<[DVec3]>>(
         &self,
         region: &[P],
         n: DVec3,
         id: Option<PolygonId>,
+        both_sides: bool,
+    ) -> Vec<Seam> {
+        self.lines_across(region, n, id, both_sides, false)
+    }
+
+    /// A small face `target` (too small to look for what stands on it, see
+    /// `builder::is_large`) cut where other faces pass through it: a door handle's stem
+    /// through the door, one part of a model sunk into another. The part beyond the other
+    /// face lies in other light: as one element with the rest, a handle's stem took the lit
+    /// side's light and gave it to the dark side (Bitterli's Veach Ajar: the handles in the
+    /// dark room took direct light that cannot reach them, 65–118 % too bright). Faces that
+    /// only touch it (its neighbours, what stands on it) leave a small face whole: cut
+    /// along them, a model's facets fragment. `None` when nothing passes through it.
+    pub(crate) fn small_face_cut(
+        &self,
+        target: &Polygon,
+        id: Option<PolygonId>,
+        both_sides: bool,
+    ) -> Option<Vec<Polygon>> {
+        let n = target.normal();
+        let seams = self.lines_across(std::slice::from_ref(&target.vertices()), n, id, both_sides, true);
+        if seams.is_empty() {
+            return None;
+        }
+        let tiny = 1e-9 * target.area();
+        let mut pieces = vec![target.vertices().to_vec()];
+        for seam in &seams {
+            pieces = cut_pieces(pieces, seam, n, tiny);
+        }
+        if pieces.len() < 2 {
+            return None;
+        }
+        // A piece the validation refuses (a sliver of round-off): keep the face whole.
+        pieces
+            .into_iter()
+            .filter(|p| area(p, n) > tiny)
+            .map(|p| Polygon::try_new(clean(p, target)).ok())
+            .collect()
+    }
+
+    /// The lines along which other faces meet the plane of `region` (see [`Self::seams`]);
+    /// for a `small` face only faces passing through it count, and a line divides it when a
+    /// tenth of the seams' reach lies on each side (a part poking a millimetre through: the
+    /// reach is a thousandth of the face's diagonal).
+    fn lines_across<P: AsRef<[DVec3]>>(
+        &self,
+        region: &[P],
+        n: DVec3,
+        id: Option<PolygonId>,
+        both_sides: bool,
+        small: bool,
     ) -> Vec<Seam> {
         let Some(first) = region.first().and_then(|p| p.as_ref().first().copied()) else {
             return Vec::new();
@@ -127,28 +180,35 @@ impl Contacts<'_> {
                 continue;
             }
             let pv = p.vertices();
-            let heights: Vec<f64> = pv.iter().map(|&q| n.dot(q) - d).collect();
-            let low = heights.iter().copied().fold(f64::INFINITY, f64::min);
-            let high = heights.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            if low > eps || high <= 0.1 * eps {
-                continue; // above the surface, or not rising off it on its front
-            }
-            let level = low.max(0.0) + 1e-7 * diagonal;
-            let mut ends = Vec::with_capacity(2);
-            for i in 0..pv.len() {
-                let j = (i + 1) % pv.len();
-                let (hi_, hj) = (heights[i] - level, heights[j] - level);
-                if (hi_ >= 0.0) != (hj >= 0.0) {
-                    let x = pv[i] + (pv[j] - pv[i]) * (hi_ / (hi_ - hj));
-                    ends.push(x - n * (n.dot(x) - d));
+            // Faces meeting the back of a two-sided surface cut it too: they shape the light
+            // its back face takes, which shares its elements.
+            for side in if both_sides { [1.0, -1.0].as_slice() } else { [1.0].as_slice() } {
+                let heights: Vec<f64> = pv.iter().map(|&q| side * (n.dot(q) - d)).collect();
+                let low = heights.iter().copied().fold(f64::INFINITY, f64::min);
+                let high = heights.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                if low > eps || high <= 0.1 * eps {
+                    continue; // above the surface, or not rising off it on this side
                 }
-            }
-            if let [a, b] = ends[..]
-                && a.distance(b) > 1e-6 * diagonal
-            {
-                segments.push((a, b));
-                if segments.len() > MAX_SEGMENTS {
-                    return Vec::new();
+                if small && low >= -eps {
+                    continue; // touching a small face, not passing through it
+                }
+                let level = low.max(0.0) + 1e-7 * diagonal;
+                let mut ends = Vec::with_capacity(2);
+                for i in 0..pv.len() {
+                    let j = (i + 1) % pv.len();
+                    let (hi_, hj) = (heights[i] - level, heights[j] - level);
+                    if (hi_ >= 0.0) != (hj >= 0.0) {
+                        let x = pv[i] + (pv[j] - pv[i]) * (hi_ / (hi_ - hj));
+                        ends.push(x - n * (n.dot(x) - d));
+                    }
+                }
+                if let [a, b] = ends[..]
+                    && a.distance(b) > 1e-6 * diagonal
+                {
+                    segments.push((a, b));
+                    if segments.len() > MAX_SEGMENTS {
+                        return Vec::new();
+                    }
                 }
             }
         }
@@ -193,7 +253,8 @@ impl Contacts<'_> {
                 // A line along the surface's outline divides nothing.
                 let sides = all.iter().map(|&q| s.side(n, q));
                 let (below, above) = sides.fold((0.0_f64, 0.0_f64), |(b, a), v| (b.min(v), a.max(v)));
-                let divides = below < -eps && above > eps;
+                let beyond = if small { 0.1 * eps } else { eps };
+                let divides = below < -beyond && above > beyond;
                 (divides && across > 0.0 && met >= MIN_COVER * across).then_some((met, s))
             })
             .collect();

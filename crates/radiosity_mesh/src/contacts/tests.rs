@@ -40,7 +40,7 @@ fn a_box_on_the_floor_cuts_its_footprint_out() {
     let contacts = Contacts::new(&scene);
     let Shape::Polygons(floor) = &scene.objects[0].shape else { unreachable!() };
     let cut = contacts
-        .cut(&floor[0], Some(PolygonId { object: 0, index: 0 }), |q| (q.area() * 100.0) as usize)
+        .cut(&floor[0], Some(PolygonId { object: 0, index: 0 }), false, |q| (q.area() * 100.0) as usize)
         .expect("a cut");
     assert!((cut.hidden - 1.5).abs() < 1e-9, "hidden {}", cut.hidden);
     let kept: f64 = cut.pieces.iter().map(Polygon::area).sum();
@@ -64,7 +64,7 @@ fn a_box_on_the_floor_cuts_its_footprint_out() {
     let Shape::Polygons(lamp) = &scene.objects[2].shape else { unreachable!() };
     assert!(
         contacts
-            .cut(&lamp[0], Some(PolygonId { object: 2, index: 0 }), |q| (q.area() * 100.0) as usize)
+            .cut(&lamp[0], Some(PolygonId { object: 2, index: 0 }), false, |q| (q.area() * 100.0) as usize)
             .is_none()
     );
 }
@@ -75,7 +75,7 @@ fn hidden_under(block: Vec<Polygon>) -> Option<f64> {
     let contacts = Contacts::new(&scene);
     let Shape::Polygons(floor) = &scene.objects[0].shape else { unreachable!() };
     contacts
-        .cut(&floor[0], Some(PolygonId { object: 0, index: 0 }), |q| (q.area() * 100.0) as usize)
+        .cut(&floor[0], Some(PolygonId { object: 0, index: 0 }), false, |q| (q.area() * 100.0) as usize)
         .map(|c| c.hidden)
 }
 
@@ -153,7 +153,7 @@ fn a_footprint_over_the_edge_hides_its_overlap() {
     let contacts = Contacts::new(&scene);
     let Shape::Polygons(floor) = &scene.objects[0].shape else { unreachable!() };
     let cut = contacts
-        .cut(&floor[0], Some(PolygonId { object: 0, index: 0 }), |q| (q.area() * 100.0) as usize)
+        .cut(&floor[0], Some(PolygonId { object: 0, index: 0 }), false, |q| (q.area() * 100.0) as usize)
         .unwrap();
     assert!((cut.hidden - 0.5).abs() < 1e-9, "{}", cut.hidden);
     let kept: f64 = cut.pieces.iter().map(Polygon::area).sum();
@@ -191,10 +191,10 @@ fn a_board_along_the_surface_cuts_a_seam_and_a_short_one_does_not() {
     let contacts = Contacts::new(&scene);
     let Shape::Polygons(floor) = &scene.objects[0].shape else { unreachable!() };
     let id = Some(PolygonId { object: 0, index: 0 });
-    let seams = contacts.seams(std::slice::from_ref(&floor[0].vertices()), DVec3::Y, id);
+    let seams = contacts.seams(std::slice::from_ref(&floor[0].vertices()), DVec3::Y, id, false);
     assert_eq!(seams.len(), 1, "{seams:?}");
     assert!(seams[0].dir.abs().abs_diff_eq(DVec3::X, 1e-12) && (seams[0].at.z - 0.02).abs() < 1e-12);
-    let cut = contacts.cut(&floor[0], id, |q| (q.area() * 100.0) as usize).expect("a seam");
+    let cut = contacts.cut(&floor[0], id, false, |q| (q.area() * 100.0) as usize).expect("a seam");
     assert_eq!(cut.hidden, 0.0);
     let mut areas: Vec<f64> = cut.pieces.iter().map(Polygon::area).collect();
     areas.sort_by(f64::total_cmp);
@@ -203,6 +203,56 @@ fn a_board_along_the_surface_cuts_a_seam_and_a_short_one_does_not() {
     let scene = floor_and(board(1.0));
     let contacts = Contacts::new(&scene);
     let Shape::Polygons(floor) = &scene.objects[0].shape else { unreachable!() };
-    assert!(contacts.seams(std::slice::from_ref(&floor[0].vertices()), DVec3::Y, id).is_empty());
-    assert!(contacts.cut(&floor[0], id, |q| (q.area() * 100.0) as usize).is_none());
+    assert!(contacts.seams(std::slice::from_ref(&floor[0].vertices()), DVec3::Y, id, false).is_empty());
+    assert!(contacts.cut(&floor[0], id, false, |q| (q.area() * 100.0) as usize).is_none());
+}
+
+/// A board standing under the floor (against its back): it cuts a seam only when the floor
+/// is two-sided, as its back face then takes light that the board shapes.
+#[test]
+fn a_board_against_the_back_cuts_a_two_sided_surface_only() {
+    let under: Vec<Polygon> = board(4.0)
+        .iter()
+        .map(|p| {
+            Polygon::try_new(p.vertices().iter().map(|v| v * DVec3::new(1.0, -1.0, 1.0)).collect()).unwrap()
+        })
+        .collect();
+    let scene = floor_and(under);
+    let contacts = Contacts::new(&scene);
+    let Shape::Polygons(floor) = &scene.objects[0].shape else { unreachable!() };
+    let id = Some(PolygonId { object: 0, index: 0 });
+    let corners = floor[0].vertices();
+    let region = std::slice::from_ref(&corners);
+    assert!(contacts.seams(region, DVec3::Y, id, false).is_empty());
+    let seams = contacts.seams(region, DVec3::Y, id, true);
+    assert_eq!(seams.len(), 1, "{seams:?}");
+    assert!((seams[0].at.z - 0.02).abs() < 1e-12, "{seams:?}");
+}
+
+/// A small face passing through a large one (a door handle's stem through the door) is cut
+/// along the line where it passes; one only touching it, or standing beside it, stays whole.
+#[test]
+fn a_small_face_is_cut_where_another_passes_through_it() {
+    let p = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+    // The stem: 2 cm wide, from 3 cm behind the floor's plane to 5 cm above it.
+    let stem = |from: f64, x: f64| {
+        Polygon::try_new(vec![p(x, from, 1.0), p(x, from, 1.02), p(x, 0.05, 1.02), p(x, 0.05, 1.0)]).unwrap()
+    };
+    let scene = floor_and(vec![stem(-0.03, 1.0), stem(0.0, 2.0), stem(-0.03, 5.0)]);
+    let contacts = Contacts::new(&scene);
+    let Shape::Polygons(stems) = &scene.objects[1].shape else { unreachable!() };
+    let id = |index| Some(PolygonId { object: 1, index });
+    let pieces = contacts.small_face_cut(&stems[0], id(0), false).expect("cut where the floor passes");
+    assert_eq!(pieces.len(), 2);
+    let mut spans: Vec<(f64, f64)> = pieces
+        .iter()
+        .map(|q| q.vertices().iter().fold((f64::MAX, f64::MIN), |(lo, hi), v| (lo.min(v.y), hi.max(v.y))))
+        .collect();
+    spans.sort_by(|a, b| a.0.total_cmp(&b.0));
+    assert!((spans[0].0 + 0.03).abs() < 1e-12 && spans[0].1.abs() < 1e-12, "{spans:?}");
+    assert!(spans[1].0.abs() < 1e-12 && (spans[1].1 - 0.05).abs() < 1e-12, "{spans:?}");
+    let total: f64 = pieces.iter().map(Polygon::area).sum();
+    assert!((total - stems[0].area()).abs() < 1e-12);
+    assert!(contacts.small_face_cut(&stems[1], id(1), true).is_none(), "standing on it");
+    assert!(contacts.small_face_cut(&stems[2], id(2), true).is_none(), "beside the floor");
 }
