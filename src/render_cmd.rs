@@ -160,13 +160,15 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let base = radiosity_image::camera_or_framing(&prepared.scene);
     // The points given are in the file's frame; the scene has been turned +y up.
     let turned = |p: DVec3| prepared.up.to_y_up(p);
-    let camera = Camera::try_new(
-        a.camera_position.map_or(base.position, turned),
-        a.look_at.map_or(base.look_at, turned),
-        base.up,
-        a.fov.unwrap_or(base.fov_y_deg),
-    )
-    .map_err(|e| input(format!("camera options (--camera-position, --look-at, --fov): {e}")))?;
+    let (position, look_at) =
+        (a.camera_position.map_or(base.position, turned), a.look_at.map_or(base.look_at, turned));
+    // A camera placed by hand stands upright: the automatic framing of an open scene may look
+    // straight down with +z up, which turned a level view on its side or upside down.
+    let placed = prepared.scene.camera.is_none() && (a.camera_position.is_some() || a.look_at.is_some());
+    let level = (look_at - position).normalize_or_zero().cross(DVec3::Y).length() > 1e-3;
+    let up = if placed && level { DVec3::Y } else { base.up };
+    let camera = Camera::try_new(position, look_at, up, a.fov.unwrap_or(base.fov_y_deg))
+        .map_err(|e| input(format!("camera options (--camera-position, --look-at, --fov): {e}")))?;
     let lit = radiosity_image::lit_share_seen_by(&prepared.scene, &camera);
     if lit < 0.05 {
         note(format_args!(

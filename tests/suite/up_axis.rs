@@ -225,6 +225,43 @@ fn camera_points_are_in_the_files_frame() {
     assert!(worst < 1e-4, "pixels differ by up to {worst}");
 }
 
+/// A camera placed by hand in a scene whose automatic view looks straight down (a wide lit
+/// floor under a low lamp, seen from above with +z up in the picture) stands upright: the
+/// floor it looks along fills the bottom of the picture, not one side of it.
+#[test]
+fn a_camera_placed_by_hand_stands_upright() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("floor.obj");
+    std::fs::write(dir.path().join("room.mtl"), MTL).unwrap();
+    std::fs::write(
+        &obj,
+        "mtllib room.mtl\nv -10 0 -10\nv 10 0 -10\nv 10 0 10\nv -10 0 10\nv -0.5 1 -0.5\nv 0.5 1 -0.5\n\
+         v 0.5 1 0.5\nv -0.5 1 0.5\no floor\nusemtl white\nf 1 4 3 2\no lamp\nusemtl lamp\nf 5 6 7 8\n",
+    )
+    .unwrap();
+    let out = dir.path().join("level.pfm");
+    let (w, h) = (16usize, 12usize);
+    let mut args = vec!["render", obj.to_str().unwrap(), "--pfm", out.to_str().unwrap(), "--sides", "1"];
+    args.extend_from_slice(&["--width", "16", "--height", "12", "--spp", "1", "--gather", "none"]);
+    args.extend_from_slice(&["--camera-position", "-8,0.5,0", "--look-at", "0,0.5,0", "--fov", "40"]);
+    args.extend_from_slice(&QUICK);
+    let o = radiosity(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let px = pfm_pixels(&out);
+    assert_eq!(px.len(), w * h * 3);
+    // Pixels that see something lit, counted (the lamp is brighter than the whole floor).
+    let lit = |ys: std::ops::Range<usize>, xs: std::ops::Range<usize>| -> usize {
+        ys.flat_map(|y| xs.clone().map(move |x| (y * w + x) * 3))
+            .filter(|&i| px[i] + px[i + 1] + px[i + 2] > 0.0)
+            .count()
+    };
+    // PFM rows run from the bottom of the picture up.
+    let (bottom, top) = (lit(0..h / 2, 0..w), lit(h / 2..h, 0..w));
+    let (left, right) = (lit(0..h, 0..w / 2), lit(0..h, w / 2..w));
+    assert!(bottom > 3 * top, "the floor below the horizon: lit pixels below {bottom}, above {top}");
+    assert!(left.abs_diff(right) <= (left + right) / 8, "level: lit pixels left {left}, right {right}");
+}
+
 /// An up axis that is not one: one line, exit code 2, from the option and from the key.
 #[test]
 fn a_bad_up_axis_is_one_line_with_exit_code_2() {
