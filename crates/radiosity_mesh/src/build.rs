@@ -125,7 +125,7 @@ impl Mesh {
                 }
                 Shape::Sphere(s) => {
                     let mut b = SurfaceBuilder::default();
-                    mesh_sphere(&mut b, s, params);
+                    mesh_sphere(&mut b, s, params, scene.materials[o.material].is_emitter());
                     for pts in &b.patches {
                         mesh.occluders.extend((1..pts.len() - 1).map(|i| [pts[0], pts[i], pts[i + 1]]));
                     }

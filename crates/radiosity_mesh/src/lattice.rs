@@ -116,11 +116,20 @@ pub(crate) fn mesh_polygon(b: &mut SurfaceBuilder, poly: &Polygon, params: &Mesh
     }
 }
 
+/// Fewest latitude bands of an emitting sphere. Its facets are inscribed, so they hold less
+/// area than the sphere, and an emitter's power is its area times its exitance: at the six
+/// bands a lamp of a metre's radius got from 0.5 m elements, the sun sphere above Dabrovic's
+/// Sponza emitted 5.6 % too little and every surface came out 5–7 % dark against `verify`.
+/// The shortfall falls as the square of the bands: 24 leave about 0.5 %.
+const MIN_EMITTER_BANDS: usize = 24;
+
 /// A latitude/longitude tessellation; every facet is one patch and one element (a curved
-/// surface has no planar patch bigger than a facet).
-pub(crate) fn mesh_sphere(b: &mut SurfaceBuilder, s: &Sphere, params: &MeshParams) {
+/// surface has no planar patch bigger than a facet). An `emitting` sphere gets at least
+/// [`MIN_EMITTER_BANDS`] bands.
+pub(crate) fn mesh_sphere(b: &mut SurfaceBuilder, s: &Sphere, params: &MeshParams, emitting: bool) {
     use std::f64::consts::PI;
-    let n_lat = divisions(PI * s.radius, params.element_size).max(6);
+    let fewest = if emitting { MIN_EMITTER_BANDS } else { 6 };
+    let n_lat = divisions(PI * s.radius, params.element_size).max(fewest);
     let n_lon = divisions(2.0 * PI * s.radius, params.element_size).max(2 * n_lat).max(12);
     let sign = if s.facing == Facing::Inward { -1.0 } else { 1.0 };
     let dir = |k: usize, m: usize| {

@@ -106,6 +106,51 @@ fn sphere_facets_face_the_right_way() {
     }
 }
 
+/// An emitting sphere meshed with elements as large as its radius keeps its power: its facets
+/// hold within 0.6 % of the sphere's area (a lamp's power is its area times its exitance),
+/// where a grey one at the same size keeps the coarse mesh and falls short by more.
+#[test]
+fn an_emitting_sphere_keeps_its_area() {
+    let s = Sphere::try_new(DVec3::ZERO, 1.0, Facing::Outward).unwrap();
+    let exact = 4.0 * std::f64::consts::PI;
+    let params = MeshParams::try_new(1.0, 1.0).unwrap();
+    let area = |emission: Rgb| {
+        let m = Material::try_new("m", Rgb::splat(0.5), emission).unwrap();
+        let lamp = Material::try_new("lamp", Rgb::ZERO, Rgb::ONE).unwrap();
+        let quad = vec![
+            DVec3::new(5.0, 0.0, 0.0),
+            DVec3::new(5.0, 0.0, 1.0),
+            DVec3::new(5.0, 1.0, 1.0),
+            DVec3::new(5.0, 1.0, 0.0),
+        ];
+        let objects = vec![
+            Object {
+                name: "ball".into(),
+                material: 0,
+                shape: Shape::Sphere(s),
+                sides: radiosity_core::Sides::One,
+            },
+            Object {
+                name: "lamp".into(),
+                material: 1,
+                shape: Shape::Polygons(vec![Polygon::try_new(quad).unwrap()]),
+                sides: radiosity_core::Sides::One,
+            },
+        ];
+        let mesh = Mesh::build(&Scene::try_new("t", None, vec![m, lamp], objects).unwrap(), &params).unwrap();
+        let of_ball: Vec<_> = mesh
+            .elements
+            .iter()
+            .filter(|e| mesh.surfaces[mesh.patches[e.patch as usize].surface as usize].object == 0)
+            .collect();
+        (of_ball.iter().map(|e| e.area).sum::<f64>(), of_ball.len())
+    };
+    let (lamp, lamp_facets) = area(Rgb::ONE);
+    let (grey, grey_facets) = area(Rgb::ZERO);
+    assert!((exact - lamp) / exact < 0.006, "emitting: {lamp} of {exact}");
+    assert!((exact - grey) / exact > 0.02 && grey_facets < lamp_facets, "grey: {grey} of {exact}");
+}
+
 /// A flat n×n grid of unit squares in z = 0, each cut into two triangles.
 fn triangle_grid(n: u32) -> PolygonMesh {
     let positions = (0..=n).flat_map(|j| (0..=n).map(move |i| DVec3::new(i as f64, j as f64, 0.0))).collect();
