@@ -21,7 +21,7 @@ use rustc_hash::FxHashMap as HashMap;
 use glam::DVec3;
 
 use crate::planar::{
-    area, area_signed, bounds, clean, contains_within, distance_to_polygon, key, lexicographic, plane, split,
+    area, area_signed, bounds, contains_within, distance_to_polygon, key, lexicographic, plane, split,
     tolerance,
 };
 use radiosity_core::{Polygon, Scene, Shape};
@@ -381,10 +381,8 @@ impl<'a> Contacts<'a> {
         let whole = target.area();
         let tiny = 1e-9 * whole;
         // Seams first (lines across the surface), then the footprints out of their pieces.
-        let mut seamed = vec![target.vertices().to_vec()];
-        for seam in self.seams(std::slice::from_ref(&target.vertices()), n, id, both_sides) {
-            seamed = seams::cut_pieces(seamed, &seam, n, tiny);
-        }
+        let lines = self.seams(std::slice::from_ref(&target.vertices()), n, id, both_sides);
+        let seamed = seams::cut_along(target, &lines, n, tiny);
         let footprints = self.footprints(target, id);
         let mut pieces = seamed.clone();
         let mut hidden = 0.0;
@@ -402,17 +400,7 @@ impl<'a> Contacts<'a> {
         if !footprinted {
             (pieces, hidden) = (seamed.clone(), 0.0);
         }
-        let polygons = |pieces: Vec<Vec<DVec3>>| -> Option<Vec<Polygon>> {
-            let mut polygons = Vec::new();
-            for piece in pieces {
-                if area(&piece, n) <= tiny {
-                    continue;
-                }
-                // A piece the validation refuses (a sliver of round-off): keep the surface whole.
-                polygons.push(Polygon::try_new(clean(piece, target)).ok()?);
-            }
-            Some(polygons)
-        };
+        let polygons = |pieces: Vec<Vec<DVec3>>| seams::as_polygons(pieces, target, n, tiny);
         // Slivers mesh into many thin elements: footprints cut only when their pieces cost at
         // most four times the surface's elements. Seams are few and run across the surface
         // (strips, not wedges), and always cut.

@@ -132,23 +132,12 @@ impl Contacts<'_> {
     ) -> Option<Vec<Polygon>> {
         let n = target.normal();
         let seams = self.lines_across(std::slice::from_ref(&target.vertices()), n, id, both_sides, true);
-        if seams.is_empty() {
-            return None;
-        }
         let tiny = 1e-9 * target.area();
-        let mut pieces = vec![target.vertices().to_vec()];
-        for seam in &seams {
-            pieces = cut_pieces(pieces, seam, n, tiny);
-        }
+        let pieces = cut_along(target, &seams, n, tiny);
         if pieces.len() < 2 {
             return None;
         }
-        // A piece the validation refuses (a sliver of round-off): keep the face whole.
-        pieces
-            .into_iter()
-            .filter(|p| area(p, n) > tiny)
-            .map(|p| Polygon::try_new(clean(p, target)).ok())
-            .collect()
+        as_polygons(pieces, target, n, tiny)
     }
 
     /// The lines along which other faces meet the plane of `region` (see [`Self::seams`]);
@@ -262,6 +251,32 @@ impl Contacts<'_> {
         kept.truncate(MAX_SEAMS);
         kept.into_iter().map(|(_, s)| s).collect()
     }
+}
+
+/// The corners of the convex pieces of `target` (facing unit `n`) cut along `seams` (see
+/// [`cut_pieces`]).
+pub(crate) fn cut_along(target: &Polygon, seams: &[Seam], n: DVec3, tiny: f64) -> Vec<Vec<DVec3>> {
+    let mut pieces = vec![target.vertices().to_vec()];
+    for seam in seams {
+        pieces = cut_pieces(pieces, seam, n, tiny);
+    }
+    pieces
+}
+
+/// `pieces` of `target` (facing unit `n`) as polygons, those of at most `tiny` area left out;
+/// `None` when the validation refuses one (a sliver of round-off: the caller keeps `target`
+/// whole).
+pub(crate) fn as_polygons(
+    pieces: Vec<Vec<DVec3>>,
+    target: &Polygon,
+    n: DVec3,
+    tiny: f64,
+) -> Option<Vec<Polygon>> {
+    pieces
+        .into_iter()
+        .filter(|p| area(p, n) > tiny)
+        .map(|p| Polygon::try_new(clean(p, target)).ok())
+        .collect()
 }
 
 /// Convex `pieces` (on the plane of unit normal `n`) cut along `seam`: a piece with more
