@@ -21,7 +21,7 @@
 //!   cluster, Willmott, Heckbert & Garland 1999, §4);
 //! * near, by [`POINTS`] points drawn over the members by unshot power, each a disc of
 //!   1/[`POINTS`] of the area (Wallace, Elmquist & Haines 1989: a cos θ cos θ' / (π r² + a),
-//!   finite at contact);
+//!   finite at contact); an emitting group's direct light so at every distance;
 //! * visibility: `dim_rays` rays per receiving element (`visibility_rays` when the group is
 //!   bright) to those points, through the scene's ray structure.
 //!

@@ -137,6 +137,7 @@ impl Aim<'_> {
         let mut rng = Rng::for_task(seed, stream, e as u64);
         let (mut visible, mut traced) = (0u32, 0u32);
         let (mut walked, mut at) = (0.0, 0);
+        let mut far_cdf = None;
         for j in 0..rays {
             let target = if near {
                 let t = (f64::from(j) + rng.next_f64()) / f64::from(rays) * f;
@@ -158,9 +159,21 @@ impl Aim<'_> {
                         break;
                     }
                 }
-                found
+                // Few of the group's points face the receiver (a cap of a sphere seen from
+                // its side): the same draw from the points' weights, which rejection only
+                // spares computing. Counting such a receiver unblocked lit the backs of
+                // Sponza's walls through the building from its sun sphere.
+                found.or_else(|| {
+                    let cdf = far_cdf.get_or_insert_with(|| far_weights(frozen, p, el.normal));
+                    draw(cdf, rng.next_f64())
+                })
             };
-            let Some(i) = target else { continue };
+            let Some(i) = target else {
+                // No point of the group both faces the receiver and is faced by it: no
+                // light reaches it that way, a blocked ray.
+                traced += 1;
+                continue;
+            };
             let (u, v) = (rng.next_f64() as f32, rng.next_f64() as f32);
             let from = Vec3::from(point_on_f32(corners, u, v));
             visible += u32::from(!accel.occluded(from, frozen.lifted[i]));
@@ -168,6 +181,35 @@ impl Aim<'_> {
         }
         (visible, traced)
     }
+}
+
+/// The cumulative weights of a group's points for a far receiver at `p` with normal `n`:
+/// cos θ at the point where the point and the receiver face each other, else 0 (the
+/// distribution [`Aim::trace`] draws far ray ends from by rejection).
+fn far_weights(frozen: &Frozen, p: DVec3, n: DVec3) -> [f64; POINTS] {
+    let mut cdf = [0.0; POINTS];
+    let mut sum = 0.0;
+    for (c, (q, nq, _)) in cdf.iter_mut().zip(&frozen.points) {
+        let d = p - *q;
+        if n.dot(-d) > 0.0 {
+            sum += (nq.dot(d) / d.length()).max(0.0);
+        }
+        *c = sum;
+    }
+    // A group with fewer points than `POINTS` leaves the rest at the total (never drawn).
+    cdf[frozen.points.len().min(POINTS)..].fill(sum);
+    cdf
+}
+
+/// The point drawn from cumulative weights `cdf` by `u` in [0, 1), or `None` when they are
+/// all 0.
+fn draw(cdf: &[f64; POINTS], u: f64) -> Option<usize> {
+    let total = cdf[POINTS - 1];
+    if total.is_nan() || total <= 0.0 {
+        return None;
+    }
+    let t = u * total;
+    Some(cdf.partition_point(|&c| c <= t).min(POINTS - 1))
 }
 
 /// The form factor from a receiver at `p` (normal `n`, on patch `patch`) to the group,
@@ -189,7 +231,12 @@ pub(super) fn unoccluded(
         return (0.0, false);
     }
     let r2 = to_centre.length_squared();
-    if r2 > (FAR * group.radius).powi(2) {
+    // An emitting group takes its points at any distance: its shot is the direct light, and
+    // the far field's one normal per bin, clamped once, misplaces it. On Sponza's sun sphere
+    // (12 groups, direct light against the path tracer) the far field put the roof +6.6 %,
+    // the parapet +8.0 %, the walls −4.1 %, a gallery floor −11.6 %; the points: −1.5 %,
+    // 0.0 %, −0.3 %, −1.7 %, for 0.3 s more over 240 k elements.
+    if !group.emits && r2 > (FAR * group.radius).powi(2) {
         let r = r2.sqrt();
         let d = -to_centre / r; // from the group towards the receiver
         let cos_r = -n.dot(d);

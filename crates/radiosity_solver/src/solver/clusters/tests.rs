@@ -8,8 +8,13 @@ use radiosity_core::{Material, MeshParams, Object, PolygonMesh, Scene, Shape, Si
 use radiosity_scenes::cornell_box;
 
 /// A latitude–longitude sphere of `rings × segments` planar quads (triangles at the
-/// poles), facing outwards: every facet its own surface.
+/// poles), facing outwards: every facet its own surface, emitting 1.
 fn globe(rings: u32, segments: u32) -> Mesh {
+    globe_emitting(rings, segments, 1.0)
+}
+
+/// [`globe`] emitting `emission`.
+fn globe_emitting(rings: u32, segments: u32, emission: f64) -> Mesh {
     use std::f64::consts::{PI, TAU};
     let mut positions = Vec::new();
     for i in 0..=rings {
@@ -31,10 +36,10 @@ fn globe(rings: u32, segments: u32) -> Mesh {
             }
         }
     }
-    let white = Material::try_new("white", Rgb::splat(0.5), Rgb::splat(1.0)).unwrap();
+    let white = Material::try_new("white", Rgb::splat(0.5), Rgb::splat(emission)).unwrap();
     let globe = PolygonMesh::try_new(positions, faces).unwrap();
     let object = Object { name: "globe".into(), material: 0, shape: Shape::Mesh(globe), sides: Sides::One };
-    let scene = Scene::try_new("globe", None, vec![white], vec![object]).unwrap();
+    let scene = Scene::try_new_unlit("globe", None, vec![white], vec![object]).unwrap();
     Mesh::build(&scene, &MeshParams::try_new(1.0, 1.0).unwrap()).unwrap()
 }
 
@@ -167,9 +172,15 @@ fn the_brightest_shooter_follows_changed_patches() {
 }
 
 /// The 24 × 48 globe grouped, unit unshot radiosity everywhere, and the groups `pick`
-/// chooses from the number of groups frozen (returned with the mesh and the clusters).
+/// chooses from the number of groups frozen (returned with the mesh and the clusters). It
+/// reflects light only: an emitting group has no far field.
 fn frozen_globe(pick: impl Fn(usize) -> Vec<usize>) -> (Mesh, Clusters, Vec<usize>) {
-    let mesh = globe(24, 48);
+    frozen_globe_emitting(pick, 0.0)
+}
+
+/// [`frozen_globe`] emitting `emission`.
+fn frozen_globe_emitting(pick: impl Fn(usize) -> Vec<usize>, emission: f64) -> (Mesh, Clusters, Vec<usize>) {
+    let mesh = globe_emitting(24, 48, emission);
     let mut clusters = Clusters::new(&mesh, true);
     let unshot = vec![Rgb::splat(1.0); mesh.elements.len()];
     let tables = MeshTables::new(&mesh);
@@ -274,5 +285,64 @@ fn the_far_field_is_the_members_sum() {
                 .sum();
             assert!((far / exact - 1.0).abs() < 0.02, "group {g}, tilt {tilt}: {far} vs {exact}");
         }
+    }
+}
+
+/// An emitting group lights a receiver by its points at any distance, where the far field's
+/// one normal per bin misplaces its direct light. Receivers 3.5 group radii from a group's
+/// centre, facing it, along its mean normal tilted by 0°, 50° and 75°: the points' form
+/// factor against the members' exact point-to-polygon sum, and the far field (the same
+/// group reflecting) against it. Measured on three groups: the points within −1.56 … +0.25 %,
+/// the far field +4.4 … +6.2 % along the normal and −3.0 … −14.9 % at 75°. Asserted: the
+/// points within 2 %, and nearer than the far field at each group's worst receiver.
+#[test]
+fn an_emitting_group_lights_receivers_by_its_points_at_any_distance() {
+    let pick = |n: usize| vec![0, n / 3, n / 2];
+    let (mesh, lit, groups) = frozen_globe_emitting(pick, 1.0);
+    let (_, dark, _) = frozen_globe(pick);
+    for g in groups {
+        let group = lit.group(g);
+        let sum = |k: usize| {
+            let frozen = dark.groups[g].frozen.as_ref().unwrap();
+            frozen.axes.iter().map(|a| f64::from(a[k].element_sum())).sum::<f64>()
+        };
+        let axis = DVec3::new(sum(0), sum(1), sum(2)).normalize();
+        let side = axis.any_orthonormal_vector();
+        let (mut worst, mut worst_far) = (0.0f64, 0.0f64);
+        for tilt in [0.0f64, 50.0, 75.0] {
+            let t = tilt.to_radians();
+            let dir = axis * t.cos() + side * t.sin();
+            let p = group.centre + dir * 3.5 * group.radius;
+            let n = -dir;
+            let exact: f64 = (group.patches.iter())
+                .map(|&q| {
+                    let patch = &mesh.patches[q as usize];
+                    let in_front = patch.normal.dot(p - patch.centre) > 0.0;
+                    if in_front { crate::form_factor::point_to_polygon(p, n, patch.corners()) } else { 0.0 }
+                })
+                .sum();
+            let mut shares = [0.0; POINTS];
+            let (points, near) =
+                unoccluded(group, lit.groups[g].frozen.as_ref().unwrap(), p, n, u32::MAX, &mut shares);
+            let (far, far_near) = unoccluded(
+                dark.group(g),
+                dark.groups[g].frozen.as_ref().unwrap(),
+                p,
+                n,
+                u32::MAX,
+                &mut shares,
+            );
+            let (points, far) = (points / exact - 1.0, far / exact - 1.0);
+            println!(
+                "group {g}, tilt {tilt}°: points {:+.2} %, far field {:+.2} %",
+                points * 100.0,
+                far * 100.0
+            );
+            assert!(near && !far_near, "group {g}, tilt {tilt}°: the emitting group takes its points");
+            assert!(points.abs() < 0.02, "group {g}, tilt {tilt}°: points {points:+.4} off the exact sum");
+            worst = worst.max(points.abs());
+            worst_far = worst_far.max(far.abs());
+        }
+        assert!(worst < worst_far, "group {g}: points {worst:.4} against the far field {worst_far:.4}");
     }
 }
