@@ -135,7 +135,8 @@ pub fn run(a: VerifyArgs) -> Result<()> {
         scale_solver_reflectance(&mut mesh, k)?;
         let rays = prepared.problem.ray_queries().clone();
         prepared.problem = Problem::with_ray_queries(Arc::new(mesh), rays)
-            .with_luminaires(prepared.scene.lighting.luminaires.clone());
+            .with_luminaires(prepared.scene.lighting.luminaires.clone())
+            .with_sun(prepared.scene.lighting.sun);
     }
     let (solver, report) = run_solver(&prepared)?;
     let Prepared { scene, problem, .. } = &prepared;

@@ -438,6 +438,23 @@ impl Grid {
     }
 }
 
+/// Sunlight: parallel light from a direction at infinity, the sun's 0.53° disc taken as a
+/// point (its shadows sharp). It shoots first, exactly, as the luminaires do.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sun {
+    /// Unit direction from the scene towards the sun.
+    pub towards: DVec3,
+    /// Irradiance on a plane facing the sun, W/unit² per channel.
+    pub irradiance: Rgb,
+}
+
+impl Sun {
+    /// Irradiance on a surface of unit normal `n` when nothing is in the way: E cos θ.
+    pub fn irradiance_on(&self, n: DVec3) -> Rgb {
+        self.irradiance * n.dot(self.towards).max(0.0)
+    }
+}
+
 /// The photometric part of a scene: its unit, luminaires and grids.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Lighting {
@@ -448,6 +465,8 @@ pub struct Lighting {
     pub luminaires: Vec<Luminaire>,
     /// Calculation grids.
     pub grids: Vec<Grid>,
+    /// Sunlight, when the scene has it.
+    pub sun: Option<Sun>,
 }
 
 impl Lighting {
@@ -473,6 +492,9 @@ impl Lighting {
             l.nadir = f(l.nadir);
             l.c0 = f(l.c0);
             l.c90 = f(l.c90);
+        }
+        if let Some(sun) = &mut self.sun {
+            sun.towards = f(sun.towards);
         }
         for g in &mut self.grids {
             g.origin = f(g.origin);

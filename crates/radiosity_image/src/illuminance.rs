@@ -17,10 +17,10 @@
 use std::f64::consts::PI;
 
 use glam::DVec3;
-use radiosity_accel::RayQuery;
+use radiosity_accel::{Bvh, RayQuery};
 use radiosity_core::random::Rng;
 use radiosity_core::{Grid, Lighting, Rgb};
-use radiosity_solver::Solution;
+use radiosity_solver::{Solution, hull_triangles};
 use rayon::prelude::*;
 
 use crate::gather::cosine_direction;
@@ -93,7 +93,7 @@ pub fn luminaire_irradiance(lighting: &Lighting, blockers: &dyn RayQuery, p: DVe
         .sum()
 }
 
-/// The illuminance of every point of `grid`: the luminaires' direct light by shadow rays
+/// The illuminance of every point of `grid`: the luminaires' and the sun's direct light by shadow rays
 /// against `blockers` (the solver's occluders), the reflected light gathered from `solution`
 /// through `renderer`.
 ///
@@ -122,13 +122,25 @@ pub fn grid_illuminance(
     let lift = 1e-6 * (hi - lo).length().max(f64::MIN_POSITIVE);
     let points = grid.points();
     let n = grid.normal.normalize();
+    // The sun's shadow rays leave the scene: a room's own walls, which no ray between two of
+    // its surface points crosses and `blockers` leaves out, block them too.
+    let hull = lighting.sun.map(|_| Bvh::new(&hull_triangles(renderer.mesh())));
+    let reach = 2.0 * (hi - lo).length();
+    let sunlight = |from: DVec3, n: DVec3| match (&lighting.sun, &hull) {
+        (Some(sun), Some(hull)) => {
+            let to = (from + sun.towards * reach).as_vec3();
+            let clear = !blockers.occluded(from.as_vec3(), to) && !hull.occluded(from.as_vec3(), to);
+            if clear { sun.irradiance_on(n) } else { Rgb::ZERO }
+        }
+        _ => Rgb::ZERO,
+    };
     let columns = f64::from(params.gather_rays).sqrt().ceil() as u32;
     let rows = params.gather_rays.div_ceil(columns);
     let values: Vec<(f64, f64)> = points
         .par_iter()
         .enumerate()
         .map(|(i, &p)| {
-            let direct = luminaire_irradiance(lighting, blockers, p, n);
+            let direct = luminaire_irradiance(lighting, blockers, p, n) + sunlight(p + n * lift, n);
             let mut rng = Rng::for_task(params.seed, GRID_TASK, i as u64);
             let origin = p + n * lift;
             let mut gathered = Rgb::ZERO;

@@ -89,6 +89,27 @@ pub(crate) struct SceneDesc {
     /// `[[grid]]` entries (calculation grids).
     #[serde(default)]
     pub(crate) grid: Vec<Spanned<GridDesc>>,
+    /// `[sun]`: parallel light from a direction at infinity.
+    pub(crate) sun: Option<Spanned<SunDesc>>,
+}
+
+/// `[sun]`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct SunDesc {
+    /// Direction from the scene towards the sun, in the file's frame.
+    #[serde(deserialize_with = "point_opt", default)]
+    pub(crate) direction: Option<Spanned<[f64; 3]>>,
+    /// Illuminance on a plane facing the sun, lx (clear noon: about 100 000).
+    pub(crate) illuminance: Option<Spanned<f64>>,
+    /// Irradiance on a plane facing the sun, W/unit² per channel, as `emission` is given.
+    #[serde(deserialize_with = "point_opt", default)]
+    pub(crate) irradiance: Option<Spanned<[f64; 3]>>,
+    /// Linear RGB colour of `illuminance`'s light, scaled to luminance 1; default white.
+    #[serde(deserialize_with = "point_opt", default)]
+    pub(crate) colour: Option<Spanned<[f64; 3]>>,
+    /// Colour as a correlated colour temperature, K.
+    pub(crate) cct: Option<Spanned<f64>>,
 }
 
 /// `[camera]`.

@@ -9,12 +9,12 @@ use std::sync::Arc;
 use radiosity_core::glam::DVec3;
 use radiosity_core::{
     Grid, IntensityTable, LUMENS_PER_WATT, LengthUnit, Lighting, Luminaire, Material, Object, Rgb, Shape,
-    Sides, UpAxis, colour_of_cct, unit_luminance,
+    Sides, Sun, UpAxis, colour_of_cct, unit_luminance,
 };
 use toml::Spanned;
 
 use crate::LoadError;
-use crate::desc::{MaterialDesc, SceneDesc};
+use crate::desc::{MaterialDesc, SceneDesc, SunDesc};
 use crate::locate::Locator;
 use crate::photometric::load_photometry;
 
@@ -182,6 +182,54 @@ fn direction(loc: &Locator, key: String, v: &Spanned<[f64; 3]>) -> Result<DVec3,
     } else {
         Err(loc.at(v.span(), key, "a direction must not be zero"))
     }
+}
+
+/// The `[sun]` table: a direction and either lux (with a colour) or W/unit².
+fn sun(loc: &Locator, d: &Spanned<SunDesc>, unit: LengthUnit) -> Result<Sun, LoadError> {
+    let (span, d) = (d.span(), d.get_ref());
+    let Some(towards) = &d.direction else {
+        return Err(loc.at(span, "sun.direction", "the sun needs direction = [x, y, z] (towards the sun)"));
+    };
+    let towards = direction(loc, "sun.direction".into(), towards)?;
+    let irradiance = match (&d.illuminance, &d.irradiance) {
+        (Some(lx), None) => {
+            let colour = light_colour(loc, "sun", d.colour.as_ref(), d.cct.as_ref())?;
+            colour * (positive(loc, "sun.illuminance".into(), lx)? / unit.lux_per_irradiance())
+        }
+        (None, Some(w)) => {
+            if let Some(c) = &d.colour {
+                return Err(loc.at(
+                    c.span(),
+                    "sun.colour",
+                    "irradiance has its own colour; colour goes with illuminance",
+                ));
+            }
+            let e = Rgb::from_array(*w.get_ref());
+            if !(e.is_finite() && e.min_channel() >= 0.0 && e.max_channel() > 0.0) {
+                return Err(loc.at(
+                    w.span(),
+                    "sun.irradiance",
+                    "irradiance must be finite, ≥ 0 and not black",
+                ));
+            }
+            e
+        }
+        (Some(lx), Some(_)) => {
+            return Err(loc.at(
+                lx.span(),
+                "sun.illuminance",
+                "give illuminance (lx) or irradiance (W/unit²), not both",
+            ));
+        }
+        (None, None) => {
+            return Err(loc.at(
+                span,
+                "sun",
+                "the sun needs illuminance = <lx> or irradiance = [r, g, b] (W/unit²)",
+            ));
+        }
+    };
+    Ok(Sun { towards, irradiance })
 }
 
 /// The `[[luminaire]]` and `[[grid]]` entries, in the file's frame (`up`: the file's up axis,
@@ -374,7 +422,8 @@ pub(crate) fn lighting(
         });
         grids.push(Grid { name, origin, u, v, divisions, normal, height });
     }
-    Ok(Lighting { units, luminaires, grids })
+    let sun = desc.sun.as_ref().map(|d| sun(loc, d, unit)).transpose()?;
+    Ok(Lighting { units, luminaires, grids, sun })
 }
 
 /// How far a surface's grid points stand off it, metres.

@@ -100,6 +100,9 @@ pub(crate) struct Geometry {
     pub offset: f64,
     /// The scene's point luminaires (next-event estimation towards each, every vertex).
     pub luminaires: Vec<radiosity_core::Luminaire>,
+    /// The scene's sun (next-event estimation towards it, every vertex) and how far a shadow
+    /// ray towards it reaches: past the scene.
+    pub sun: Option<(radiosity_core::Sun, f64)>,
 }
 
 /// Index of the first entry of the non-decreasing `cdf` that exceeds `u · total`.
@@ -128,6 +131,7 @@ impl Geometry {
             emitter_cdf: Vec::new(),
             offset: 0.0,
             luminaires: scene.lighting.luminaires.clone(),
+            sun: None,
         };
         for (oi, o) in scene.objects.iter().enumerate() {
             let material = &scene.materials[o.material];
@@ -219,6 +223,7 @@ impl Geometry {
         g.bvh = Bvh::new(&f32_triangles);
         let (lo, hi) = scene.bounds();
         g.offset = 1e-5 * (hi - lo).length().max(f64::MIN_POSITIVE);
+        g.sun = scene.lighting.sun.map(|s| (s, 2.0 * (hi - lo).length().max(f64::MIN_POSITIVE)));
         g
     }
 

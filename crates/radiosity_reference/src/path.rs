@@ -60,12 +60,21 @@ impl Geometry {
 
     /// Irradiance at `p` (unit normal `n`) straight from the point luminaires: each one's
     /// I(C, γ) · cos θ / d² when a shadow ray to it is clear (a point light cannot be met by
-    /// a bounce, so its next-event estimate is the whole of it, with no noise but visibility).
+    /// a bounce, so its next-event estimate is the whole of it, with no noise but visibility);
+    /// and from the sun, E cos θ when a shadow ray towards it leaves the scene (a direction,
+    /// met by no bounce either).
     pub(crate) fn luminaire_irradiance(&self, p: DVec3, n: DVec3) -> Rgb {
         let mut sum = Rgb::ZERO;
+        let from = p + n * self.offset;
         for l in &self.luminaires {
             let h = l.irradiance_unblocked(p, n);
-            if h.max_channel() > 0.0 && !self.occluded(p + n * self.offset, l.position) {
+            if h.max_channel() > 0.0 && !self.occluded(from, l.position) {
+                sum += h;
+            }
+        }
+        if let Some((sun, reach)) = &self.sun {
+            let h = sun.irradiance_on(n);
+            if h.max_channel() > 0.0 && !self.occluded(from, from + sun.towards * *reach) {
                 sum += h;
             }
         }
@@ -91,8 +100,11 @@ impl Geometry {
     /// balance heuristic against the cosine-sampled bounce (Veach & Guibas 1995), plus the
     /// luminaires' exact share.
     fn direct_irradiance(&self, x: &SurfacePoint, rng: &mut Rng) -> Rgb {
-        let luminaires =
-            if self.luminaires.is_empty() { Rgb::ZERO } else { self.luminaire_irradiance(x.p, x.n) };
+        let luminaires = if self.luminaires.is_empty() && self.sun.is_none() {
+            Rgb::ZERO
+        } else {
+            self.luminaire_irradiance(x.p, x.n)
+        };
         if self.emitters.is_empty() {
             return luminaires;
         }

@@ -22,10 +22,10 @@ pub(crate) fn blocking_triangles(mesh: &Mesh) -> Vec<[DVec3; 3]> {
     split_triangles(mesh).0
 }
 
-/// The occluder triangles that [`blocking_triangles`] leaves out: those with every surface
+/// The occluder triangles that [`occluder_triangles`] leaves out: those with every surface
 /// point in front of them (a box room's walls). No ray between two surface points crosses
-/// them, but a ray leaving the scene from inside a closed room meets them.
-pub(crate) fn hull_triangles(mesh: &Mesh) -> Vec<[Vec3; 3]> {
+/// them, but a ray leaving the scene from inside a closed room (towards the sun) meets them.
+pub fn hull_triangles(mesh: &Mesh) -> Vec<[Vec3; 3]> {
     split_triangles(mesh).1.iter().map(|t| t.map(|p| p.as_vec3())).collect()
 }
 

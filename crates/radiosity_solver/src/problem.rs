@@ -8,7 +8,7 @@
 use std::sync::Arc;
 
 use radiosity_accel::{Bvh, RayQuery};
-use radiosity_core::{Luminaire, MeshParams, Rgb, Scene};
+use radiosity_core::{Luminaire, MeshParams, Rgb, Scene, Sun};
 use radiosity_mesh::{MAX_ELEMENTS, Mesh, MeshError, Refinement};
 
 use crate::solution::VertexElements;
@@ -121,6 +121,8 @@ pub struct Problem {
     unrefined_elements: usize,
     /// The scene's point luminaires, which shoot first in every solver made here.
     luminaires: Arc<[Luminaire]>,
+    /// The scene's sun, which shoots first too.
+    sun: Option<Sun>,
 }
 
 impl Problem {
@@ -139,7 +141,8 @@ impl Problem {
     /// [`MeshError`] when the scene cannot be meshed with these sizes (too many elements, …).
     pub fn new(scene: &Scene, mesh_params: &MeshParams) -> Result<Self, MeshError> {
         let problem = Self::from_mesh(Arc::new(Mesh::build(scene, mesh_params)?))
-            .with_luminaires(scene.lighting.luminaires.clone());
+            .with_luminaires(scene.lighting.luminaires.clone())
+            .with_sun(scene.lighting.sun);
         Ok(problem.refined(scene, mesh_params))
     }
 
@@ -184,7 +187,8 @@ impl Problem {
             match Mesh::build_refined(scene, params, &refinement) {
                 Ok(m) => {
                     problem = Self::with_ray_queries(Arc::new(m), problem.ray_queries.clone())
-                        .with_luminaires(problem.luminaires.to_vec());
+                        .with_luminaires(problem.luminaires.to_vec())
+                        .with_sun(problem.sun);
                 }
                 Err(_) => break,
             }
@@ -198,7 +202,13 @@ impl Problem {
     pub fn from_mesh(mesh: Arc<Mesh>) -> Self {
         let ray_queries = Arc::new(Bvh::new(&occluder_triangles(&mesh)));
         let unrefined_elements = mesh.elements.len();
-        Self { mesh, ray_queries, unrefined_elements, luminaires: Arc::from([]) }
+        Self { mesh, ray_queries, unrefined_elements, luminaires: Arc::from([]), sun: None }
+    }
+
+    /// The same problem lit by the `sun` too (it shoots first in every solver made from it).
+    pub fn with_sun(mut self, sun: Option<Sun>) -> Self {
+        self.sun = sun;
+        self
     }
 
     /// The same problem lit by `luminaires` too (each shoots first in every solver made
@@ -218,7 +228,7 @@ impl Problem {
     /// against it). The backend must answer for the occluders of `mesh`.
     pub fn with_ray_queries(mesh: Arc<Mesh>, ray_queries: Arc<dyn RayQuery>) -> Self {
         let unrefined_elements = mesh.elements.len();
-        Self { mesh, ray_queries, unrefined_elements, luminaires: Arc::from([]) }
+        Self { mesh, ray_queries, unrefined_elements, luminaires: Arc::from([]), sun: None }
     }
 
     /// How many elements the mesh had before adaptive subdivision (its own count when it was
@@ -242,7 +252,13 @@ impl Problem {
     /// # Errors
     /// As [`Solver::new`]: out-of-range params, a scene that emits nothing.
     pub fn solver(&self, params: SolverParams) -> Result<Solver, SolverError> {
-        Solver::with_luminaires(self.mesh.clone(), self.ray_queries.clone(), params, &self.luminaires)
+        Solver::with_lights(
+            self.mesh.clone(),
+            self.ray_queries.clone(),
+            params,
+            &self.luminaires,
+            self.sun.as_ref(),
+        )
     }
 }
 

@@ -9,13 +9,18 @@
 //! sides, weighted by their areas (one point per side; second order, so a room's elements of
 //! a few centimetres integrate the 1/d² falloff to well under 0.1 %).
 //!
+//! The sun ([`Sun`]) shoots first the same way: E_sun cos θ at each sample point whose
+//! shadow ray towards the sun leaves the scene unblocked, by the blocking triangles or the
+//! hull's (see `occluders`). Its power is what the elements
+//! receive (light from infinity has no total of its own), so none of it escapes.
+//!
 //! The luminaires' light is not the emitters' *direct part* (`Tally::direct`): a
 //! final gather recomputes only area emitters per pixel, and takes this light from the
 //! solution.
 
-use radiosity_accel::RayQuery;
+use radiosity_accel::{Bvh, RayQuery};
 use radiosity_core::glam::DVec3;
-use radiosity_core::{LUMENS_PER_WATT, Luminaire, Rgb};
+use radiosity_core::{LUMENS_PER_WATT, Luminaire, Rgb, Sun};
 use radiosity_mesh::Mesh;
 use rayon::prelude::*;
 
@@ -30,21 +35,35 @@ pub(super) struct LuminaireLight {
 }
 
 impl LuminaireLight {
-    /// The direct light of `luminaires` on the elements of `mesh`, shadowed by `rays`; `None`
-    /// without luminaires.
-    pub(super) fn new(mesh: &Mesh, rays: &dyn RayQuery, luminaires: &[Luminaire]) -> Option<Self> {
-        if luminaires.is_empty() {
+    /// The direct light of `luminaires` and the `sun` on the elements of `mesh`, shadowed by
+    /// `rays`; `None` without either.
+    pub(super) fn new(
+        mesh: &Mesh,
+        rays: &dyn RayQuery,
+        luminaires: &[Luminaire],
+        sun: Option<&Sun>,
+    ) -> Option<Self> {
+        if luminaires.is_empty() && sun.is_none() {
             return None;
         }
         let (lo, hi) = mesh.bounds();
-        let lift = 1e-6 * (hi - lo).length().max(f64::MIN_POSITIVE);
-        let irradiance = (0..mesh.elements.len())
+        let diagonal = (hi - lo).length().max(f64::MIN_POSITIVE);
+        let lift = 1e-6 * diagonal;
+        // A shadow ray towards the sun ends past the scene, twice its diagonal from any point,
+        // so the triangles no ray between two surface points can cross (a room's own walls,
+        // left out of `rays`) block it too.
+        let hull = sun.map(|_| Bvh::new(&crate::occluders::hull_triangles(mesh)));
+        let sun = sun.zip(hull.as_ref()).map(|(s, hull)| (s, 2.0 * diagonal, hull));
+        let both: Vec<(Rgb, Rgb)> = (0..mesh.elements.len())
             .into_par_iter()
             .with_min_len(64)
-            .map(|e| element_irradiance(mesh, e, rays, luminaires, lift))
+            .map(|e| element_irradiance(mesh, e, rays, luminaires, sun, lift))
             .collect();
-        let power = luminaires.iter().map(|l| l.colour * (l.flux() / LUMENS_PER_WATT)).sum();
-        Some(Self { irradiance, power, count: luminaires.len() })
+        let sun_power: Rgb = both.iter().zip(&mesh.elements).map(|((_, s), el)| *s * el.area).sum();
+        let irradiance = both.into_iter().map(|(l, s)| l + s).collect();
+        let power =
+            luminaires.iter().map(|l| l.colour * (l.flux() / LUMENS_PER_WATT)).sum::<Rgb>() + sun_power;
+        Some(Self { irradiance, power, count: luminaires.len() + usize::from(sun.is_some()) })
     }
 
     /// Whether no light arrives anywhere.
@@ -76,13 +95,16 @@ fn sample_points(mesh: &Mesh, e: usize) -> ([(DVec3, f64); 4], usize) {
     }
 }
 
+/// Element `e`'s direct irradiance from the luminaires and from the sun (with the length of
+/// its shadow rays), apart.
 fn element_irradiance(
     mesh: &Mesh,
     e: usize,
     rays: &dyn RayQuery,
     luminaires: &[Luminaire],
+    sun: Option<(&Sun, f64, &Bvh)>,
     lift: f64,
-) -> Rgb {
+) -> (Rgb, Rgb) {
     let n = mesh.elements[e].normal;
     let (points, count) = sample_points(mesh, e);
     let mut sum = Rgb::ZERO;
@@ -97,5 +119,18 @@ fn element_irradiance(
             }
         }
     }
-    sum
+    let mut sunlight = Rgb::ZERO;
+    if let Some((sun, reach, hull)) = sun {
+        let h = sun.irradiance_on(n);
+        if h.max_channel() > 0.0 {
+            for &(p, w) in &points[..count] {
+                let from = p + n * lift;
+                let to = (from + sun.towards * reach).as_vec3();
+                if !rays.occluded(from.as_vec3(), to) && !hull.occluded(from.as_vec3(), to) {
+                    sunlight += h * w;
+                }
+            }
+        }
+    }
+    (sum, sunlight)
 }

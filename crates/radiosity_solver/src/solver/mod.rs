@@ -146,9 +146,24 @@ impl Solver {
         params: SolverParams,
         luminaires: &[radiosity_core::Luminaire],
     ) -> Result<Self, SolverError> {
+        Self::with_lights(mesh, accel, params, luminaires, None)
+    }
+
+    /// [`Solver::with_luminaires`] with the `sun` shooting first too, the same way (its
+    /// direct light by shadow rays towards it).
+    ///
+    /// # Errors
+    /// As [`Solver::with_luminaires`], the sun counting as a luminaire.
+    pub fn with_lights(
+        mesh: Arc<Mesh>,
+        accel: Arc<dyn RayQuery>,
+        params: SolverParams,
+        luminaires: &[radiosity_core::Luminaire],
+        sun: Option<&radiosity_core::Sun>,
+    ) -> Result<Self, SolverError> {
         params.validate()?;
         mesh_tables::check_patch_runs(&mesh)?;
-        let light = luminaires::LuminaireLight::new(&mesh, accel.as_ref(), luminaires);
+        let light = luminaires::LuminaireLight::new(&mesh, accel.as_ref(), luminaires, sun);
         let tally = Tally::lit(&mesh, light.as_ref())?;
         let mut clusters = Clusters::new(&mesh, params.clustering);
         clusters.sum(&tally.patch_abs);
