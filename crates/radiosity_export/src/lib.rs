@@ -11,8 +11,8 @@
 //!   [`VertexColours`] for what `COLOR_0` holds. An object with a colour texture (and texture
 //!   coordinates, [`radiosity_image::element_uvs`]) also gets `TEXCOORD_0` per element corner
 //!   and an unlit material showing the texture, its PNG embedded in the file's buffer; its
-//!   `COLOR_0` is then the colour over the material's mean reflectance, so texel × colour is
-//!   what `render` shows (see the `textured` module).
+//!   `COLOR_0` is then the colour over the material's mean reflectance (clamped to 1), so
+//!   texel × colour is what `render` shows (see the `textured` module).
 //! * PLY: binary little endian; per vertex `float x y z`, `uchar red green blue` (sRGB-encoded
 //!   display colour, what PLY viewers show) and `float radiosity_r radiosity_g radiosity_b`
 //!   (linear B); faces are the elements' triangles (a quad element gives two, as in glTF) as
@@ -43,7 +43,7 @@ use radiosity_mesh::Mesh;
 use radiosity_solver::Solution;
 use rayon::prelude::*;
 use serde_json::{Value, json};
-use textured::TexturedMaterials;
+use textured::{TexturedMaterials, push_view};
 
 mod textured;
 
@@ -153,21 +153,6 @@ pub fn gltf_vertex_count(mesh: &Mesh, uvs: &[Option<ElementUvs>]) -> usize {
     objects_of(mesh, uvs).iter().map(|o| o.verts.len()).sum()
 }
 
-/// Appends `bytes` to `blob`, padded to 4 bytes, and returns the buffer view's JSON (an
-/// image's view has no target).
-fn push_view(blob: &mut Vec<u8>, bytes: &[u8], target: Option<u32>) -> Value {
-    let offset = blob.len();
-    blob.extend_from_slice(bytes);
-    while !blob.len().is_multiple_of(4) {
-        blob.push(0);
-    }
-    let mut view = json!({ "buffer": 0, "byteOffset": offset, "byteLength": bytes.len() });
-    if let Some(target) = target {
-        view["target"] = target.into();
-    }
-    view
-}
-
 /// The glTF document (JSON) and its binary buffer for `mesh` with `colours` per vertex.
 /// With `uri`, the buffer is referenced by it (a data URI for `.gltf`); without, it is the
 /// GLB's own chunk.
@@ -200,8 +185,10 @@ fn gltf_document(
         let mut col = Vec::with_capacity(verts.len() * 12);
         for &(v, _) in &verts {
             for (c, s) in colours[v as usize].to_array().into_iter().zip(scale) {
-                // glTF colours are linear and non-negative; a tiny negative from round-off is 0.
-                col.extend_from_slice(&((c * s).max(0.0) as f32).to_le_bytes());
+                // glTF colours are linear and in [0, 1] (the validator's ACCESSOR_NON_CLAMPED):
+                // a tiny negative from round-off is 0, and a textured object's colour over its
+                // mean reflectance is clamped to 1 where the light is that bright.
+                col.extend_from_slice(&((c * s).clamp(0.0, 1.0) as f32).to_le_bytes());
             }
         }
         let mut rad = Vec::with_capacity(verts.len() * 12);
@@ -257,7 +244,7 @@ fn gltf_document(
         "asset": { "version": "2.0", "generator": concat!("radiosity ", env!("CARGO_PKG_VERSION")),
             "extras": { "COLOR_0": colours_are, "_RADIOSITY": "radiosity B, W/unit^2, linear, unclamped",
                 "TEXCOORD_0": "textured objects: COLOR_0 is the colour over the material's mean reflectance \
-                    per channel (may exceed 1), so baseColorTexture x COLOR_0 is the light times the texel's albedo" } },
+                    per channel (clamped to 1), so baseColorTexture x COLOR_0 is the light times the texel's albedo" } },
         "extensionsUsed": ["KHR_materials_unlit"],
         "scene": 0,
         "scenes": [{ "nodes": (0..nodes.len()).collect::<Vec<_>>() }],

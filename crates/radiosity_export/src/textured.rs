@@ -3,7 +3,10 @@
 //! as the mesh data already does), sampled with the wrap modes it was loaded with, and its
 //! `COLOR_0` holds the light over the material's mean reflectance, so that an unlit viewer's
 //! texel × vertex colour is the light times the texel's albedo, as `render` shows it:
-//! L = B·ρ(uv)/ρ̄ / π.
+//! L = B·ρ(uv)/ρ̄ / π. glTF colours may not exceed 1, so where the light over the mean
+//! reflectance does (a bright colour on a dark texture), `COLOR_0` is clamped to 1 and the
+//! texture shows darker than in a picture; the texture image is kept as it is, not brightened
+//! to make room, so it stays the model's own.
 //!
 //! Emitting textured materials keep their mean colour (no texture): a picture adds the
 //! emitted part unscaled and scales only the reflected part, which one vertex colour
@@ -41,6 +44,21 @@ pub(crate) fn colour_scale(material: &Material) -> [f64; 3] {
         let over_mean = if mean[c] > 0.0 { 1.0 / mean[c] } else { 1.0 };
         over_mean * factor[c].max(1.0)
     })
+}
+
+/// Appends `bytes` to `blob`, padded to 4 bytes, and returns the buffer view's JSON (an
+/// image's view has no target).
+pub(crate) fn push_view(blob: &mut Vec<u8>, bytes: &[u8], target: Option<u32>) -> Value {
+    let offset = blob.len();
+    blob.extend_from_slice(bytes);
+    while !blob.len().is_multiple_of(4) {
+        blob.push(0);
+    }
+    let mut view = json!({ "buffer": 0, "byteOffset": offset, "byteLength": bytes.len() });
+    if let Some(target) = target {
+        view["target"] = target.into();
+    }
+    view
 }
 
 /// glTF's sampler wrap code.
@@ -95,7 +113,7 @@ impl TexturedMaterials {
                 // A texture has at least one texel, and the encoder writes into memory: it
                 // cannot fail.
                 let png = encode_png(&picture, Path::new("texture.png")).expect("a texture encodes as PNG");
-                views.push(crate::push_view(blob, &png, None));
+                views.push(push_view(blob, &png, None));
                 self.images.push(json!({ "name": material.name, "bufferView": views.len() - 1,
                     "mimeType": "image/png" }));
                 self.by_texture.push((texture.clone(), self.images.len() - 1));
