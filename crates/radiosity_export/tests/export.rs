@@ -148,7 +148,7 @@ fn ply_holds_display_colours_and_radiosity() {
     }
     // The two halves of each quad cover it: the faces' area is the elements' area.
     assert!((area - mesh.total_area()).abs() < 1e-9 * mesh.total_area(), "{area} vs {}", mesh.total_area());
-    let shown = vertex_colours(&solution, VertexColours::Display(tone), &[]);
+    let shown = vertex_colours(&solution, VertexColours::Display(tone));
     for v in [0, mesh.positions.len() / 2, mesh.positions.len() - 1] {
         let at = end + v * vertex_size;
         let f = |o: usize| f32::from_le_bytes(bytes[at + o..at + o + 4].try_into().unwrap());
