@@ -163,6 +163,50 @@ pub(super) fn shown(b: Rgb, emitted: Rgb, ratio: Rgb) -> Rgb {
     emitted + (b - emitted) * ratio
 }
 
+/// Texture coordinates of an element's corners, in its vertex order; only the first
+/// `vertex_count` are meaningful (a triangle's fourth is `[0, 0]`).
+pub type ElementUvs = [[f64; 2]; 4];
+
+/// Per element of `mesh` (built from `scene`), the texture coordinates of its corners where its
+/// object's material has a texture and its model mesh has texture coordinates; `None`
+/// elsewhere. Empty when no object is textured.
+///
+/// The mesher remeshes coplanar faces as one surface, so elements do not follow the model's
+/// faces: each element takes the affine texture map of the model face under its centre (found
+/// by a ray along its normal, as pictures find a hit's face), extrapolated to its corners.
+/// Where the map is continuous across faces this is exact for every corner; an element
+/// straddling a seam of the map takes the map of the face under its centre. When no face lies
+/// under the centre (it sits on an edge a single-precision ray slips through), points halfway
+/// to each corner are tried, and then the face nearest the centre.
+pub fn element_uvs(scene: &Scene, mesh: &Mesh) -> Vec<Option<ElementUvs>> {
+    let Some(textures) = Textures::new(scene) else { return Vec::new() };
+    let mut textured = vec![false; scene.objects.len()];
+    for &(o, _) in &textures.faces {
+        textured[o as usize] = true;
+    }
+    (0..mesh.elements.len())
+        .map(|e| {
+            let object = mesh.element_object(e);
+            if !textured.get(object).copied().unwrap_or(false) {
+                return None;
+            }
+            let corners: Vec<DVec3> = mesh.element_corners(e).collect();
+            let centre = corners.iter().sum::<DVec3>() / corners.len() as f64;
+            let normal = (corners[1] - corners[0]).cross(corners[2] - corners[0]).normalize_or_zero();
+            let object = object as u32;
+            let face = std::iter::once(centre)
+                .chain(corners.iter().map(|&c| centre + (c - centre) * 0.5))
+                .find_map(|p| textures.face_under(object, p, normal))
+                .or_else(|| textures.nearest_face(object, centre))?;
+            let mut uvs = [[0.0; 2]; 4];
+            for (uv, &c) in uvs.iter_mut().zip(&corners) {
+                *uv = textures.affine_uv(face, c)?;
+            }
+            Some(uvs)
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -215,48 +259,62 @@ mod tests {
         let b = shown(Rgb::new(3.0, 0.0, 0.0), m.emission, Rgb::new(2.0, 1.0, 1.0));
         assert_eq!(b.to_array(), [5.0, 0.0, 0.0]);
     }
-}
 
-/// Texture coordinates of an element's corners, in its vertex order; only the first
-/// `vertex_count` are meaningful (a triangle's fourth is `[0, 0]`).
-pub type ElementUvs = [[f64; 2]; 4];
-
-/// Per element of `mesh` (built from `scene`), the texture coordinates of its corners where its
-/// object's material has a texture and its model mesh has texture coordinates; `None`
-/// elsewhere. Empty when no object is textured.
-///
-/// The mesher remeshes coplanar faces as one surface, so elements do not follow the model's
-/// faces: each element takes the affine texture map of the model face under its centre (found
-/// by a ray along its normal, as pictures find a hit's face), extrapolated to its corners.
-/// Where the map is continuous across faces this is exact for every corner; an element
-/// straddling a seam of the map takes the map of the face under its centre. When no face lies
-/// under the centre (it sits on an edge a single-precision ray slips through), points halfway
-/// to each corner are tried, and then the face nearest the centre.
-pub fn element_uvs(scene: &Scene, mesh: &Mesh) -> Vec<Option<ElementUvs>> {
-    let Some(textures) = Textures::new(scene) else { return Vec::new() };
-    let mut textured = vec![false; scene.objects.len()];
-    for &(o, _) in &textures.faces {
-        textured[o as usize] = true;
+    /// Two coplanar model faces under one continuous, affine map (u = x/2 + ¼, v = z) are
+    /// meshed as one surface: every element corner, on either face or across their shared
+    /// edge, gets the map's own coordinates; the untextured lamp gets none.
+    #[test]
+    fn element_corners_take_the_affine_map_of_the_face_under_them() {
+        use radiosity_core::{MeshParams, Object, PolygonMesh, Sides};
+        let positions = [[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [0.0, 1.0], [1.0, 1.0], [2.0, 1.0]]
+            .map(|[x, z]| DVec3::new(x, 0.0, z))
+            .to_vec();
+        // Counter-clockwise seen from above: both faces face up, towards the lamp.
+        let faces = vec![vec![0, 3, 4, 1], vec![1, 4, 5, 2]];
+        let map = |p: DVec3| [p.x / 2.0 + 0.25, p.z];
+        let uvs = faces.iter().map(|f| f.iter().map(|&i| map(positions[i as usize])).collect()).collect();
+        let floor_mesh = PolygonMesh::try_new(positions, faces).unwrap().with_uvs(uvs);
+        let mut floor = Material::try_new("floor", Rgb::splat(0.5), Rgb::ZERO).unwrap();
+        floor.texture = Some(Arc::new(Texture {
+            width: 1,
+            height: 1,
+            texels: vec![[188; 3]],
+            factor: [1.0; 3],
+            wrap: [Wrap::Repeat; 2],
+        }));
+        let light = Material::try_new("light", Rgb::ZERO, Rgb::splat(1.0)).unwrap();
+        let lamp = radiosity_core::Polygon::try_new(vec![
+            DVec3::new(0.5, 1.0, 0.25),
+            DVec3::new(1.5, 1.0, 0.25),
+            DVec3::new(1.5, 1.0, 0.75),
+            DVec3::new(0.5, 1.0, 0.75),
+        ])
+        .unwrap();
+        let objects = vec![
+            Object { name: "floor".into(), material: 0, shape: Shape::Mesh(floor_mesh), sides: Sides::One },
+            Object {
+                name: "lamp".into(),
+                material: 1,
+                shape: Shape::Polygons(vec![lamp]),
+                sides: Sides::One,
+            },
+        ];
+        let scene = Scene::try_new("two faces", None, vec![floor, light], objects).unwrap();
+        let params = MeshParams::try_new(0.3, 0.3).unwrap();
+        let mesh = radiosity_solver::Problem::new(&scene, &params).unwrap().mesh().clone();
+        let uvs = element_uvs(&scene, &mesh);
+        assert_eq!(uvs.len(), mesh.elements.len());
+        let mut textured = 0;
+        for e in 0..mesh.elements.len() {
+            let is_floor = mesh.element_object(e) == 0;
+            assert_eq!(uvs[e].is_some(), is_floor, "element {e}");
+            let Some(corners) = uvs[e] else { continue };
+            textured += 1;
+            for (uv, p) in corners.iter().zip(mesh.element_corners(e)) {
+                let want = map(p);
+                assert!((uv[0] - want[0]).abs() < 1e-9 && (uv[1] - want[1]).abs() < 1e-9, "{p}: {uv:?}");
+            }
+        }
+        assert!(textured > 2, "{textured} floor elements");
     }
-    (0..mesh.elements.len())
-        .map(|e| {
-            let object = mesh.element_object(e);
-            if !textured.get(object).copied().unwrap_or(false) {
-                return None;
-            }
-            let corners: Vec<DVec3> = mesh.element_corners(e).collect();
-            let centre = corners.iter().sum::<DVec3>() / corners.len() as f64;
-            let normal = (corners[1] - corners[0]).cross(corners[2] - corners[0]).normalize_or_zero();
-            let object = object as u32;
-            let face = std::iter::once(centre)
-                .chain(corners.iter().map(|&c| centre + (c - centre) * 0.5))
-                .find_map(|p| textures.face_under(object, p, normal))
-                .or_else(|| textures.nearest_face(object, centre))?;
-            let mut uvs = [[0.0; 2]; 4];
-            for (uv, &c) in uvs.iter_mut().zip(&corners) {
-                *uv = textures.affine_uv(face, c)?;
-            }
-            Some(uvs)
-        })
-        .collect()
 }
