@@ -305,10 +305,10 @@ mod tests {
         let uvs = element_uvs(&scene, &mesh);
         assert_eq!(uvs.len(), mesh.elements.len());
         let mut textured = 0;
-        for e in 0..mesh.elements.len() {
+        for (e, uv) in uvs.iter().enumerate() {
             let is_floor = mesh.element_object(e) == 0;
-            assert_eq!(uvs[e].is_some(), is_floor, "element {e}");
-            let Some(corners) = uvs[e] else { continue };
+            assert_eq!(uv.is_some(), is_floor, "element {e}");
+            let Some(corners) = uv else { continue };
             textured += 1;
             for (uv, p) in corners.iter().zip(mesh.element_corners(e)) {
                 let want = map(p);
