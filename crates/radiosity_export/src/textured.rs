@@ -76,8 +76,11 @@ fn wrap_code(wrap: Wrap) -> u32 {
 pub(crate) struct TexturedMaterials {
     /// glTF materials after the untextured `baked` one (index 0).
     pub(crate) materials: Vec<Value>,
+    /// glTF textures: one per textured material (image and sampler).
     pub(crate) textures: Vec<Value>,
+    /// glTF samplers: one per pair of wrap modes.
     pub(crate) samplers: Vec<Value>,
+    /// glTF images: one per texture, its PNG in a buffer view.
     pub(crate) images: Vec<Value>,
     /// Mesh material index → glTF material index.
     by_material: HashMap<usize, usize>,
