@@ -7,6 +7,8 @@
 //! reflectance does (a bright colour on a dark texture), `COLOR_0` is clamped to 1 and the
 //! texture shows darker than in a picture; the texture image is kept as it is, not brightened
 //! to make room, so it stays the model's own.
+//! With `--tonemapped` colours the quotient is taken after the tone curve, so texel × colour
+//! is the picture's tone-mapped colour only where the curve is near linear (its toe).
 //!
 //! Emitting textured materials keep their mean colour (no texture): a picture adds the
 //! emitted part unscaled and scales only the reflected part, which one vertex colour
