@@ -85,10 +85,15 @@ pub fn run(a: ExportArgs) -> Result<()> {
     let tone = ToneParams::new(ev, a.tone.tonemap.into());
     let mode =
         if a.tonemapped { VertexColours::Display(tone) } else { VertexColours::Linear { exposure_ev: ev } };
+    // Texture coordinates per element corner, for glTF's textured materials (PLY has none).
+    let uvs = match format {
+        ExportFormat::Ply => Vec::new(),
+        ExportFormat::Glb | ExportFormat::Gltf => radiosity_image::element_uvs(&prepared.scene, mesh),
+    };
     spinning(&format!("writing {}", a.output.display()), || {
         let bytes = match format {
-            ExportFormat::Glb => radiosity_export::glb_bytes(mesh, &solution, mode),
-            ExportFormat::Gltf => radiosity_export::gltf_text(mesh, &solution, mode).into_bytes(),
+            ExportFormat::Glb => radiosity_export::glb_bytes(mesh, &solution, mode, &uvs),
+            ExportFormat::Gltf => radiosity_export::gltf_text(mesh, &solution, mode, &uvs).into_bytes(),
             ExportFormat::Ply => radiosity_export::ply_bytes(mesh, &solution, tone, prepared.up),
         };
         output::write_file(&a.output, a.force, &bytes)
@@ -109,7 +114,11 @@ pub fn run(a: ExportArgs) -> Result<()> {
         (_, true) => format!("display colours ({}, {ev:+.2} EV)", ToneOperator::from(a.tone.tonemap)),
         (_, false) => format!("linear colours ({ev:+.2} EV) and radiosity"),
     };
-    note(format_args!("wrote {} ({} vertices, {colours})", a.output.display(), mesh.positions.len()))?;
+    let vertices = match format {
+        ExportFormat::Ply => mesh.positions.len(),
+        ExportFormat::Glb | ExportFormat::Gltf => radiosity_export::gltf_vertex_count(mesh, &uvs),
+    };
+    note(format_args!("wrote {} ({vertices} vertices, {colours})", a.output.display()))?;
     if let Some(dir) = &a.lightmap {
         let gather = Gather::from(a.gather);
         let renderer = (gather != Gather::None).then(|| Renderer::new(mesh.clone()));

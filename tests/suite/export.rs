@@ -173,3 +173,56 @@ fn existing_output_and_bad_input_are_one_line_errors_with_exit_code_2() {
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("missing.gltf: cannot read the model file"), "{}", stderr(&o));
 }
+
+/// A textured OBJ floor under a lamp, exported to GLB and glTF: the floor's primitive has
+/// `TEXCOORD_0` and a material whose base colour texture is the PNG embedded in the buffer,
+/// sampled as loaded (`-clamp on`); the lamp keeps the untextured material; the count of
+/// vertices said is the count written; the validator finds no error.
+#[test]
+fn a_textured_model_exports_its_texture_and_passes_the_validator() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let pixels = (0..16u8).map(|i| [i * 16, 255 - i * 16, 128]).collect();
+    radiosity_image::write_png(
+        &d.join("tiles.png"),
+        &radiosity_image::SrgbImage { width: 4, height: 4, pixels },
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("room.mtl"),
+        "newmtl floor\nKd 1 1 1\nmap_Kd -clamp on tiles.png\nnewmtl lamp\nKe 10 10 10\n",
+    )
+    .unwrap();
+    let obj = "mtllib room.mtl\no floor\nv 0 0 0\nv 0 0 2\nv 2 0 2\nv 2 0 0\n\
+        vt 0 0\nvt 0 1\nvt 1 1\nvt 1 0\nusemtl floor\nf 1/1 2/2 3/3 4/4\n\
+        o lamp\nv 0.75 1.5 0.75\nv 1.25 1.5 0.75\nv 1.25 1.5 1.25\nv 0.75 1.5 1.25\nusemtl lamp\nf 5 6 7 8\n";
+    let model = d.join("room.obj");
+    std::fs::write(&model, obj).unwrap();
+    let (glb, gltf) = (d.join("lit.glb"), d.join("lit.gltf"));
+    for out in [&glb, &gltf] {
+        let o =
+            radiosity(&["export", model.to_str().unwrap(), "-o", out.to_str().unwrap(), "--max-shots", "50"]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let doc = if out == &glb {
+            glb_json(&std::fs::read(out).unwrap())
+        } else {
+            serde_json::from_slice(&std::fs::read(out).unwrap()).unwrap()
+        };
+        assert!(stderr(&o).contains(&format!("({} vertices", vertex_count(&doc))), "{}", stderr(&o));
+        let floor = doc["meshes"].as_array().unwrap().iter().find(|m| m["name"] == "floor").unwrap();
+        let prim = &floor["primitives"][0];
+        assert!(prim["attributes"]["TEXCOORD_0"].is_u64(), "{prim}");
+        let material = &doc["materials"][prim["material"].as_u64().unwrap() as usize];
+        let texture = &doc["textures"]
+            [material["pbrMetallicRoughness"]["baseColorTexture"]["index"].as_u64().unwrap() as usize];
+        let image = &doc["images"][texture["source"].as_u64().unwrap() as usize];
+        assert_eq!(image["mimeType"], "image/png");
+        assert!(image["bufferView"].is_u64(), "embedded: {image}");
+        let sampler = &doc["samplers"][texture["sampler"].as_u64().unwrap() as usize];
+        assert_eq!((sampler["wrapS"].as_u64(), sampler["wrapT"].as_u64()), (Some(33071), Some(33071)));
+        let lamp = doc["meshes"].as_array().unwrap().iter().find(|m| m["name"] == "lamp").unwrap();
+        assert!(lamp["primitives"][0]["attributes"].get("TEXCOORD_0").is_none());
+        assert_eq!(lamp["primitives"][0]["material"], 0);
+    }
+    validate(&[&glb, &gltf]);
+}

@@ -148,7 +148,7 @@ fn mutated_glb_files_never_panic() {
         vertex_radiosity: (0..mesh.positions.len()).map(|v| Rgb::splat(v as f64 / 1000.0)).collect(),
         ..Solution::default()
     };
-    let glb = glb_bytes(&mesh, &solution, VertexColours::Linear { exposure_ev: 0.0 });
+    let glb = glb_bytes(&mesh, &solution, VertexColours::Linear { exposure_ev: 0.0 }, &[]);
     // Its triangles have no material: default grey, so as a model it loads (with a warning).
     fuzz("lit.glb", &glb, ModelFormat::Gltf, None, 0x61b_5eed, 1500);
 }

@@ -8,7 +8,11 @@
 //!   [`radiosity_solver::Solution::vertex_radiosity`], unclamped — glTF's colours may not
 //!   exceed 1, and a light's radiosity does) and a `KHR_materials_unlit` material with a white
 //!   base colour, so every viewer shows the baked colour itself whatever its lights. See
-//!   [`VertexColours`] for what `COLOR_0` holds.
+//!   [`VertexColours`] for what `COLOR_0` holds. An object with a colour texture (and texture
+//!   coordinates, [`radiosity_image::element_uvs`]) also gets `TEXCOORD_0` per element corner
+//!   and an unlit material showing the texture, its PNG embedded in the file's buffer; its
+//!   `COLOR_0` is then the colour over the material's mean reflectance (clamped to 1), so
+//!   texel × colour is what `render` shows (see the `textured` module).
 //! * PLY: binary little endian; per vertex `float x y z`, `uchar red green blue` (sRGB-encoded
 //!   display colour, what PLY viewers show) and `float radiosity_r radiosity_g radiosity_b`
 //!   (linear B); faces are the elements' triangles (a quad element gives two, as in glTF) as
@@ -26,16 +30,22 @@
 #![warn(missing_docs)]
 #![forbid(unsafe_code)]
 
+use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use radiosity_core::glam::DVec3;
 use radiosity_core::{Rgb, UpAxis, encode_srgb, unique_names};
-use radiosity_image::{HdrImage, RenderError, RenderParams, Renderer, ToneOperator, ToneParams, tone_map};
+use radiosity_image::{
+    ElementUvs, HdrImage, RenderError, RenderParams, Renderer, ToneOperator, ToneParams, tone_map,
+};
 use radiosity_mesh::Mesh;
 use radiosity_solver::Solution;
 use rayon::prelude::*;
 use serde_json::{Value, json};
+use textured::{TexturedMaterials, push_view};
+
+mod textured;
 
 /// What the exported vertex colours (`COLOR_0`) hold. glTF requires colours in [0, 1], so
 /// radiosity itself (lights reach 65 W per unit² in the Cornell box) goes unclamped into the
@@ -84,51 +94,86 @@ pub fn vertex_colours(solution: &Solution, mode: VertexColours) -> Vec<Rgb> {
     solution.vertex_radiosity.iter().map(|&b| tone_map(b / std::f64::consts::PI, &tone)).collect()
 }
 
-/// The vertices and triangles of each object: `(object, vertex list, triangles in local
-/// indices)`. Vertices are never shared across surfaces, so never across objects.
-fn objects_of(mesh: &Mesh) -> Vec<(usize, Vec<u32>, Vec<[u32; 3]>)> {
+/// One object's glTF vertices and triangles.
+struct ObjectMesh {
+    object: usize,
+    /// Per glTF vertex: the mesh vertex and, on a textured object, its texture coordinates.
+    verts: Vec<(u32, [f32; 2])>,
+    /// Triangles in indices into `verts`.
+    tris: Vec<[u32; 3]>,
+    /// The mesh material index when the object is exported textured.
+    textured: Option<usize>,
+}
+
+/// The vertices and triangles of each object. Vertices are never shared across surfaces, so
+/// never across objects; on a textured object (see [`textured::is_textured`]) a mesh vertex
+/// is one glTF vertex per distinct texture coordinate of the element corners at it.
+fn objects_of(mesh: &Mesh, uvs: &[Option<ElementUvs>]) -> Vec<ObjectMesh> {
     let mut local = vec![u32::MAX; mesh.positions.len()];
-    let mut out: Vec<(usize, Vec<u32>, Vec<[u32; 3]>)> =
-        (0..mesh.object_names.len()).map(|o| (o, Vec::new(), Vec::new())).collect();
-    for (e, tri) in mesh.element_triangles() {
-        let (_, verts, tris) = &mut out[mesh.element_object(e as usize)];
-        let t = tri.map(|v| {
-            if local[v as usize] == u32::MAX {
-                local[v as usize] = verts.len() as u32;
-                verts.push(v);
-            }
-            local[v as usize]
-        });
-        tris.push(t);
+    let mut split: HashMap<(u32, [u32; 2]), u32> = HashMap::new();
+    let mut out: Vec<ObjectMesh> = (0..mesh.object_names.len())
+        .map(|object| ObjectMesh { object, verts: Vec::new(), tris: Vec::new(), textured: None })
+        .collect();
+    // An object is one material: textured when its elements are.
+    for e in 0..mesh.elements.len() {
+        if textured::is_textured(mesh, uvs, e) {
+            out[mesh.element_object(e)].textured = Some(textured::material_index(mesh, e));
+        }
     }
-    out.retain(|(_, v, _)| !v.is_empty());
+    for (e, tri) in mesh.element_triangles() {
+        let e = e as usize;
+        let o = &mut out[mesh.element_object(e)];
+        let corners = mesh.elements[e].vertex_indices();
+        let t = tri.map(|v| match (o.textured, uvs.get(e).copied().flatten()) {
+            (Some(_), Some(element_uvs)) => {
+                let k = corners.iter().position(|&c| c == v).expect("a triangle's vertex is its element's");
+                let uv = element_uvs[k].map(|c| c as f32);
+                *split.entry((v, uv.map(f32::to_bits))).or_insert_with(|| {
+                    o.verts.push((v, uv));
+                    o.verts.len() as u32 - 1
+                })
+            }
+            _ => {
+                if local[v as usize] == u32::MAX {
+                    local[v as usize] = o.verts.len() as u32;
+                    o.verts.push((v, [0.0; 2]));
+                }
+                local[v as usize]
+            }
+        });
+        o.tris.push(t);
+    }
+    out.retain(|o| !o.verts.is_empty());
     out
 }
 
-/// Appends `bytes` to `blob`, padded to 4 bytes, and returns the buffer view's JSON.
-fn push_view(blob: &mut Vec<u8>, bytes: &[u8], target: u32) -> Value {
-    let offset = blob.len();
-    blob.extend_from_slice(bytes);
-    while !blob.len().is_multiple_of(4) {
-        blob.push(0);
-    }
-    json!({ "buffer": 0, "byteOffset": offset, "byteLength": bytes.len(), "target": target })
+/// The number of vertices [`gltf_text`] and [`glb_bytes`] write: the mesh's, plus the copies
+/// of vertices where textured elements meet with different texture coordinates.
+pub fn gltf_vertex_count(mesh: &Mesh, uvs: &[Option<ElementUvs>]) -> usize {
+    objects_of(mesh, uvs).iter().map(|o| o.verts.len()).sum()
 }
 
 /// The glTF document (JSON) and its binary buffer for `mesh` with `colours` per vertex.
 /// With `uri`, the buffer is referenced by it (a data URI for `.gltf`); without, it is the
 /// GLB's own chunk.
-fn gltf_document(mesh: &Mesh, colours: &[Rgb], radiosity: &[Rgb], mode: VertexColours) -> (Value, Vec<u8>) {
+fn gltf_document(
+    mesh: &Mesh,
+    colours: &[Rgb],
+    radiosity: &[Rgb],
+    mode: VertexColours,
+    uvs: &[Option<ElementUvs>],
+) -> (Value, Vec<u8>) {
     const ARRAY_BUFFER: u32 = 34962;
     const ELEMENT_ARRAY_BUFFER: u32 = 34963;
     const FLOAT: u32 = 5126;
     const UNSIGNED_INT: u32 = 5125;
     let mut blob = Vec::new();
     let (mut views, mut accessors, mut meshes, mut nodes) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    for (object, verts, tris) in objects_of(mesh) {
+    let mut textured = TexturedMaterials::default();
+    for ObjectMesh { object, verts, tris, textured: material } in objects_of(mesh, uvs) {
         let mut pos = Vec::with_capacity(verts.len() * 12);
         let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-        for &v in &verts {
+        for &(v, _) in &verts {
             let p = mesh.positions[v as usize].as_vec3().to_array();
             for c in 0..3 {
                 lo[c] = lo[c].min(p[c]);
@@ -136,37 +181,51 @@ fn gltf_document(mesh: &Mesh, colours: &[Rgb], radiosity: &[Rgb], mode: VertexCo
                 pos.extend_from_slice(&p[c].to_le_bytes());
             }
         }
+        let scale = material.map_or([1.0; 3], |m| textured::colour_scale(&mesh.materials[m]));
         let mut col = Vec::with_capacity(verts.len() * 12);
-        for &v in &verts {
-            for c in colours[v as usize].to_array() {
-                // glTF colours are linear and non-negative; a tiny negative from round-off is 0.
-                col.extend_from_slice(&(c.max(0.0) as f32).to_le_bytes());
+        for &(v, _) in &verts {
+            for (c, s) in colours[v as usize].to_array().into_iter().zip(scale) {
+                // glTF colours are linear and in [0, 1] (the validator's ACCESSOR_NON_CLAMPED):
+                // a tiny negative from round-off is 0, and a textured object's colour over its
+                // mean reflectance is clamped to 1 where the light is that bright.
+                col.extend_from_slice(&((c * s).clamp(0.0, 1.0) as f32).to_le_bytes());
             }
         }
         let mut rad = Vec::with_capacity(verts.len() * 12);
-        for &v in &verts {
+        for &(v, _) in &verts {
             for c in radiosity[v as usize].to_array() {
                 rad.extend_from_slice(&(c as f32).to_le_bytes());
             }
         }
         let idx: Vec<u8> = tris.iter().flatten().flat_map(|i| i.to_le_bytes()).collect();
         let base = accessors.len();
-        views.push(push_view(&mut blob, &pos, ARRAY_BUFFER));
+        views.push(push_view(&mut blob, &pos, Some(ARRAY_BUFFER)));
         accessors.push(json!({ "bufferView": views.len() - 1, "componentType": FLOAT, "count": verts.len(),
             "type": "VEC3", "min": lo, "max": hi }));
-        views.push(push_view(&mut blob, &col, ARRAY_BUFFER));
+        views.push(push_view(&mut blob, &col, Some(ARRAY_BUFFER)));
         accessors.push(json!({ "bufferView": views.len() - 1, "componentType": FLOAT, "count": verts.len(),
             "type": "VEC3" }));
-        views.push(push_view(&mut blob, &rad, ARRAY_BUFFER));
+        views.push(push_view(&mut blob, &rad, Some(ARRAY_BUFFER)));
         accessors.push(json!({ "bufferView": views.len() - 1, "componentType": FLOAT, "count": verts.len(),
             "type": "VEC3" }));
-        views.push(push_view(&mut blob, &idx, ELEMENT_ARRAY_BUFFER));
+        views.push(push_view(&mut blob, &idx, Some(ELEMENT_ARRAY_BUFFER)));
         accessors.push(json!({ "bufferView": views.len() - 1, "componentType": UNSIGNED_INT,
             "count": tris.len() * 3, "type": "SCALAR" }));
+        let mut attributes = json!({ "POSITION": base, "COLOR_0": base + 1, "_RADIOSITY": base + 2 });
+        let mut material_index = 0;
+        if let Some(m) = material {
+            let uv: Vec<u8> =
+                verts.iter().flat_map(|(_, uv)| uv.iter().flat_map(|c| c.to_le_bytes())).collect();
+            views.push(push_view(&mut blob, &uv, Some(ARRAY_BUFFER)));
+            accessors
+                .push(json!({ "bufferView": views.len() - 1, "componentType": FLOAT, "count": verts.len(),
+                "type": "VEC2" }));
+            attributes["TEXCOORD_0"] = (accessors.len() - 1).into();
+            material_index = textured.material(mesh, m, &mut blob, &mut views);
+        }
         let name = &mesh.object_names[object];
         meshes.push(json!({ "name": name, "primitives": [{
-            "attributes": { "POSITION": base, "COLOR_0": base + 1, "_RADIOSITY": base + 2 }, "indices": base + 3,
-            "material": 0 }] }));
+            "attributes": attributes, "indices": base + 3, "material": material_index }] }));
         nodes.push(json!({ "name": name, "mesh": meshes.len() - 1 }));
     }
     let colours_are = match mode {
@@ -177,20 +236,33 @@ fn gltf_document(mesh: &Mesh, colours: &[Rgb], radiosity: &[Rgb], mode: VertexCo
             format!("display colour (tone mapped {}, exposure {:+.3} EV)", t.operator, t.exposure_ev)
         }
     };
-    let doc = json!({
+    let mut materials = vec![json!({ "name": "baked", "pbrMetallicRoughness": {
+        "baseColorFactor": [1.0, 1.0, 1.0, 1.0], "metallicFactor": 0.0, "roughnessFactor": 1.0 },
+        "extensions": { "KHR_materials_unlit": {} } })];
+    materials.append(&mut textured.materials);
+    let mut doc = json!({
         "asset": { "version": "2.0", "generator": concat!("radiosity ", env!("CARGO_PKG_VERSION")),
-            "extras": { "COLOR_0": colours_are, "_RADIOSITY": "radiosity B, W/unit^2, linear, unclamped" } },
+            "extras": { "COLOR_0": colours_are, "_RADIOSITY": "radiosity B, W/unit^2, linear, unclamped",
+                "TEXCOORD_0": "textured objects: COLOR_0 is the colour over the material's mean reflectance \
+                    per channel (clamped to 1), so baseColorTexture x COLOR_0 is the light times the texel's albedo" } },
         "extensionsUsed": ["KHR_materials_unlit"],
         "scene": 0,
         "scenes": [{ "nodes": (0..nodes.len()).collect::<Vec<_>>() }],
         "nodes": nodes,
         "meshes": meshes,
-        "materials": [{ "name": "baked", "pbrMetallicRoughness": { "baseColorFactor": [1.0, 1.0, 1.0, 1.0],
-            "metallicFactor": 0.0, "roughnessFactor": 1.0 }, "extensions": { "KHR_materials_unlit": {} } }],
+        "materials": materials,
         "accessors": accessors,
         "bufferViews": views,
         "buffers": [{ "byteLength": blob.len() }],
     });
+    // glTF forbids empty arrays: these appear only when something is textured.
+    for (key, list) in
+        [("textures", textured.textures), ("samplers", textured.samplers), ("images", textured.images)]
+    {
+        if !list.is_empty() {
+            doc[key] = Value::Array(list);
+        }
+    }
     (doc, blob)
 }
 
@@ -213,10 +285,18 @@ fn base64(bytes: &[u8]) -> String {
     s
 }
 
-/// A `.gltf` file (JSON, buffer embedded as a base64 data URI) of the lit mesh.
-pub fn gltf_text(mesh: &Mesh, solution: &Solution, mode: VertexColours) -> String {
+/// A `.gltf` file (JSON, buffer embedded as a base64 data URI, texture images in it as PNG) of
+/// the lit mesh. `uvs`: per element, its corners' texture coordinates
+/// ([`radiosity_image::element_uvs`] of the scene the mesh was built from); empty, or `None`
+/// for an element, exports it with its material's mean colour.
+pub fn gltf_text(
+    mesh: &Mesh,
+    solution: &Solution,
+    mode: VertexColours,
+    uvs: &[Option<ElementUvs>],
+) -> String {
     let colours = vertex_colours(solution, mode);
-    let (mut doc, blob) = gltf_document(mesh, &colours, &solution.vertex_radiosity, mode);
+    let (mut doc, blob) = gltf_document(mesh, &colours, &solution.vertex_radiosity, mode, uvs);
     doc["buffers"][0]["uri"] =
         Value::String(format!("data:application/octet-stream;base64,{}", base64(&blob)));
     let mut text = serde_json::to_string(&doc).expect("a JSON value always serialises");
@@ -224,10 +304,16 @@ pub fn gltf_text(mesh: &Mesh, solution: &Solution, mode: VertexColours) -> Strin
     text
 }
 
-/// A `.glb` file (binary glTF: JSON chunk and BIN chunk) of the lit mesh.
-pub fn glb_bytes(mesh: &Mesh, solution: &Solution, mode: VertexColours) -> Vec<u8> {
+/// A `.glb` file (binary glTF: JSON chunk and BIN chunk, texture images in the latter as PNG)
+/// of the lit mesh; `uvs` as for [`gltf_text`].
+pub fn glb_bytes(
+    mesh: &Mesh,
+    solution: &Solution,
+    mode: VertexColours,
+    uvs: &[Option<ElementUvs>],
+) -> Vec<u8> {
     let colours = vertex_colours(solution, mode);
-    let (doc, blob) = gltf_document(mesh, &colours, &solution.vertex_radiosity, mode);
+    let (doc, blob) = gltf_document(mesh, &colours, &solution.vertex_radiosity, mode, uvs);
     let mut json = serde_json::to_vec(&doc).expect("a JSON value always serialises");
     // Chunks are 4-byte aligned: JSON padded with spaces, BIN (already padded) with zeros.
     while !json.len().is_multiple_of(4) {

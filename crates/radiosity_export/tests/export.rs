@@ -74,11 +74,11 @@ fn glb_and_gltf_reload_with_the_same_vertices_and_colours() {
     for (mode, bytes) in [
         (
             VertexColours::Linear { exposure_ev: 2.0 },
-            glb_bytes(&mesh, &solution, VertexColours::Linear { exposure_ev: 2.0 }),
+            glb_bytes(&mesh, &solution, VertexColours::Linear { exposure_ev: 2.0 }, &[]),
         ),
         (
             VertexColours::Display(tone),
-            gltf_text(&mesh, &solution, VertexColours::Display(tone)).into_bytes(),
+            gltf_text(&mesh, &solution, VertexColours::Display(tone), &[]).into_bytes(),
         ),
     ] {
         let Reloaded { positions: pos, colours: col, radiosity: rad, indices, names } = reload(&bytes);

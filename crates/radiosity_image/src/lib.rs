@@ -53,7 +53,8 @@ pub use illuminance::{GridIlluminance, GridParams, grid_illuminance, grid_statis
 pub use lux_scale::{LuxScale, format_lux};
 pub use metrics::{ObjectPixels, difference_image, object_mean_radiance};
 pub use render::{
-    RECORD_RAYS_PER_GATHER_RAY, RenderError, RenderParams, Renderer, Rendering, Shading, SurfaceHit,
+    ElementUvs, RECORD_RAYS_PER_GATHER_RAY, RenderError, RenderParams, Renderer, Rendering, Shading,
+    SurfaceHit, element_uvs,
 };
 pub use tonemap::{
     AUTO_EXPOSURE_HIGHLIGHTS, AUTO_EXPOSURE_KEY, AUTO_EXPOSURE_WHITE, Exposure, MeterSample, SrgbImage,

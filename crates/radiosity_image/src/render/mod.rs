@@ -36,6 +36,7 @@ mod tests;
 mod texture;
 
 pub use params::{RenderError, RenderParams, Shading};
+pub use texture::{ElementUvs, element_uvs};
 
 /// An irradiance-cache record gathers this many times [`RenderParams::gather_rays`] (1 024
 /// rays at the default). A record speaks for the pixels around it, so its noise shows as a

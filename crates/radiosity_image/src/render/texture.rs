@@ -13,12 +13,15 @@ use std::sync::Arc;
 use glam::DVec3;
 use radiosity_accel::{Bvh, RayQuery};
 use radiosity_core::{Material, Rgb, Scene, Shape, Texture, Wrap, srgb_decode};
+use radiosity_mesh::Mesh;
 
 /// The textured faces of a scene, as triangles a ray can meet.
 pub(super) struct Textures {
     bvh: Bvh,
     /// Per BVH triangle: its object and the texture coordinates of its corners.
     faces: Vec<(u32, [[f64; 2]; 3])>,
+    /// Per BVH triangle: its corners in double precision, for its affine texture map.
+    corners: Vec<[DVec3; 3]>,
     /// How far along the ray the face may lie from the element's hit and still be its face:
     /// the two are the same plane up to the BVH's single precision.
     tolerance: f64,
@@ -30,6 +33,7 @@ impl Textures {
     pub(super) fn new(scene: &Scene) -> Option<Self> {
         let mut triangles = Vec::new();
         let mut faces = Vec::new();
+        let mut corners = Vec::new();
         for (o, object) in scene.objects.iter().enumerate() {
             let Shape::Mesh(mesh) = &object.shape else { continue };
             if scene.materials[object.material].texture.is_none() || mesh.uvs().is_empty() {
@@ -37,8 +41,10 @@ impl Textures {
             }
             for (face, uvs) in mesh.faces().iter().zip(mesh.uvs()) {
                 for k in 1..face.len() - 1 {
-                    let corner = |i: usize| mesh.positions()[face[i] as usize].as_vec3();
-                    triangles.push([corner(0), corner(k), corner(k + 1)]);
+                    let corner = |i: usize| mesh.positions()[face[i] as usize];
+                    let triangle = [corner(0), corner(k), corner(k + 1)];
+                    triangles.push(triangle.map(DVec3::as_vec3));
+                    corners.push(triangle);
                     faces.push((o as u32, [uvs[0], uvs[k], uvs[k + 1]]));
                 }
             }
@@ -47,20 +53,61 @@ impl Textures {
             return None;
         }
         let (lo, hi) = scene.bounds();
-        Some(Self { bvh: Bvh::new(&triangles), faces, tolerance: 1e-4 * (hi - lo).length() })
+        Some(Self { bvh: Bvh::new(&triangles), faces, corners, tolerance: 1e-4 * (hi - lo).length() })
+    }
+
+    /// The textured face of `object` that the ray from `origin` along unit `dir` meets at
+    /// `distance` (its BVH triangle), or `None`.
+    fn face(&self, object: u32, origin: DVec3, dir: DVec3, distance: f64) -> Option<usize> {
+        let reach = (distance + self.tolerance) as f32;
+        let hit = self.bvh.closest_hit(origin.as_vec3(), dir.as_vec3(), reach)?;
+        let (owner, _) = self.faces[hit.triangle as usize];
+        (owner == object && (f64::from(hit.t) - distance).abs() <= self.tolerance)
+            .then_some(hit.triangle as usize)
+    }
+
+    /// The textured face of `object` under `point` of a surface with unit normal `normal`:
+    /// met by a ray along the normal from either side, so a face of the same object a little
+    /// above the point (a thin slab's far side) does not hide it.
+    fn face_under(&self, object: u32, point: DVec3, normal: DVec3) -> Option<usize> {
+        // Far enough off the plane for the BVH's single precision, near enough that little
+        // else of the object lies between.
+        let h = 4.0 * self.tolerance;
+        self.face(object, point + normal * h, -normal, h)
+            .or_else(|| self.face(object, point - normal * h, normal, h))
+    }
+
+    /// Texture coordinates of `point` by face `f`'s affine map: its barycentric weights in the
+    /// face's plane, extrapolated outside the face. `None` for a degenerate face.
+    fn affine_uv(&self, f: usize, point: DVec3) -> Option<[f64; 2]> {
+        let [a, b, c] = self.corners[f];
+        let (e0, e1, d) = (b - a, c - a, point - a);
+        let (d00, d01, d11) = (e0.dot(e0), e0.dot(e1), e1.dot(e1));
+        let det = d00 * d11 - d01 * d01;
+        if det <= 1e-12 * d00 * d11 || !det.is_finite() {
+            return None;
+        }
+        let (d20, d21) = (d.dot(e0), d.dot(e1));
+        let v = (d11 * d20 - d01 * d21) / det;
+        let w = (d00 * d21 - d01 * d20) / det;
+        let uvs = self.faces[f].1;
+        Some([0, 1].map(|k| uvs[0][k] * (1.0 - v - w) + uvs[1][k] * v + uvs[2][k] * w))
+    }
+
+    /// The textured face of `object` nearest `point` (by the distance to its centroid), for an
+    /// element no ray finds a face under: a last resort, searched face by face.
+    fn nearest_face(&self, object: u32, point: DVec3) -> Option<usize> {
+        (0..self.faces.len()).filter(|&f| self.faces[f].0 == object).min_by(|&f, &g| {
+            let d = |f: usize| (self.corners[f].iter().sum::<DVec3>() / 3.0 - point).length_squared();
+            d(f).total_cmp(&d(g))
+        })
     }
 
     /// Texture coordinates where the ray from `origin` along unit `dir` meets `object` at
     /// `distance`, or `None` when no textured face of it lies there.
     pub(super) fn uv(&self, object: u32, origin: DVec3, dir: DVec3, distance: f64) -> Option<[f64; 2]> {
-        let reach = (distance + self.tolerance) as f32;
-        let hit = self.bvh.closest_hit(origin.as_vec3(), dir.as_vec3(), reach)?;
-        let (owner, uvs) = self.faces[hit.triangle as usize];
-        if owner != object || (f64::from(hit.t) - distance).abs() > self.tolerance {
-            return None;
-        }
-        let w = [1.0 - f64::from(hit.u) - f64::from(hit.v), f64::from(hit.u), f64::from(hit.v)];
-        Some([0, 1].map(|c| uvs[0][c] * w[0] + uvs[1][c] * w[1] + uvs[2][c] * w[2]))
+        let f = self.face(object, origin, dir, distance)?;
+        self.affine_uv(f, origin + dir * distance)
     }
 }
 
@@ -116,6 +163,50 @@ pub(super) fn shown(b: Rgb, emitted: Rgb, ratio: Rgb) -> Rgb {
     emitted + (b - emitted) * ratio
 }
 
+/// Texture coordinates of an element's corners, in its vertex order; only the first
+/// `vertex_count` are meaningful (a triangle's fourth is `[0, 0]`).
+pub type ElementUvs = [[f64; 2]; 4];
+
+/// Per element of `mesh` (built from `scene`), the texture coordinates of its corners where its
+/// object's material has a texture and its model mesh has texture coordinates; `None`
+/// elsewhere. Empty when no object is textured.
+///
+/// The mesher remeshes coplanar faces as one surface, so elements do not follow the model's
+/// faces: each element takes the affine texture map of the model face under its centre (found
+/// by a ray along its normal, as pictures find a hit's face), extrapolated to its corners.
+/// Where the map is continuous across faces this is exact for every corner; an element
+/// straddling a seam of the map takes the map of the face under its centre. When no face lies
+/// under the centre (it sits on an edge a single-precision ray slips through), points halfway
+/// to each corner are tried, and then the face nearest the centre.
+pub fn element_uvs(scene: &Scene, mesh: &Mesh) -> Vec<Option<ElementUvs>> {
+    let Some(textures) = Textures::new(scene) else { return Vec::new() };
+    let mut textured = vec![false; scene.objects.len()];
+    for &(o, _) in &textures.faces {
+        textured[o as usize] = true;
+    }
+    (0..mesh.elements.len())
+        .map(|e| {
+            let object = mesh.element_object(e);
+            if !textured.get(object).copied().unwrap_or(false) {
+                return None;
+            }
+            let corners: Vec<DVec3> = mesh.element_corners(e).collect();
+            let centre = corners.iter().sum::<DVec3>() / corners.len() as f64;
+            let normal = (corners[1] - corners[0]).cross(corners[2] - corners[0]).normalize_or_zero();
+            let object = object as u32;
+            let face = std::iter::once(centre)
+                .chain(corners.iter().map(|&c| centre + (c - centre) * 0.5))
+                .find_map(|p| textures.face_under(object, p, normal))
+                .or_else(|| textures.nearest_face(object, centre))?;
+            let mut uvs = [[0.0; 2]; 4];
+            for (uv, &c) in uvs.iter_mut().zip(&corners) {
+                *uv = textures.affine_uv(face, c)?;
+            }
+            Some(uvs)
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -167,5 +258,63 @@ mod tests {
         // B = E + reflected: only the reflected 2 doubles.
         let b = shown(Rgb::new(3.0, 0.0, 0.0), m.emission, Rgb::new(2.0, 1.0, 1.0));
         assert_eq!(b.to_array(), [5.0, 0.0, 0.0]);
+    }
+
+    /// Two coplanar model faces under one continuous, affine map (u = x/2 + ¼, v = z) are
+    /// meshed as one surface: every element corner, on either face or across their shared
+    /// edge, gets the map's own coordinates; the untextured lamp gets none.
+    #[test]
+    fn element_corners_take_the_affine_map_of_the_face_under_them() {
+        use radiosity_core::{MeshParams, Object, PolygonMesh, Sides};
+        let positions = [[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [0.0, 1.0], [1.0, 1.0], [2.0, 1.0]]
+            .map(|[x, z]| DVec3::new(x, 0.0, z))
+            .to_vec();
+        // Counter-clockwise seen from above: both faces face up, towards the lamp.
+        let faces = vec![vec![0, 3, 4, 1], vec![1, 4, 5, 2]];
+        let map = |p: DVec3| [p.x / 2.0 + 0.25, p.z];
+        let uvs = faces.iter().map(|f| f.iter().map(|&i| map(positions[i as usize])).collect()).collect();
+        let floor_mesh = PolygonMesh::try_new(positions, faces).unwrap().with_uvs(uvs);
+        let mut floor = Material::try_new("floor", Rgb::splat(0.5), Rgb::ZERO).unwrap();
+        floor.texture = Some(Arc::new(Texture {
+            width: 1,
+            height: 1,
+            texels: vec![[188; 3]],
+            factor: [1.0; 3],
+            wrap: [Wrap::Repeat; 2],
+        }));
+        let light = Material::try_new("light", Rgb::ZERO, Rgb::splat(1.0)).unwrap();
+        let lamp = radiosity_core::Polygon::try_new(vec![
+            DVec3::new(0.5, 1.0, 0.25),
+            DVec3::new(1.5, 1.0, 0.25),
+            DVec3::new(1.5, 1.0, 0.75),
+            DVec3::new(0.5, 1.0, 0.75),
+        ])
+        .unwrap();
+        let objects = vec![
+            Object { name: "floor".into(), material: 0, shape: Shape::Mesh(floor_mesh), sides: Sides::One },
+            Object {
+                name: "lamp".into(),
+                material: 1,
+                shape: Shape::Polygons(vec![lamp]),
+                sides: Sides::One,
+            },
+        ];
+        let scene = Scene::try_new("two faces", None, vec![floor, light], objects).unwrap();
+        let params = MeshParams::try_new(0.3, 0.3).unwrap();
+        let mesh = radiosity_solver::Problem::new(&scene, &params).unwrap().mesh().clone();
+        let uvs = element_uvs(&scene, &mesh);
+        assert_eq!(uvs.len(), mesh.elements.len());
+        let mut textured = 0;
+        for (e, uv) in uvs.iter().enumerate() {
+            let is_floor = mesh.element_object(e) == 0;
+            assert_eq!(uv.is_some(), is_floor, "element {e}");
+            let Some(corners) = uv else { continue };
+            textured += 1;
+            for (uv, p) in corners.iter().zip(mesh.element_corners(e)) {
+                let want = map(p);
+                assert!((uv[0] - want[0]).abs() < 1e-9 && (uv[1] - want[1]).abs() < 1e-9, "{p}: {uv:?}");
+            }
+        }
+        assert!(textured > 2, "{textured} floor elements");
     }
 }
