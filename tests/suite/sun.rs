@@ -179,3 +179,23 @@ fn a_sun_missing_its_direction_or_light_is_refused_by_key() {
         assert!(message.contains(key) && !message.contains('\n'), "[sun] {sun:?}: {message}");
     }
 }
+
+/// A sun overhead over a floor under a lid lights nothing: the solve refuses to start with
+/// one line saying why, not a black picture.
+#[test]
+fn a_sun_that_lights_nothing_is_refused_with_a_reason() {
+    let (_dir, scene) = skylight([0.0, 1.0, 0.0], 100_000.0, false);
+    let mut scene = scene;
+    // A lid over the whole floor, facing down: closed as far as a sun overhead goes.
+    let lid = radiosity_core::Polygon::try_new(
+        [[0.0, 3.0, 0.0], [4.0, 3.0, 0.0], [4.0, 3.0, 4.0], [0.0, 3.0, 4.0]]
+            .map(radiosity_core::glam::DVec3::from)
+            .to_vec(),
+    )
+    .unwrap();
+    scene.objects.push(radiosity_core::Object::new("lid", 1, radiosity_core::Shape::Polygons(vec![lid])));
+    let err = Problem::new(&scene, &scene.mesh_params()).unwrap().solver(SolverParams::default()).err();
+    assert_eq!(err, Some(radiosity_solver::SolverError::DarkSun));
+    let message = radiosity_solver::SolverError::DarkSun.to_string();
+    assert!(message.contains("sun") && !message.contains('\n'), "{message}");
+}

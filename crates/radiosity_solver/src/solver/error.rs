@@ -17,6 +17,12 @@ pub enum SolverError {
         /// Luminaires in the scene.
         count: usize,
     },
+    /// Nothing emits, there is no luminaire, and the sun lights no element: every shadow ray
+    /// towards it meets the scene (a closed room) or it is below every surface.
+    #[error(
+        "the sun lights no surface and nothing else lights the scene: every shadow ray towards it meets the scene (a room with no opening) or it is below every surface; open the room, turn the sun or add a light"
+    )]
+    DarkSun,
     /// The mesh has no elements.
     #[error("the mesh has no elements")]
     EmptyMesh,

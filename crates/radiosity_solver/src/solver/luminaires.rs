@@ -30,7 +30,7 @@ pub(super) struct LuminaireLight {
     pub(super) irradiance: Vec<Rgb>,
     /// The luminaires' total flux, W per channel (lm / 683 × colour).
     pub(super) power: Rgb,
-    /// How many luminaires shine.
+    /// How many luminaires shine (the sun aside).
     pub(super) count: usize,
 }
 
@@ -63,7 +63,7 @@ impl LuminaireLight {
         let irradiance = both.into_iter().map(|(l, s)| l + s).collect();
         let power =
             luminaires.iter().map(|l| l.colour * (l.flux() / LUMENS_PER_WATT)).sum::<Rgb>() + sun_power;
-        Some(Self { irradiance, power, count: luminaires.len() + usize::from(sun.is_some()) })
+        Some(Self { irradiance, power, count: luminaires.len() })
     }
 
     /// Whether no light arrives anywhere.
