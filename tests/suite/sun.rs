@@ -2,28 +2,25 @@
 //! shadow rays towards it, against closed forms, in the solver and in `verify`'s path tracer.
 
 use radiosity_core::{LUMENS_PER_WATT, Scene};
-use radiosity_solver::{Problem, SolverParams};
+use radiosity_solver::{Problem, Solver, SolverParams};
 
 use crate::photometry::load;
 
-/// A grey floor (ρ = 0.5) of 4 × 4 m under a black roof 3 m up with a 1 × 1 m opening over
-/// its middle (`roof = false`: no roof), lit by a sun along `towards` of `lux` on a plane
-/// facing it.
-fn skylight(towards: [f64; 3], lux: f64, roof: bool) -> (tempfile::TempDir, Scene) {
-    let roof = if roof {
-        r#"
-[[object]]
-name = "roof"
-type = "polygons"
-material = "black"
-faces = [
-  [[0, 3, 0], [4, 3, 0], [4, 3, 1.5], [0, 3, 1.5]],
+/// The roof of [`skylight`] with a 1 × 1 m opening over the floor's middle.
+const OPENING: &str = "[[0, 3, 0], [4, 3, 0], [4, 3, 1.5], [0, 3, 1.5]],
   [[0, 3, 2.5], [4, 3, 2.5], [4, 3, 4], [0, 3, 4]],
   [[0, 3, 1.5], [1.5, 3, 1.5], [1.5, 3, 2.5], [0, 3, 2.5]],
-  [[2.5, 3, 1.5], [4, 3, 1.5], [4, 3, 2.5], [2.5, 3, 2.5]],
-]"#
+  [[2.5, 3, 1.5], [4, 3, 1.5], [4, 3, 2.5], [2.5, 3, 2.5]]";
+
+/// A grey floor (ρ = 0.5) of 4 × 4 m under a black roof 3 m up made of the faces `roof` (none
+/// when empty), lit by a sun along `towards` of `lux` on a plane facing it; 0.25 m elements.
+fn skylight(towards: [f64; 3], lux: f64, roof: &str) -> (tempfile::TempDir, Scene) {
+    let roof = if roof.is_empty() {
+        String::new()
     } else {
-        ""
+        format!(
+            "[[object]]\nname = \"roof\"\ntype = \"polygons\"\nmaterial = \"black\"\nfaces = [\n  {roof},\n]\n"
+        )
     };
     let text = format!(
         r#"
@@ -51,18 +48,34 @@ element_size = 0.25
     load(&text, &[])
 }
 
+/// `scene` solved with the default parameters.
+fn solved(scene: &Scene) -> Solver {
+    let mut solver =
+        Problem::new(scene, &scene.mesh_params()).unwrap().solver(SolverParams::default()).unwrap();
+    solver.solve();
+    solver
+}
+
+/// The floor's power in a solve, Σ B A (green channel), W.
+fn floor_power(solver: &Solver) -> f64 {
+    let mesh = solver.mesh().clone();
+    let radiosity = solver.solution().element_radiosity;
+    (0..mesh.elements.len())
+        .filter(|&e| mesh.object_names[mesh.element_object(e)] == "floor")
+        .map(|e| radiosity[e].g * mesh.elements[e].area)
+        .sum()
+}
+
 /// An open floor under a sun 60° from the zenith: every element gets E cos 60° (lux / 683 W
 /// per m² of Y on a plane facing the sun), so B = ρ E cos 60° on each, to round-off: nothing
 /// else lights it and a plane does not see itself.
 #[test]
 fn the_sun_lights_an_open_floor_by_the_cosine_law() {
     let t = 60f64.to_radians();
-    let (_dir, scene) = skylight([t.sin(), t.cos(), 0.0], 100_000.0, false);
+    let (_dir, scene) = skylight([t.sin(), t.cos(), 0.0], 100_000.0, "");
     let sun = scene.lighting.sun.expect("a sun");
     assert!((sun.irradiance.luminance() * LUMENS_PER_WATT / 100_000.0 - 1.0).abs() < 1e-12);
-    let mut solver =
-        Problem::new(&scene, &scene.mesh_params()).unwrap().solver(SolverParams::default()).unwrap();
-    solver.solve();
+    let solver = solved(&scene);
     let expected = 0.5 * sun.irradiance.g * t.cos();
     for b in solver.solution().element_radiosity {
         assert!((b.g / expected - 1.0).abs() < 1e-9, "{} against {expected}", b.g);
@@ -77,19 +90,11 @@ fn the_sun_lights_an_open_floor_by_the_cosine_law() {
 #[test]
 fn the_sun_through_a_roof_opening_lights_its_area() {
     use radiosity_reference::{EstimateParams, PathBudget, Reference};
-    let (_dir, scene) = skylight([0.0, 1.0, 0.0], 68_300.0, true);
+    let (_dir, scene) = skylight([0.0, 1.0, 0.0], 68_300.0, OPENING);
     let e = scene.lighting.sun.unwrap().irradiance.g;
     assert!((e / 100.0 - 1.0).abs() < 1e-12, "{e} W/m²");
     let expected = 0.5 * e * 1.0;
-    let mut solver =
-        Problem::new(&scene, &scene.mesh_params()).unwrap().solver(SolverParams::default()).unwrap();
-    solver.solve();
-    let mesh = solver.mesh().clone();
-    let radiosity = solver.solution().element_radiosity;
-    let power: f64 = (0..mesh.elements.len())
-        .filter(|&e| mesh.object_names[mesh.element_object(e)] == "floor")
-        .map(|e| radiosity[e].g * mesh.elements[e].area)
-        .sum();
+    let power = floor_power(&solved(&scene));
     assert!((power / expected - 1.0).abs() < 1e-6, "floor power {power} W against {expected}");
     let reference = Reference::new(&scene);
     let params = EstimateParams { budget: PathBudget::Fixed { paths: 20_000 }, ..EstimateParams::default() };
@@ -109,44 +114,10 @@ fn the_sun_through_a_roof_opening_lights_its_area() {
 /// element over 32 elements.
 #[test]
 fn the_sun_through_a_slit_lights_a_strip_narrower_than_an_element() {
-    let text = r#"
-units = "m"
-[sun]
-direction = [0, 1, 0]
-irradiance = [100, 100, 100]
-[[material]]
-name = "grey"
-reflectance = [0.5, 0.5, 0.5]
-[[material]]
-name = "black"
-reflectance = [0, 0, 0]
-[[object]]
-name = "floor"
-type = "polygon"
-material = "grey"
-vertices = [[0, 0, 0], [0, 0, 4], [4, 0, 4], [4, 0, 0]]
-[[object]]
-name = "roof"
-type = "polygons"
-material = "black"
-faces = [
-  [[0, 3, 0], [1.95, 3, 0], [1.95, 3, 4], [0, 3, 4]],
-  [[2.05, 3, 0], [4, 3, 0], [4, 3, 4], [2.05, 3, 4]],
-]
-[mesh]
-patch_size = 0.5
-element_size = 0.25
-"#;
-    let (_dir, scene) = load(text, &[]);
-    let mut solver =
-        Problem::new(&scene, &scene.mesh_params()).unwrap().solver(SolverParams::default()).unwrap();
-    solver.solve();
-    let mesh = solver.mesh().clone();
-    let radiosity = solver.solution().element_radiosity;
-    let power: f64 = (0..mesh.elements.len())
-        .filter(|&e| mesh.object_names[mesh.element_object(e)] == "floor")
-        .map(|e| radiosity[e].g * mesh.elements[e].area)
-        .sum();
+    let slit = "[[0, 3, 0], [1.95, 3, 0], [1.95, 3, 4], [0, 3, 4]],
+  [[2.05, 3, 0], [4, 3, 0], [4, 3, 4], [2.05, 3, 4]]";
+    let (_dir, scene) = skylight([0.0, 1.0, 0.0], 68_300.0, slit);
+    let power = floor_power(&solved(&scene));
     let expected = 0.5 * 100.0 * 0.4;
     eprintln!("slit: floor power {power} W against {expected} ({:+.2} %)", (power / expected - 1.0) * 100.0);
     assert!((power / expected - 1.0).abs() < 0.03, "floor power {power} W against {expected}");
@@ -184,16 +155,9 @@ fn a_sun_missing_its_direction_or_light_is_refused_by_key() {
 /// one line saying why, not a black picture.
 #[test]
 fn a_sun_that_lights_nothing_is_refused_with_a_reason() {
-    let (_dir, scene) = skylight([0.0, 1.0, 0.0], 100_000.0, false);
-    let mut scene = scene;
     // A lid over the whole floor, facing down: closed as far as a sun overhead goes.
-    let lid = radiosity_core::Polygon::try_new(
-        [[0.0, 3.0, 0.0], [4.0, 3.0, 0.0], [4.0, 3.0, 4.0], [0.0, 3.0, 4.0]]
-            .map(radiosity_core::glam::DVec3::from)
-            .to_vec(),
-    )
-    .unwrap();
-    scene.objects.push(radiosity_core::Object::new("lid", 1, radiosity_core::Shape::Polygons(vec![lid])));
+    let lid = "[[0, 3, 0], [4, 3, 0], [4, 3, 4], [0, 3, 4]]";
+    let (_dir, scene) = skylight([0.0, 1.0, 0.0], 100_000.0, lid);
     let err = Problem::new(&scene, &scene.mesh_params()).unwrap().solver(SolverParams::default()).err();
     assert_eq!(err, Some(radiosity_solver::SolverError::DarkSun));
     let message = radiosity_solver::SolverError::DarkSun.to_string();
