@@ -11,8 +11,9 @@
 //!
 //! The sun ([`Sun`]) shoots first the same way: E_sun cos θ times the part of each element
 //! whose shadow rays towards the sun leave the scene unblocked, by the blocking triangles or
-//! the hull's (see `occluders`), from 16 jittered points ([`sunlit_fraction`]). Its power is what the elements
-//! receive (light from infinity has no total of its own), so none of it escapes.
+//! the hull's (see `occluders`), from 16 jittered points ([`sunlit_fraction`]). Its power is
+//! what the elements receive (light from infinity has no total of its own), so none of it
+//! escapes.
 //!
 //! The luminaires' light is not the emitters' *direct part* (`Tally::direct`): a
 //! final gather recomputes only area emitters per pixel, and takes this light from the
@@ -37,11 +38,15 @@ pub(super) struct LuminaireLight {
 impl LuminaireLight {
     /// The direct light of `luminaires` and the `sun` on the elements of `mesh`, shadowed by
     /// `rays`; `None` without either.
+    ///
+    /// `hull` holds the occluder triangles left out of `rays` (a room's own walls, see
+    /// `occluders::hull_triangles`): no ray between two surface points crosses them, but a
+    /// shadow ray towards the sun, which ends past the scene, does. Needed with a sun only.
     pub(super) fn new(
         mesh: &Mesh,
         rays: &dyn RayQuery,
         luminaires: &[Luminaire],
-        sun: Option<&Sun>,
+        sun: Option<(&Sun, &Bvh)>,
     ) -> Option<Self> {
         if luminaires.is_empty() && sun.is_none() {
             return None;
@@ -49,11 +54,8 @@ impl LuminaireLight {
         let (lo, hi) = mesh.bounds();
         let diagonal = (hi - lo).length().max(f64::MIN_POSITIVE);
         let lift = 1e-6 * diagonal;
-        // A shadow ray towards the sun ends past the scene, twice its diagonal from any point,
-        // so the triangles no ray between two surface points can cross (a room's own walls,
-        // left out of `rays`) block it too.
-        let hull = sun.map(|_| Bvh::new(&crate::occluders::hull_triangles(mesh)));
-        let sun = sun.zip(hull.as_ref()).map(|(s, hull)| (s, 2.0 * diagonal, hull));
+        // A shadow ray towards the sun ends past the scene, twice its diagonal from any point.
+        let sun = sun.map(|(s, hull)| (s, 2.0 * diagonal, hull));
         let both: Vec<(Rgb, Rgb)> = (0..mesh.elements.len())
             .into_par_iter()
             .with_min_len(64)

@@ -110,7 +110,7 @@ pub struct Solver {
     /// once probed.
     enclosed: Vec<Option<bool>>,
     /// The occluder triangles left out of `accel` (a room's walls, see
-    /// `occluders::hull_triangles`), built at the first probe.
+    /// `occluders::hull_triangles`), built with the sun's light or at the first probe.
     hull: Option<radiosity_accel::Bvh>,
     /// How far the probe rays reach: twice the mesh's diagonal, measured once (a walk over
     /// every vertex at each shooter's first shot was 3 % of a furnished room's solve).
@@ -163,7 +163,11 @@ impl Solver {
     ) -> Result<Self, SolverError> {
         params.validate()?;
         mesh_tables::check_patch_runs(&mesh)?;
-        let light = luminaires::LuminaireLight::new(&mesh, accel.as_ref(), luminaires, sun);
+        // The hull's triangles block the sun's shadow rays and the enclosure probes alike:
+        // built once here when there is a sun, else at the first probe.
+        let hull = sun.map(|_| radiosity_accel::Bvh::new(&crate::occluders::hull_triangles(&mesh)));
+        let light =
+            luminaires::LuminaireLight::new(&mesh, accel.as_ref(), luminaires, sun.zip(hull.as_ref()));
         let tally = Tally::lit(&mesh, light.as_ref())?;
         let mut clusters = Clusters::new(&mesh, params.clustering);
         clusters.sum(&tally.patch_abs);
@@ -180,7 +184,7 @@ impl Solver {
             tally,
             progress: Progress::new(mesh.patches.len()),
             enclosed: vec![None; shooters],
-            hull: None,
+            hull,
             probe_reach: {
                 let (lo, hi) = mesh.bounds();
                 2.0 * (hi - lo).length()
