@@ -25,6 +25,24 @@ pub(super) fn for_each_maybe_parallel<T: Send>(items: &mut [T], f: impl Fn(usize
     }
 }
 
+/// Items per run of [`for_each_run_maybe_parallel`].
+const RUN: usize = 64;
+
+/// `f(first index, run)` for consecutive runs of [`RUN`] items (the last may be shorter), on
+/// the thread pool when there are enough items: per-item work whose scratch is too large to
+/// set up for each item sets it up once per run. Each item is in exactly one run, so the
+/// result is the same either way.
+pub(super) fn for_each_run_maybe_parallel<T: Send>(
+    items: &mut [T],
+    f: impl Fn(usize, &mut [T]) + Sync + Send,
+) {
+    if items.len() < PARALLEL_MIN || rayon::current_num_threads() == 1 {
+        items.chunks_mut(RUN).enumerate().for_each(|(c, run)| f(c * RUN, run));
+    } else {
+        items.par_chunks_mut(RUN).enumerate().for_each(|(c, run)| f(c * RUN, run));
+    }
+}
+
 /// A mesh is cut into about this many blocks...
 const BLOCKS: usize = 256;
 

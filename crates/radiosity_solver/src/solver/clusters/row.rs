@@ -9,7 +9,7 @@ use super::*;
 use crate::sampling::{Rng, point_on_f32};
 use crate::solver::SolverParams;
 use crate::solver::mesh_tables::MeshTables;
-use crate::solver::parallel::for_each_maybe_parallel;
+use crate::solver::parallel::{for_each_maybe_parallel, for_each_run_maybe_parallel};
 use crate::solver::row::Row;
 use crate::solver::shot::{ShotScratch, facet_rays};
 
@@ -45,29 +45,28 @@ impl Clusters {
         factors.resize(mesh.elements.len(), 0.0);
         // Rays traced, for the progress figures (an integer sum: the same in any order).
         let traced = AtomicU64::new(0);
-        // Elements in no sharing group, with their own rays; the sharing groups' below.
-        for_each_maybe_parallel(factors, |e, out| {
-            if sharing.shares(e) {
-                return;
-            }
-            let el = &mesh.elements[e];
-            let mut shares = [0.0; POINTS];
-            let (f, near) =
-                unoccluded(group, frozen, tables.vertex_means[e], el.normal, el.patch, &mut shares);
-            *out = f as f32;
-            if f > 0.0 {
-                let (visible, n) = aim.trace(e, f, near, &shares);
-                *out = if n == 0 { f as f32 } else { (f * f64::from(visible) / f64::from(n)) as f32 };
-                traced.fetch_add(u64::from(n), Ordering::Relaxed);
+        // Elements in no sharing group, with their own rays; the sharing groups' below. The
+        // near points' shares are scratch for a run of elements, not zeroed for each.
+        for_each_run_maybe_parallel(factors, |first, run| {
+            let mut scratch = [0.0; POINTS];
+            for (k, out) in run.iter_mut().enumerate() {
+                let e = first + k;
+                if sharing.shares(e) {
+                    continue;
+                }
+                let el = &mesh.elements[e];
+                let (f, shares) =
+                    unoccluded(group, frozen, tables.vertex_means[e], el.normal, el.patch, &mut scratch);
+                *out = f as f32;
+                if f > 0.0 {
+                    let (visible, n) = aim.trace(e, f, shares);
+                    *out = if n == 0 { f as f32 } else { (f * f64::from(visible) / f64::from(n)) as f32 };
+                    traced.fetch_add(u64::from(n), Ordering::Relaxed);
+                }
             }
         });
         let mut traced = traced.into_inner();
         if sharing.any() {
-            let unoccluded_at = |e: usize, shares: &mut [f64; POINTS]| {
-                let el = &mesh.elements[e];
-                unoccluded(group, frozen, tables.vertex_means[e], el.normal, el.patch, shares)
-            };
-
             let (received, rays) = sharing.receive(
                 self,
                 &tables.element_area,
@@ -75,15 +74,18 @@ impl Clusters {
                 // Another group's members: none is a patch of the shooting group.
                 |r, range| {
                     let receivers = &self.groups[r].receivers[range];
+                    let mut scratch = [0.0; POINTS];
                     receivers
                         .iter()
-                        .map(|&(p, n)| unoccluded(group, frozen, p, n, NONE, &mut [0.0; POINTS]).0)
+                        .map(|&(p, n)| unoccluded(group, frozen, p, n, NONE, &mut scratch).0)
                         .collect()
                 },
                 |e| {
-                    let mut shares = [0.0; POINTS];
-                    let (f, near) = unoccluded_at(e, &mut shares);
-                    aim.trace(e, f, near, &shares)
+                    let el = &mesh.elements[e];
+                    let mut scratch = [0.0; POINTS];
+                    let p = tables.vertex_means[e];
+                    let (f, shares) = unoccluded(group, frozen, p, el.normal, el.patch, &mut scratch);
+                    aim.trace(e, f, shares)
                 },
             );
             traced += rays;
@@ -122,14 +124,14 @@ struct Aim<'a> {
 
 impl Aim<'_> {
     /// Element `e`'s visibility rays to the group, whose unoccluded form factor to it is
-    /// `f`, near or not, with its points' `shares` of it when near: (unblocked, traced),
-    /// from the element's own stream.
+    /// `f`, with its points' `shares` of it when near: (unblocked, traced), from the
+    /// element's own stream.
     ///
     /// Rays end at points that give the receiver light: a ray to a point on a facet turned
     /// away would cross the model and count as blocked (the model then came out 2 % dark).
     /// Near the group, points by their share of the form factor, stratified; far, points by
     /// the cosine at them (rejection).
-    fn trace(&self, e: usize, f: f64, near: bool, shares: &[f64; POINTS]) -> (u32, u32) {
+    fn trace(&self, e: usize, f: f64, shares: Option<&[f64; POINTS]>) -> (u32, u32) {
         let Self { frozen, mesh, tables, accel, rays, seed, stream } = *self;
         let el = &mesh.elements[e];
         let p = tables.vertex_means[e];
@@ -139,7 +141,7 @@ impl Aim<'_> {
         let (mut walked, mut at) = (0.0, 0);
         let mut far_cdf = None;
         for j in 0..rays {
-            let target = if near {
+            let target = if let Some(shares) = shares {
                 let t = (f64::from(j) + rng.next_f64()) / f64::from(rays) * f;
                 while at + 1 < POINTS && walked + shares[at] < t {
                     walked += shares[at];
@@ -164,7 +166,7 @@ impl Aim<'_> {
                 // spares computing. Counting such a receiver unblocked lit the backs of
                 // Sponza's walls through the building from its sun sphere.
                 found.or_else(|| {
-                    let cdf = far_cdf.get_or_insert_with(|| far_weights(frozen, p, el.normal));
+                    let cdf = far_cdf.get_or_insert_with(|| far_weights(&frozen.near, p, el.normal));
                     draw(cdf, rng.next_f64())
                 })
             };
@@ -185,19 +187,29 @@ impl Aim<'_> {
 
 /// The cumulative weights of a group's points for a far receiver at `p` with normal `n`:
 /// cos θ at the point where the point and the receiver face each other, else 0 (the
-/// distribution [`Aim::trace`] draws far ray ends from by rejection).
-fn far_weights(frozen: &Frozen, p: DVec3, n: DVec3) -> [f64; POINTS] {
+/// distribution [`Aim::trace`] draws far ray ends from by rejection). In single precision
+/// about the group's centre, as [`near_factor`]: in double precision, one division and one
+/// square root per point after another, it was half of the group rows' own time in the
+/// furnished room.
+fn far_weights(pts: &NearPoints, p: DVec3, n: DVec3) -> [f64; POINTS] {
+    let d0 = (p - pts.origin).as_vec3();
+    let n = n.as_vec3();
+    let mut weights = [0.0f32; POINTS];
+    for (i, w) in weights.iter_mut().enumerate() {
+        // From the point to the receiver.
+        let d = [d0.x - pts.x[0][i], d0.y - pts.x[1][i], d0.z - pts.x[2][i]];
+        let out = pts.n[0][i] * d[0] + pts.n[1][i] * d[1] + pts.n[2][i] * d[2];
+        let faced = n.x * d[0] + n.y * d[1] + n.z * d[2] < 0.0;
+        let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        // A group of fewer than `POINTS` points pads the rest with zero normals: weight 0.
+        *w = if faced && out > 0.0 { out / r } else { 0.0 };
+    }
     let mut cdf = [0.0; POINTS];
     let mut sum = 0.0;
-    for (c, (q, nq, _)) in cdf.iter_mut().zip(&frozen.points) {
-        let d = p - *q;
-        if n.dot(-d) > 0.0 {
-            sum += (nq.dot(d) / d.length()).max(0.0);
-        }
+    for (c, w) in cdf.iter_mut().zip(weights) {
+        sum += f64::from(w);
         *c = sum;
     }
-    // A group with fewer points than `POINTS` leaves the rest at the total (never drawn).
-    cdf[frozen.points.len().min(POINTS)..].fill(sum);
     cdf
 }
 
@@ -214,21 +226,34 @@ fn draw(cdf: &[f64; POINTS], u: f64) -> Option<usize> {
 
 /// The form factor from a receiver at `p` (normal `n`, on patch `patch`) to the group,
 /// without visibility, such that the receiver's irradiance is the group's mean unshot
-/// radiosity ΔΦ/A times it, and whether it is near (then `shares` holds each point's part of
-/// it). A member receives from the group's other facets (a fold of the model), not from its
+/// radiosity ΔΦ/A times it, and when the receiver is near, each point's part of it (written
+/// into `scratch`, which far receivers leave alone: zeroed for every receiver of a row, its
+/// 256 entries were 4 % of a furnished room's solve). A member receives from the group's other facets (a fold of the model), not from its
 /// own.
-pub(super) fn unoccluded(
+pub(super) fn unoccluded<'a>(
     group: &Group,
     frozen: &Frozen,
     p: DVec3,
     n: DVec3,
     patch: u32,
-    shares: &mut [f64; POINTS],
-) -> (f64, bool) {
+    scratch: &'a mut [f64; POINTS],
+) -> (f64, Option<&'a [f64; POINTS]>) {
+    match far_factor(group, frozen, p, n) {
+        Some(f) => (f, None),
+        None => {
+            let f = near_factor(group, frozen, p, n, patch, scratch);
+            (f, Some(scratch))
+        }
+    }
+}
+
+/// The form factor from a receiver at `p` (normal `n`) to the group when the group is all
+/// behind the receiver (0) or far from it (its far field); `None` when its points decide.
+fn far_factor(group: &Group, frozen: &Frozen, p: DVec3, n: DVec3) -> Option<f64> {
     let to_centre = group.centre - p;
     // All of the group behind the receiver's plane.
     if n.dot(to_centre) <= -group.radius {
-        return (0.0, false);
+        return Some(0.0);
     }
     let r2 = to_centre.length_squared();
     // An emitting group takes its points at any distance: its shot is the direct light, and
@@ -241,11 +266,24 @@ pub(super) fn unoccluded(
         let d = -to_centre / r; // from the group towards the receiver
         let cos_r = -n.dot(d);
         if cos_r <= 0.0 {
-            return (0.0, false);
+            return Some(0.0);
         }
         let out = frozen.lobe(d);
-        return (group.area * out * cos_r / (std::f64::consts::PI * r2), false);
+        return Some(group.area * out * cos_r / (std::f64::consts::PI * r2));
     }
+    None
+}
+
+/// The form factor from a receiver at `p` (normal `n`, on patch `patch`) to the group by its
+/// points, each point's part of it in `shares`.
+fn near_factor(
+    group: &Group,
+    frozen: &Frozen,
+    p: DVec3,
+    n: DVec3,
+    patch: u32,
+    shares: &mut [f64; POINTS],
+) -> f64 {
     let disc = group.area / POINTS as f64;
     let pts = &frozen.near;
     // In single precision about the group's centre (7 digits, far below the points' own
@@ -271,5 +309,5 @@ pub(super) fn unoccluded(
             sums[k] += shares[k];
         }
     }
-    ((sums[0] + sums[1]) + (sums[2] + sums[3]), true)
+    (sums[0] + sums[1]) + (sums[2] + sums[3])
 }

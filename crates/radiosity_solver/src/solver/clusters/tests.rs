@@ -274,9 +274,9 @@ fn the_far_field_is_the_members_sum() {
             let dir = (axis + tilt).normalize();
             let p = group.centre + dir * 10.0 * group.radius;
             let n = -dir;
-            let mut shares = [0.0; POINTS];
-            let (far, near) = unoccluded(group, frozen, p, n, u32::MAX, &mut shares);
-            assert!(!near);
+            let mut scratch = [0.0; POINTS];
+            let (far, shares) = unoccluded(group, frozen, p, n, u32::MAX, &mut scratch);
+            assert!(shares.is_none());
             let exact: f64 = (group.patches.iter())
                 .map(|&q| {
                     let patch = &mesh.patches[q as usize];
@@ -321,17 +321,12 @@ fn an_emitting_group_lights_receivers_by_its_points_at_any_distance() {
                     if in_front { crate::form_factor::point_to_polygon(p, n, patch.corners()) } else { 0.0 }
                 })
                 .sum();
-            let mut shares = [0.0; POINTS];
-            let (points, near) =
-                unoccluded(group, lit.groups[g].frozen.as_ref().unwrap(), p, n, u32::MAX, &mut shares);
-            let (far, far_near) = unoccluded(
-                dark.group(g),
-                dark.groups[g].frozen.as_ref().unwrap(),
-                p,
-                n,
-                u32::MAX,
-                &mut shares,
-            );
+            let (mut scratch, mut far_scratch) = ([0.0; POINTS], [0.0; POINTS]);
+            let lit_frozen = lit.groups[g].frozen.as_ref().unwrap();
+            let (points, shares) = unoccluded(group, lit_frozen, p, n, u32::MAX, &mut scratch);
+            let dark_frozen = dark.groups[g].frozen.as_ref().unwrap();
+            let (far, far_shares) = unoccluded(dark.group(g), dark_frozen, p, n, u32::MAX, &mut far_scratch);
+            let (near, far_near) = (shares.is_some(), far_shares.is_some());
             let (points, far) = (points / exact - 1.0, far / exact - 1.0);
             println!(
                 "group {g}, tilt {tilt}°: points {:+.2} %, far field {:+.2} %",
