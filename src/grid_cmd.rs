@@ -8,7 +8,7 @@ use clap::Args;
 use radiosity_image::{GridIlluminance, PictureFormat, encode_png, grid_picture, picture_sheet};
 
 use crate::errors::InputError;
-use crate::lighting_cmd::{compute_grids, grid_table, write_grid_csv};
+use crate::lighting_cmd::{compute_grids, grid_table, sky_lux, write_grid_csv};
 use crate::output::{self, Targets, note};
 use crate::prepare::{Prepared, prepare, run_solver};
 use crate::solve_opts::SolveOpts;
@@ -77,7 +77,7 @@ pub fn run(a: GridArgs) -> Result<()> {
         report.total_shots,
         report.elapsed.as_secs_f64()
     ))?;
-    output::stdout(&grid_table(&grids))?;
+    output::stdout(&grid_table(&grids, sky_lux(&prepared.scene)))?;
     if let Some(path) = &a.output {
         write_grid_csv(path, a.force, &prepared, &grids)?;
     }

@@ -37,21 +37,37 @@ pub fn compute_grids(prepared: &Prepared, solution: &Solution) -> Result<Vec<Gri
     })
 }
 
-/// One line per grid: Em, Emin, Emax, U0.
-pub fn grid_table(grids: &[GridIlluminance]) -> String {
+/// Illuminance of the scene's sky on an open horizontal plane, lx (`None` without a sky):
+/// what daylight factors are taken against (CIE overcast sky; EN 17037).
+pub fn sky_lux(scene: &radiosity_core::Scene) -> Option<f64> {
+    let to_lux = scene.lighting.unit().lux_per_irradiance();
+    scene.lighting.sky.map(|s| s.horizontal_irradiance().luminance() * to_lux).filter(|&e| e > 0.0)
+}
+
+/// One line per grid: Em, Emin, Emax, U0, and with a sky (`sky_lux`, see [`sky_lux`]) the
+/// mean daylight factor Em / E_sky.
+pub fn grid_table(grids: &[GridIlluminance], sky_lux: Option<f64>) -> String {
+    let df = |g: &GridIlluminance| sky_lux.map_or(String::new(), |e| format!(" {:>7.2}", 100.0 * g.avg / e));
     let mut t = format!(
-        "{:<24} {:>7} {:>10} {:>10} {:>10} {:>7}\n",
-        "grid", "points", "Em lx", "Emin lx", "Emax lx", "U0"
+        "{:<24} {:>7} {:>10} {:>10} {:>10} {:>7}{}\n",
+        "grid",
+        "points",
+        "Em lx",
+        "Emin lx",
+        "Emax lx",
+        "U0",
+        if sky_lux.is_some() { format!(" {:>7}", "DF %") } else { String::new() }
     );
     for g in grids {
         t += &format!(
-            "{:<24} {:>7} {:>10.1} {:>10.1} {:>10.1} {:>7.3}\n",
+            "{:<24} {:>7} {:>10.1} {:>10.1} {:>10.1} {:>7.3}{}\n",
             g.name,
             g.lux.len(),
             g.avg,
             g.min,
             g.max,
-            g.uniformity
+            g.uniformity,
+            df(g)
         );
     }
     t
@@ -62,6 +78,7 @@ pub fn lighting_json(prepared: &Prepared, grids: &[GridIlluminance]) -> Value {
     let lighting = &prepared.scene.lighting;
     let up = prepared.up;
     let file = |p: DVec3| up.from_y_up(p).to_array();
+    let sky = sky_lux(&prepared.scene);
     json!({
         "units": lighting.unit().as_str(),
         "luminaires": lighting.luminaires.iter().map(|l| json!({
@@ -83,7 +100,9 @@ pub fn lighting_json(prepared: &Prepared, grids: &[GridIlluminance]) -> Value {
             "avg": g.avg,
             "max": g.max,
             "uniformity": g.uniformity,
+            "daylight_factor": sky.map(|e| 100.0 * g.avg / e),
         })).collect::<Vec<_>>(),
+        "sky_lux": sky,
     })
 }
 

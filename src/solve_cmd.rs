@@ -85,7 +85,7 @@ pub fn run(a: SolveArgs) -> Result<()> {
             }
         }
         if !grids.is_empty() {
-            table += &crate::lighting_cmd::grid_table(&grids);
+            table += &crate::lighting_cmd::grid_table(&grids, crate::lighting_cmd::sky_lux(&prepared.scene));
         }
         output::stdout(&table)?;
     }
@@ -123,7 +123,7 @@ pub fn run(a: SolveArgs) -> Result<()> {
         });
         if scene.lighting.is_photometric() {
             let lighting = crate::lighting_cmd::lighting_json(&prepared, &grids);
-            for key in ["units", "luminaires", "grids"] {
+            for key in ["units", "luminaires", "grids", "sky_lux"] {
                 doc[key] = lighting[key].clone();
             }
         }

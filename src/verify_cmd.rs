@@ -136,7 +136,7 @@ pub fn run(a: VerifyArgs) -> Result<()> {
         let rays = prepared.problem.ray_queries().clone();
         prepared.problem = Problem::with_ray_queries(Arc::new(mesh), rays)
             .with_luminaires(prepared.scene.lighting.luminaires.clone())
-            .with_sun(prepared.scene.lighting.sun);
+            .with_daylight(prepared.scene.lighting.daylight());
     }
     let (solver, report) = run_solver(&prepared)?;
     let Prepared { scene, problem, .. } = &prepared;

@@ -20,6 +20,7 @@ mod progress;
 mod public_models;
 mod readme;
 mod rooms;
+mod sky;
 mod sun;
 mod surface_grids;
 mod textures;

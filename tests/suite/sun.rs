@@ -159,7 +159,7 @@ fn a_sun_that_lights_nothing_is_refused_with_a_reason() {
     let lid = "[[0, 3, 0], [4, 3, 0], [4, 3, 4], [0, 3, 4]]";
     let (_dir, scene) = skylight([0.0, 1.0, 0.0], 100_000.0, lid);
     let err = Problem::new(&scene, &scene.mesh_params()).unwrap().solver(SolverParams::default()).err();
-    assert_eq!(err, Some(radiosity_solver::SolverError::DarkSun));
-    let message = radiosity_solver::SolverError::DarkSun.to_string();
+    assert_eq!(err, Some(radiosity_solver::SolverError::DarkDaylight));
+    let message = radiosity_solver::SolverError::DarkDaylight.to_string();
     assert!(message.contains("sun") && !message.contains('\n'), "{message}");
 }

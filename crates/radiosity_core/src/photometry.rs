@@ -455,6 +455,92 @@ impl Sun {
     }
 }
 
+/// The light from infinity, which shoots first: the sun and the sky, either or both.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Daylight {
+    /// Sunlight.
+    pub sun: Option<Sun>,
+    /// Skylight.
+    pub sky: Option<Sky>,
+}
+
+impl Daylight {
+    /// Whether there is neither.
+    pub fn is_none(&self) -> bool {
+        self.sun.is_none() && self.sky.is_none()
+    }
+}
+
+/// How a sky's radiance varies with height above the horizon.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SkyModel {
+    /// The same radiance everywhere above the horizon.
+    Uniform,
+    /// The CIE standard overcast sky (Moon & Spencer 1942; CIE S 011/E:2003, sky type 1):
+    /// L(θ) = L_z (1 + 2 cos θ) / 3, θ from the zenith, three times brighter at the zenith
+    /// than at the horizon. The sky of daylight factors.
+    CieOvercast,
+}
+
+impl SkyModel {
+    /// The radiance at `cos_zenith` (cosine of the angle from the zenith, > 0) over the
+    /// zenith's.
+    pub fn relative_radiance(self, cos_zenith: f64) -> f64 {
+        match self {
+            Self::Uniform => 1.0,
+            Self::CieOvercast => (1.0 + 2.0 * cos_zenith) / 3.0,
+        }
+    }
+
+    /// The irradiance on an unobstructed horizontal plane over π L_z: ∫ g(θ) cos θ dω / π,
+    /// 1 for the uniform sky, 2 ∫₀¹ (1 + 2μ)/3 μ dμ = 7/9 for the overcast one.
+    pub fn horizontal_factor(self) -> f64 {
+        match self {
+            Self::Uniform => 1.0,
+            Self::CieOvercast => 7.0 / 9.0,
+        }
+    }
+}
+
+/// Skylight: diffuse light from a dome at infinity above the horizon, shooting first, by
+/// shadow rays towards it, as the sun does. Below the horizon there is no sky (the ground
+/// outside the model is black: model the ground to have it reflect).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sky {
+    /// Unit direction of the zenith (the scene's up).
+    pub zenith: DVec3,
+    /// How its radiance varies with height.
+    pub model: SkyModel,
+    /// Radiance at the zenith times π, W/unit² per channel: the radiosity a surface of that
+    /// radiance has, so that an unobstructed horizontal plane under a uniform sky receives
+    /// it as irradiance.
+    pub zenith_radiosity: Rgb,
+    /// Shadow rays per element towards it (stratified over the element's hemisphere).
+    pub rays: u32,
+}
+
+impl Sky {
+    /// Rays per element when the scene does not say.
+    pub const DEFAULT_RAYS: u32 = 64;
+
+    /// A sky of `model` whose unobstructed horizontal irradiance is `horizontal`.
+    pub fn from_horizontal(model: SkyModel, zenith: DVec3, horizontal: Rgb, rays: u32) -> Self {
+        Self { zenith, model, zenith_radiosity: horizontal * (1.0 / model.horizontal_factor()), rays }
+    }
+
+    /// π times the radiance seen along unit direction `towards` (0 at and below the horizon):
+    /// what a ray escaping the scene that way brings, in radiosity units.
+    pub fn radiosity_towards(&self, towards: DVec3) -> Rgb {
+        let c = towards.dot(self.zenith);
+        if c > 0.0 { self.zenith_radiosity * self.model.relative_radiance(c) } else { Rgb::ZERO }
+    }
+
+    /// Irradiance on an unobstructed horizontal plane facing the zenith.
+    pub fn horizontal_irradiance(&self) -> Rgb {
+        self.zenith_radiosity * self.model.horizontal_factor()
+    }
+}
+
 /// The photometric part of a scene: its unit, luminaires and grids.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Lighting {
@@ -467,6 +553,8 @@ pub struct Lighting {
     pub grids: Vec<Grid>,
     /// Sunlight, when the scene has it.
     pub sun: Option<Sun>,
+    /// Skylight, when the scene has it.
+    pub sky: Option<Sky>,
 }
 
 impl Lighting {
@@ -478,6 +566,11 @@ impl Lighting {
     /// Whether the scene asks for photometric figures (a unit, a luminaire or a grid).
     pub fn is_photometric(&self) -> bool {
         self.units.is_some() || !self.luminaires.is_empty() || !self.grids.is_empty()
+    }
+
+    /// The light from infinity: the sun and the sky.
+    pub fn daylight(&self) -> Daylight {
+        Daylight { sun: self.sun, sky: self.sky }
     }
 
     /// Total luminaire flux, lm.
@@ -496,6 +589,9 @@ impl Lighting {
         if let Some(sun) = &mut self.sun {
             sun.towards = f(sun.towards);
         }
+        if let Some(sky) = &mut self.sky {
+            sky.zenith = f(sky.zenith);
+        }
         for g in &mut self.grids {
             g.origin = f(g.origin);
             g.u = f(g.u);
@@ -508,6 +604,29 @@ impl Lighting {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Each sky model's horizontal factor is ∫ g(θ) cos θ dω / π over the upper hemisphere,
+    /// here by the midpoint rule over 20 000 rings of μ = cos θ (dω = 2π dμ).
+    #[test]
+    fn sky_horizontal_factors_are_the_integrals_of_their_radiance() {
+        for model in [SkyModel::Uniform, SkyModel::CieOvercast] {
+            let n = 20_000;
+            let integral: f64 = (0..n)
+                .map(|i| {
+                    let mu = (f64::from(i) + 0.5) / f64::from(n);
+                    model.relative_radiance(mu) * mu * 2.0 * PI / f64::from(n)
+                })
+                .sum();
+            assert!((integral / PI - model.horizontal_factor()).abs() < 1e-8, "{model:?}");
+        }
+        let sky = Sky::from_horizontal(SkyModel::CieOvercast, DVec3::Y, Rgb::splat(10.0), 64);
+        assert!((sky.horizontal_irradiance().g - 10.0).abs() < 1e-12);
+        assert_eq!(sky.radiosity_towards(-DVec3::Y), Rgb::ZERO, "no sky below the horizon");
+        // Three times brighter at the zenith than at the horizon.
+        let (zenith, horizon) =
+            (sky.radiosity_towards(DVec3::Y).g, sky.radiosity_towards(DVec3::new(1.0, 1e-9, 0.0)).g);
+        assert!((zenith / horizon - 3.0).abs() < 1e-6);
+    }
 
     #[test]
     fn isotropic_flux_is_four_pi_i() {

@@ -638,7 +638,7 @@ impl Scene {
     }
 
     /// Multiplies every light by `scale` (the seed document's light intensity, S11): every
-    /// material's emission and every luminaire's intensity ([`crate::Luminaire::scale`]) and the sun's, so
+    /// material's emission and every luminaire's intensity ([`crate::Luminaire::scale`]), the sun's and the sky's, so
     /// that `--light-scale` brightens a scene lit by photometric files as it does one lit by
     /// emissive surfaces.
     pub fn scale_emission(&mut self, scale: f64) {
@@ -650,6 +650,9 @@ impl Scene {
         }
         if let Some(sun) = &mut self.lighting.sun {
             sun.irradiance *= scale;
+        }
+        if let Some(sky) = &mut self.lighting.sky {
+            sky.zenith_radiosity *= scale;
         }
     }
 

@@ -95,7 +95,7 @@ pub fn luminaire_irradiance(lighting: &Lighting, blockers: &dyn RayQuery, p: DVe
 
 /// The illuminance of every point of `grid`: the luminaires' and the sun's direct light by shadow rays
 /// against `blockers` (the solver's occluders), the reflected light gathered from `solution`
-/// through `renderer`.
+/// through `renderer`, and the sky's where those gathering rays leave the scene.
 ///
 /// # Errors
 /// [`RenderError::SolutionMismatch`] when `solution` is for another mesh;
@@ -128,8 +128,9 @@ pub fn grid_illuminance(
     let reach = 2.0 * (hi - lo).length();
     let sunlight = |from: DVec3, n: DVec3| match (&lighting.sun, &hull) {
         (Some(sun), Some(hull)) => {
-            let to = (from + sun.towards * reach).as_vec3();
-            let clear = !blockers.occluded(from.as_vec3(), to) && !hull.occluded(from.as_vec3(), to);
+            let (from, towards, reach) = (from.as_vec3(), sun.towards.as_vec3(), reach as f32);
+            let clear = !blockers.occluded_towards(from, towards, reach)
+                && !hull.occluded_towards(from, towards, reach);
             if clear { sun.irradiance_on(n) } else { Rgb::ZERO }
         }
         _ => Rgb::ZERO,
@@ -143,17 +144,23 @@ pub fn grid_illuminance(
             let direct = luminaire_irradiance(lighting, blockers, p, n) + sunlight(p + n * lift, n);
             let mut rng = Rng::for_task(params.seed, GRID_TASK, i as u64);
             let origin = p + n * lift;
-            let mut gathered = Rgb::ZERO;
+            let (mut gathered, mut skylight) = (Rgb::ZERO, Rgb::ZERO);
             for k in 0..columns * rows {
                 let (j, r) = (k % columns, k / columns);
                 let u = (f64::from(j) + rng.next_f64()) / f64::from(columns);
                 let v = (f64::from(r) + rng.next_f64()) / f64::from(rows);
                 let dir = cosine_direction(n, u, v);
-                if let Ok(Some(hit)) = renderer.trace(solution, origin, dir, Shading::Smooth) {
-                    gathered += hit.radiance * PI;
+                match renderer.trace(solution, origin, dir, Shading::Smooth) {
+                    Ok(Some(hit)) => gathered += hit.radiance * PI,
+                    // A ray that leaves the scene meets the sky: direct light, by the
+                    // density that drew it π L (see `Sky::radiosity_towards`).
+                    Ok(None) => skylight += lighting.sky.map_or(Rgb::ZERO, |s| s.radiosity_towards(dir)),
+                    Err(_) => {}
                 }
             }
-            let reflected = gathered / f64::from(columns * rows);
+            let count = f64::from(columns * rows);
+            let reflected = gathered / count;
+            let direct = direct + skylight / count;
             let direct_lux = direct.luminance() * to_lux;
             (direct_lux + reflected.luminance() * to_lux, direct_lux)
         })

@@ -91,6 +91,28 @@ pub(crate) struct SceneDesc {
     pub(crate) grid: Vec<Spanned<GridDesc>>,
     /// `[sun]`: parallel light from a direction at infinity.
     pub(crate) sun: Option<Spanned<SunDesc>>,
+    /// `[sky]`: diffuse light from a dome at infinity.
+    pub(crate) sky: Option<Spanned<SkyDesc>>,
+}
+
+/// `[sky]`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct SkyDesc {
+    /// `"cie-overcast"` (default) or `"uniform"`.
+    pub(crate) model: Option<Spanned<String>>,
+    /// Illuminance on an unobstructed horizontal plane, lx (overcast: about 10 000).
+    pub(crate) illuminance: Option<Spanned<f64>>,
+    /// Irradiance on an unobstructed horizontal plane, W/unit² per channel.
+    #[serde(deserialize_with = "point_opt", default)]
+    pub(crate) irradiance: Option<Spanned<[f64; 3]>>,
+    /// Linear RGB colour of `illuminance`'s light, scaled to luminance 1; default white.
+    #[serde(deserialize_with = "point_opt", default)]
+    pub(crate) colour: Option<Spanned<[f64; 3]>>,
+    /// Colour as a correlated colour temperature, K.
+    pub(crate) cct: Option<Spanned<f64>>,
+    /// Shadow rays per element towards the sky.
+    pub(crate) rays: Option<Spanned<i64>>,
 }
 
 /// `[sun]`.

@@ -3,18 +3,19 @@
 //! emission (the RGB ↔ lumen rule is [`radiosity_core::photometric_y`]'s: 683 lm/W of
 //! Rec. 709 Y).
 
+use std::ops::Range;
 use std::path::Path;
 use std::sync::Arc;
 
 use radiosity_core::glam::DVec3;
 use radiosity_core::{
     Grid, IntensityTable, LUMENS_PER_WATT, LengthUnit, Lighting, Luminaire, Material, Object, Rgb, Shape,
-    Sides, Sun, UpAxis, colour_of_cct, unit_luminance,
+    Sides, Sky, SkyModel, Sun, UpAxis, colour_of_cct, unit_luminance,
 };
 use toml::Spanned;
 
 use crate::LoadError;
-use crate::desc::{MaterialDesc, SceneDesc, SunDesc};
+use crate::desc::{MaterialDesc, SceneDesc, SkyDesc, SunDesc};
 use crate::locate::Locator;
 use crate::photometric::load_photometry;
 
@@ -191,45 +192,102 @@ fn sun(loc: &Locator, d: &Spanned<SunDesc>, unit: LengthUnit) -> Result<Sun, Loa
         return Err(loc.at(span, "sun.direction", "the sun needs direction = [x, y, z] (towards the sun)"));
     };
     let towards = direction(loc, "sun.direction".into(), towards)?;
-    let irradiance = match (&d.illuminance, &d.irradiance) {
-        (Some(lx), None) => {
-            let colour = light_colour(loc, "sun", d.colour.as_ref(), d.cct.as_ref())?;
-            colour * (positive(loc, "sun.illuminance".into(), lx)? / unit.lux_per_irradiance())
-        }
-        (None, Some(w)) => {
-            if let Some(c) = &d.colour {
-                return Err(loc.at(
-                    c.span(),
-                    "sun.colour",
-                    "irradiance has its own colour; colour goes with illuminance",
-                ));
-            }
-            let e = Rgb::from_array(*w.get_ref());
-            if !(e.is_finite() && e.min_channel() >= 0.0 && e.max_channel() > 0.0) {
-                return Err(loc.at(
-                    w.span(),
-                    "sun.irradiance",
-                    "irradiance must be finite, ≥ 0 and not black",
-                ));
-            }
-            e
-        }
-        (Some(lx), Some(_)) => {
-            return Err(loc.at(
-                lx.span(),
-                "sun.illuminance",
-                "give illuminance (lx) or irradiance (W/unit²), not both",
-            ));
-        }
-        (None, None) => {
+    let amount =
+        Amount { illuminance: &d.illuminance, irradiance: &d.irradiance, colour: &d.colour, cct: &d.cct };
+    let irradiance = amount.irradiance(loc, span, "sun", "on a plane facing it", unit)?;
+    Ok(Sun { towards, irradiance })
+}
+
+/// The `[sky]` table: a model and its unobstructed horizontal light, lux (with a colour) or
+/// W/unit²; the zenith is the file's up axis.
+fn sky(loc: &Locator, d: &Spanned<SkyDesc>, unit: LengthUnit, zenith: DVec3) -> Result<Sky, LoadError> {
+    let (span, d) = (d.span(), d.get_ref());
+    let model = match d.model.as_ref().map(|m| (m.span(), m.get_ref().as_str())) {
+        None | Some((_, "cie-overcast")) => SkyModel::CieOvercast,
+        Some((_, "uniform")) => SkyModel::Uniform,
+        Some((span, other)) => {
+            let other = radiosity_core::escape_controls(other);
             return Err(loc.at(
                 span,
-                "sun",
-                "the sun needs illuminance = <lx> or irradiance = [r, g, b] (W/unit²)",
+                "sky.model",
+                format!("unknown sky model '{other}' (cie-overcast or uniform)"),
             ));
         }
     };
-    Ok(Sun { towards, irradiance })
+    let rays = match &d.rays {
+        None => Sky::DEFAULT_RAYS,
+        Some(r) if (1..=MAX_SKY_RAYS).contains(r.get_ref()) => *r.get_ref() as u32,
+        Some(r) => {
+            return Err(loc.at(
+                r.span(),
+                "sky.rays",
+                format!("expected a whole number from 1 to {MAX_SKY_RAYS}"),
+            ));
+        }
+    };
+    let amount =
+        Amount { illuminance: &d.illuminance, irradiance: &d.irradiance, colour: &d.colour, cct: &d.cct };
+    let horizontal = amount.irradiance(loc, span, "sky", "on an open horizontal plane", unit)?;
+    Ok(Sky::from_horizontal(model, zenith, horizontal, rays))
+}
+
+/// The most shadow rays per element a `[sky]` may ask for.
+const MAX_SKY_RAYS: i64 = 4096;
+
+/// How much light a sun or a sky gives, as written: lux with a colour, or W/unit².
+struct Amount<'a> {
+    illuminance: &'a Option<Spanned<f64>>,
+    irradiance: &'a Option<Spanned<[f64; 3]>>,
+    colour: &'a Option<Spanned<[f64; 3]>>,
+    cct: &'a Option<Spanned<f64>>,
+}
+
+impl Amount<'_> {
+    /// The irradiance per channel, W/unit²; errors name `table`'s keys (`span` is the
+    /// table's, for a missing amount; `plane` says where the amount is measured).
+    fn irradiance(
+        &self,
+        loc: &Locator,
+        span: Range<usize>,
+        table: &str,
+        plane: &str,
+        unit: LengthUnit,
+    ) -> Result<Rgb, LoadError> {
+        match (self.illuminance, self.irradiance) {
+            (Some(lx), None) => {
+                let colour = light_colour(loc, table, self.colour.as_ref(), self.cct.as_ref())?;
+                Ok(colour * (positive(loc, format!("{table}.illuminance"), lx)? / unit.lux_per_irradiance()))
+            }
+            (None, Some(w)) => {
+                if let Some(c) = self.colour {
+                    return Err(loc.at(
+                        c.span(),
+                        format!("{table}.colour"),
+                        "irradiance has its own colour; colour goes with illuminance",
+                    ));
+                }
+                let e = Rgb::from_array(*w.get_ref());
+                if !(e.is_finite() && e.min_channel() >= 0.0 && e.max_channel() > 0.0) {
+                    return Err(loc.at(
+                        w.span(),
+                        format!("{table}.irradiance"),
+                        "irradiance must be finite, ≥ 0 and not black",
+                    ));
+                }
+                Ok(e)
+            }
+            (Some(lx), Some(_)) => Err(loc.at(
+                lx.span(),
+                format!("{table}.illuminance"),
+                "give illuminance (lx) or irradiance (W/unit²), not both",
+            )),
+            (None, None) => Err(loc.at(
+                span,
+                table,
+                format!("the {table} needs illuminance = <lx> or irradiance = [r, g, b] (W/unit²), {plane}"),
+            )),
+        }
+    }
 }
 
 /// The `[[luminaire]]` and `[[grid]]` entries, in the file's frame (`up`: the file's up axis,
@@ -423,7 +481,8 @@ pub(crate) fn lighting(
         grids.push(Grid { name, origin, u, v, divisions, normal, height });
     }
     let sun = desc.sun.as_ref().map(|d| sun(loc, d, unit)).transpose()?;
-    Ok(Lighting { units, luminaires, grids, sun })
+    let sky = desc.sky.as_ref().map(|d| sky(loc, d, unit, file_up)).transpose()?;
+    Ok(Lighting { units, luminaires, grids, sun, sky })
 }
 
 /// How far a surface's grid points stand off it, metres.

@@ -257,6 +257,7 @@ pub fn parse_scene_with(text: &str, origin: &str, opts: &LoadOptions) -> Result<
     let unused_light = materials.iter().enumerate().position(|(i, m)| m.is_emitter() && !used[i]);
     let lit = !lighting.luminaires.is_empty()
         || lighting.sun.is_some()
+        || lighting.sky.is_some()
         || objects.iter().any(|o| materials.get(o.material).is_some_and(Material::is_emitter));
     let build = if opts.allow_no_light || lit { Scene::try_new_unlit } else { Scene::try_new };
     let scene_error = |e: SceneError| match e {

@@ -103,6 +103,8 @@ pub(crate) struct Geometry {
     /// The scene's sun (next-event estimation towards it, every vertex) and how far a shadow
     /// ray towards it reaches: past the scene.
     pub sun: Option<(radiosity_core::Sun, f64)>,
+    /// The scene's sky: what a path that leaves the scene meets.
+    pub sky: Option<radiosity_core::Sky>,
 }
 
 /// Index of the first entry of the non-decreasing `cdf` that exceeds `u · total`.
@@ -132,6 +134,7 @@ impl Geometry {
             offset: 0.0,
             luminaires: scene.lighting.luminaires.clone(),
             sun: None,
+            sky: None,
         };
         for (oi, o) in scene.objects.iter().enumerate() {
             let material = &scene.materials[o.material];
@@ -224,6 +227,7 @@ impl Geometry {
         let (lo, hi) = scene.bounds();
         g.offset = 1e-5 * (hi - lo).length().max(f64::MIN_POSITIVE);
         g.sun = scene.lighting.sun.map(|s| (s, 2.0 * (hi - lo).length().max(f64::MIN_POSITIVE)));
+        g.sky = scene.lighting.sky;
         g
     }
 
@@ -311,6 +315,22 @@ impl Geometry {
             }
         }
         best.map(|(_, point)| RayHit { point, front: point.n.dot(dir) < 0.0 })
+    }
+
+    /// True when something lies along the ray from `from` along unit `dir` before `reach`
+    /// (towards light at infinity), its start excluded by 1e-8 of `reach`, not 1e-4: see
+    /// `RayQuery::occluded_towards`, which the triangles take; a sphere's test takes the
+    /// same margin.
+    pub fn occluded_towards(&self, from: DVec3, dir: DVec3, reach: f64) -> bool {
+        if self.bvh.occluded_towards(from.as_vec3(), dir.as_vec3(), reach as f32) {
+            return true;
+        }
+        self.spheres.iter().any(|&s| {
+            let Primitive::Sphere { center, radius, .. } = self.pieces[s as usize].shape else {
+                return false;
+            };
+            sphere_hit(center, radius, from, dir, 1e-8 * reach, reach).is_some()
+        })
     }
 
     /// True when something lies strictly between `from` and `to` (both ends excluded by

@@ -74,7 +74,7 @@ impl Geometry {
         }
         if let Some((sun, reach)) = &self.sun {
             let h = sun.irradiance_on(n);
-            if h.max_channel() > 0.0 && !self.occluded(from, from + sun.towards * *reach) {
+            if h.max_channel() > 0.0 && !self.occluded_towards(from, sun.towards, *reach) {
                 sum += h;
             }
         }
@@ -88,12 +88,19 @@ impl Geometry {
     pub(crate) fn irradiance_at(&self, p: DVec3, n: DVec3, rng: &mut Rng) -> Rgb {
         let mut h = self.luminaire_irradiance(p, n);
         let dir = cosine_direction(n, rng.next_f64(), rng.next_f64());
-        if let Some(hit) = self.intersect(p + n * self.offset, dir)
-            && hit.front
-        {
-            h += self.radiosity_at(hit.point, u32::MAX, rng);
+        match self.intersect(p + n * self.offset, dir) {
+            Some(hit) if hit.front => h += self.radiosity_at(hit.point, u32::MAX, rng),
+            Some(_) => {}
+            None => h += self.sky_towards(dir),
         }
         h
+    }
+
+    /// What a ray leaving the scene along `dir` brings, by the cosine-weighted density that
+    /// drew it: π L_sky(dir) (0 without a sky). The sky has no next-event estimate: the
+    /// bounces find it, as a path tracer without light sampling finds an area light.
+    fn sky_towards(&self, dir: DVec3) -> Rgb {
+        self.sky.map_or(Rgb::ZERO, |sky| sky.radiosity_towards(dir))
     }
 
     /// Irradiance at `x` straight from the emitters, one next-event sample weighted by the
@@ -144,7 +151,10 @@ impl Geometry {
             depth += 1;
             b += throughput * self.direct_irradiance(&x, rng);
             let dir = cosine_direction(x.n, rng.next_f64(), rng.next_f64());
-            let Some(hit) = self.intersect(x.p + x.n * self.offset, dir) else { break };
+            let Some(hit) = self.intersect(x.p + x.n * self.offset, dir) else {
+                b += throughput * self.sky_towards(dir);
+                break;
+            };
             if !hit.front {
                 break;
             }

@@ -8,7 +8,7 @@
 use std::sync::Arc;
 
 use radiosity_accel::{Bvh, RayQuery};
-use radiosity_core::{Luminaire, MeshParams, Rgb, Scene, Sun};
+use radiosity_core::{Daylight, Luminaire, MeshParams, Rgb, Scene};
 use radiosity_mesh::{MAX_ELEMENTS, Mesh, MeshError, Refinement};
 
 use crate::solution::VertexElements;
@@ -121,8 +121,8 @@ pub struct Problem {
     unrefined_elements: usize,
     /// The scene's point luminaires, which shoot first in every solver made here.
     luminaires: Arc<[Luminaire]>,
-    /// The scene's sun, which shoots first too.
-    sun: Option<Sun>,
+    /// The scene's sun and sky, which shoot first too.
+    daylight: Daylight,
 }
 
 impl Problem {
@@ -142,7 +142,7 @@ impl Problem {
     pub fn new(scene: &Scene, mesh_params: &MeshParams) -> Result<Self, MeshError> {
         let problem = Self::from_mesh(Arc::new(Mesh::build(scene, mesh_params)?))
             .with_luminaires(scene.lighting.luminaires.clone())
-            .with_sun(scene.lighting.sun);
+            .with_daylight(scene.lighting.daylight());
         Ok(problem.refined(scene, mesh_params))
     }
 
@@ -188,7 +188,7 @@ impl Problem {
                 Ok(m) => {
                     problem = Self::with_ray_queries(Arc::new(m), problem.ray_queries.clone())
                         .with_luminaires(problem.luminaires.to_vec())
-                        .with_sun(problem.sun);
+                        .with_daylight(problem.daylight);
                 }
                 Err(_) => break,
             }
@@ -202,12 +202,19 @@ impl Problem {
     pub fn from_mesh(mesh: Arc<Mesh>) -> Self {
         let ray_queries = Arc::new(Bvh::new(&occluder_triangles(&mesh)));
         let unrefined_elements = mesh.elements.len();
-        Self { mesh, ray_queries, unrefined_elements, luminaires: Arc::from([]), sun: None }
+        Self {
+            mesh,
+            ray_queries,
+            unrefined_elements,
+            luminaires: Arc::from([]),
+            daylight: Daylight::default(),
+        }
     }
 
-    /// The same problem lit by the `sun` too (it shoots first in every solver made from it).
-    pub fn with_sun(mut self, sun: Option<Sun>) -> Self {
-        self.sun = sun;
+    /// The same problem lit by the sun and sky of `daylight` too (they shoot first in every
+    /// solver made from it).
+    pub fn with_daylight(mut self, daylight: Daylight) -> Self {
+        self.daylight = daylight;
         self
     }
 
@@ -228,7 +235,13 @@ impl Problem {
     /// against it). The backend must answer for the occluders of `mesh`.
     pub fn with_ray_queries(mesh: Arc<Mesh>, ray_queries: Arc<dyn RayQuery>) -> Self {
         let unrefined_elements = mesh.elements.len();
-        Self { mesh, ray_queries, unrefined_elements, luminaires: Arc::from([]), sun: None }
+        Self {
+            mesh,
+            ray_queries,
+            unrefined_elements,
+            luminaires: Arc::from([]),
+            daylight: Daylight::default(),
+        }
     }
 
     /// How many elements the mesh had before adaptive subdivision (its own count when it was
@@ -257,7 +270,7 @@ impl Problem {
             self.ray_queries.clone(),
             params,
             &self.luminaires,
-            self.sun.as_ref(),
+            self.daylight,
         )
     }
 }

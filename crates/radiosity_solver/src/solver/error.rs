@@ -20,9 +20,9 @@ pub enum SolverError {
     /// Nothing emits, there is no luminaire, and the sun lights no element: every shadow ray
     /// towards it meets the scene (a closed room) or it is below every surface.
     #[error(
-        "the sun lights no surface and nothing else lights the scene: every shadow ray towards it meets the scene (a room with no opening) or it is below every surface; open the room, turn the sun or add a light"
+        "the sun and sky light no surface and nothing else lights the scene: every shadow ray towards them meets the scene (a room with no opening) or they are below every surface; open the room, turn the sun or add a light"
     )]
-    DarkSun,
+    DarkDaylight,
     /// The mesh has no elements.
     #[error("the mesh has no elements")]
     EmptyMesh,

@@ -9,11 +9,15 @@
 //! sides, weighted by their areas (one point per side; second order, so a room's elements of
 //! a few centimetres integrate the 1/d² falloff to well under 0.1 %).
 //!
-//! The sun ([`Sun`]) shoots first the same way: E_sun cos θ times the part of each element
+//! The sun ([`radiosity_core::Sun`]) shoots first the same way: E_sun cos θ times the part of each element
 //! whose shadow rays towards the sun leave the scene unblocked, by the blocking triangles or
 //! the hull's (see `occluders`), from 16 jittered points ([`sunlit_fraction`]). Its power is
 //! what the elements receive (light from infinity has no total of its own), so none of it
 //! escapes.
+//!
+//! The sky ([`Sky`]) too: π L(ω) over the part of each element's hemisphere whose shadow
+//! rays leave the scene above the horizon, by [`Sky::rays`] rays per element, stratified by
+//! the cosine over the hemisphere and jittered over the element ([`skylight`]).
 //!
 //! The luminaires' light is not the emitters' *direct part* (`Tally::direct`): a
 //! final gather recomputes only area emitters per pixel, and takes this light from the
@@ -21,7 +25,7 @@
 
 use radiosity_accel::{Bvh, RayQuery};
 use radiosity_core::glam::DVec3;
-use radiosity_core::{LUMENS_PER_WATT, Luminaire, Rgb, Sun};
+use radiosity_core::{Daylight, LUMENS_PER_WATT, Luminaire, Rgb, Sky};
 use radiosity_mesh::Mesh;
 use rayon::prelude::*;
 
@@ -36,30 +40,35 @@ pub(super) struct LuminaireLight {
 }
 
 impl LuminaireLight {
-    /// The direct light of `luminaires` and the `sun` on the elements of `mesh`, shadowed by
-    /// `rays`; `None` without either.
+    /// The direct light of `luminaires` and of the sun and sky of `daylight` on the elements
+    /// of `mesh`, shadowed by `rays`; `None` without any.
     ///
-    /// `hull` holds the occluder triangles left out of `rays` (a room's own walls, see
-    /// `occluders::hull_triangles`): no ray between two surface points crosses them, but a
-    /// shadow ray towards the sun, which ends past the scene, does. Needed with a sun only.
+    /// The daylight comes with the occluder triangles left out of `rays` (a room's own walls,
+    /// see `occluders::hull_triangles`): no ray between two surface points crosses them, but a
+    /// shadow ray towards the sun or sky, which ends past the scene, does.
     pub(super) fn new(
         mesh: &Mesh,
         rays: &dyn RayQuery,
         luminaires: &[Luminaire],
-        sun: Option<(&Sun, &Bvh)>,
+        daylight: Option<(Daylight, &Bvh)>,
     ) -> Option<Self> {
-        if luminaires.is_empty() && sun.is_none() {
+        let daylight = daylight.filter(|(d, _)| !d.is_none());
+        if luminaires.is_empty() && daylight.is_none() {
             return None;
         }
         let (lo, hi) = mesh.bounds();
         let diagonal = (hi - lo).length().max(f64::MIN_POSITIVE);
         let lift = 1e-6 * diagonal;
-        // A shadow ray towards the sun ends past the scene, twice its diagonal from any point.
-        let sun = sun.map(|(s, hull)| (s, 2.0 * diagonal, hull));
+        // A shadow ray towards the sun or sky ends past the scene, twice its diagonal from
+        // any point.
+        let infinity = daylight.map(|(d, hull)| Infinity { daylight: d, reach: 2.0 * diagonal, hull, lift });
         let both: Vec<(Rgb, Rgb)> = (0..mesh.elements.len())
             .into_par_iter()
             .with_min_len(64)
-            .map(|e| element_irradiance(mesh, e, rays, luminaires, sun, lift))
+            .map(|e| {
+                let from_infinity = infinity.as_ref().map_or(Rgb::ZERO, |i| i.irradiance(mesh, e, rays));
+                (element_irradiance(mesh, e, rays, luminaires, lift), from_infinity)
+            })
             .collect();
         let sun_power: Rgb = both.iter().zip(&mesh.elements).map(|((_, s), el)| *s * el.area).sum();
         let irradiance = both.into_iter().map(|(l, s)| l + s).collect();
@@ -97,16 +106,14 @@ fn sample_points(mesh: &Mesh, e: usize) -> ([(DVec3, f64); 4], usize) {
     }
 }
 
-/// Element `e`'s direct irradiance from the luminaires and from the sun (with the length of
-/// its shadow rays), apart.
+/// Element `e`'s direct irradiance from the luminaires.
 fn element_irradiance(
     mesh: &Mesh,
     e: usize,
     rays: &dyn RayQuery,
     luminaires: &[Luminaire],
-    sun: Option<(&Sun, f64, &Bvh)>,
     lift: f64,
-) -> (Rgb, Rgb) {
+) -> Rgb {
     let n = mesh.elements[e].normal;
     let (points, count) = sample_points(mesh, e);
     let mut sum = Rgb::ZERO;
@@ -121,18 +128,41 @@ fn element_irradiance(
             }
         }
     }
-    let mut sunlight = Rgb::ZERO;
-    if let Some((sun, reach, hull)) = sun {
-        let h = sun.irradiance_on(n);
-        if h.max_channel() > 0.0 {
-            sunlight = h * sunlit_fraction(mesh, e, |p| {
-                let from = p + n * lift;
-                let to = (from + sun.towards * reach).as_vec3();
-                !rays.occluded(from.as_vec3(), to) && !hull.occluded(from.as_vec3(), to)
-            });
+    sum
+}
+
+/// The sun and sky, with what their shadow rays need.
+struct Infinity<'a> {
+    daylight: Daylight,
+    /// How far a shadow ray goes to leave the scene.
+    reach: f64,
+    /// The hull's triangles (see [`LuminaireLight::new`]).
+    hull: &'a Bvh,
+    /// How far a ray's start is lifted off its element.
+    lift: f64,
+}
+
+impl Infinity<'_> {
+    /// Element `e`'s direct irradiance from the sun and the sky.
+    fn irradiance(&self, mesh: &Mesh, e: usize, rays: &dyn RayQuery) -> Rgb {
+        let n = mesh.elements[e].normal;
+        let reach = self.reach as f32;
+        let leaves = |p: DVec3, towards: DVec3| {
+            let (from, towards) = ((p + n * self.lift).as_vec3(), towards.as_vec3());
+            !rays.occluded_towards(from, towards, reach) && !self.hull.occluded_towards(from, towards, reach)
+        };
+        let mut sum = Rgb::ZERO;
+        if let Some(sun) = &self.daylight.sun {
+            let h = sun.irradiance_on(n);
+            if h.max_channel() > 0.0 {
+                sum += h * sunlit_fraction(mesh, e, |p| leaves(p, sun.towards));
+            }
         }
+        if let Some(sky) = &self.daylight.sky {
+            sum += skylight(mesh, e, sky, leaves);
+        }
+        sum
     }
-    (sum, sunlight)
 }
 
 /// Jittered samples per side of an element for the sun's shadow rays (16 in all).
@@ -140,6 +170,48 @@ const SUN_STRATA: u32 = 4;
 
 /// Random stream of the sun's samples, apart from every other.
 const SUN_STREAM: u64 = 0x73_756e;
+
+/// Random stream of the sky's samples, apart from every other.
+const SKY_STREAM: u64 = 0x0073_6b79;
+
+/// Element `e`'s irradiance from `sky` where `leaves(point, direction)` says a shadow ray
+/// leaves the scene: E = ∫ L(ω) cos θ dω over the hemisphere, estimated with directions
+/// drawn by the cosine (density cos θ / π), so each ray brings π L(ω) (Pharr, Jakob &
+/// Humphreys, PBRT 4th ed. §A.5.3, Malley's method), on a √N × √N grid of jittered strata
+/// (Cook 1986), each from its own random point of the element, so that a shadow's edge
+/// across the element is averaged over it.
+/// Directions at or below the horizon bring nothing.
+fn skylight(mesh: &Mesh, e: usize, sky: &Sky, leaves: impl Fn(DVec3, DVec3) -> bool) -> Rgb {
+    let el = &mesh.elements[e];
+    // No part of the sky above this element's horizon: a floor's underside.
+    if el.normal.dot(sky.zenith) <= -1.0 + 1e-12 {
+        return Rgb::ZERO;
+    }
+    let corners: Vec<DVec3> = mesh.element_corners(e).take(4).collect();
+    let side = f64::from(sky.rays).sqrt().ceil().max(1.0) as u32;
+    let (rows, columns) = (sky.rays.div_ceil(side), side);
+    let mut rng = radiosity_core::random::Rng::for_task(0, SKY_STREAM, e as u64);
+    let (t, b) = el.normal.any_orthonormal_pair();
+    let mut sum = Rgb::ZERO;
+    for k in 0..rows * columns {
+        let (j, r) = (k % columns, k / columns);
+        let u = (f64::from(j) + rng.next_f64()) / f64::from(columns);
+        let v = (f64::from(r) + rng.next_f64()) / f64::from(rows);
+        // Malley: a uniform point of the unit disc lifted onto the hemisphere.
+        let (radius, phi) = (u.sqrt(), 2.0 * std::f64::consts::PI * v);
+        let (x, y) = (radius * phi.cos(), radius * phi.sin());
+        let dir = t * x + b * y + el.normal * (1.0 - u).max(0.0).sqrt();
+        let light = sky.radiosity_towards(dir);
+        if light.max_channel() <= 0.0 {
+            continue;
+        }
+        let p = crate::sampling::point_on(&corners, rng.next_f64(), rng.next_f64());
+        if leaves(p, dir) {
+            sum += light;
+        }
+    }
+    sum * (1.0 / f64::from(rows * columns))
+}
 
 /// The area fraction of element `e` whose points `clear` says the sun reaches: 4 × 4
 /// jittered points, each weighted by the area its parameter cell maps to (a quad's bilinear

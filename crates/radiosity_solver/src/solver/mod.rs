@@ -146,28 +146,29 @@ impl Solver {
         params: SolverParams,
         luminaires: &[radiosity_core::Luminaire],
     ) -> Result<Self, SolverError> {
-        Self::with_lights(mesh, accel, params, luminaires, None)
+        Self::with_lights(mesh, accel, params, luminaires, radiosity_core::Daylight::default())
     }
 
-    /// [`Solver::with_luminaires`] with the `sun` shooting first too, the same way (its
-    /// direct light by shadow rays towards it).
+    /// [`Solver::with_luminaires`] with the sun and sky of `daylight` shooting first too, the
+    /// same way (their direct light by shadow rays towards them).
     ///
     /// # Errors
-    /// As [`Solver::with_luminaires`], the sun counting as a luminaire.
+    /// As [`Solver::with_luminaires`], the sun and sky counting as luminaires.
     pub fn with_lights(
         mesh: Arc<Mesh>,
         accel: Arc<dyn RayQuery>,
         params: SolverParams,
         luminaires: &[radiosity_core::Luminaire],
-        sun: Option<&radiosity_core::Sun>,
+        daylight: radiosity_core::Daylight,
     ) -> Result<Self, SolverError> {
         params.validate()?;
         mesh_tables::check_patch_runs(&mesh)?;
-        // The hull's triangles block the sun's shadow rays and the enclosure probes alike:
-        // built once here when there is a sun, else at the first probe.
-        let hull = sun.map(|_| radiosity_accel::Bvh::new(&crate::occluders::hull_triangles(&mesh)));
-        let light =
-            luminaires::LuminaireLight::new(&mesh, accel.as_ref(), luminaires, sun.zip(hull.as_ref()));
+        // The hull's triangles block the daylight's shadow rays and the enclosure probes
+        // alike: built once here when there is daylight, else at the first probe.
+        let hull = (!daylight.is_none())
+            .then(|| radiosity_accel::Bvh::new(&crate::occluders::hull_triangles(&mesh)));
+        let daylight = hull.as_ref().map(|hull| (daylight, hull));
+        let light = luminaires::LuminaireLight::new(&mesh, accel.as_ref(), luminaires, daylight);
         let tally = Tally::lit(&mesh, light.as_ref())?;
         let mut clusters = Clusters::new(&mesh, params.clustering);
         clusters.sum(&tally.patch_abs);
