@@ -256,3 +256,69 @@ fn g_renders_a_still_in_the_background_and_save_writes_it() {
     assert!(dir.join("still.png").exists(), "{:?}", h.state().message);
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// A 2 × 2 floor with a 4 × 4 black and white checkerboard texture under a small lamp, as an
+/// OBJ with its MTL and PNG in `dir`; returns the OBJ's path.
+fn write_checkered_room(dir: &std::path::Path) -> String {
+    let texels =
+        (0..16).map(|i: u32| if (i % 4 + i / 4).is_multiple_of(2) { [255; 3] } else { [0; 3] }).collect();
+    radiosity_image::write_png(&dir.join("checker.png"), &SrgbImage { width: 4, height: 4, pixels: texels })
+        .unwrap();
+    let mtl = "newmtl floor\nKd 0.5 0.5 0.5\nmap_Kd checker.png\nnewmtl lamp\nKd 0 0 0\nKe 10 10 10\n";
+    std::fs::write(dir.join("room.mtl"), mtl).unwrap();
+    let obj = "mtllib room.mtl\n\
+        o floor\nv 0 0 0\nv 0 0 2\nv 2 0 2\nv 2 0 0\n\
+        vt 0 0\nvt 0 1\nvt 1 1\nvt 1 0\nusemtl floor\nf 1/1 2/2 3/3 4/4\n\
+        o lamp\nv 0.75 1.5 0.75\nv 1.25 1.5 0.75\nv 1.25 1.5 1.25\nv 0.75 1.5 1.25\nusemtl lamp\nf 5 6 7 8\n";
+    let path = dir.join("room.obj");
+    std::fs::write(&path, obj).unwrap();
+    path.to_string_lossy().into_owned()
+}
+
+/// A scene with a texture opens with the textures checkbox on and shows the texture, in the
+/// view and in a still; turned off, the view shows the floor's mean colour instead. The Cornell box, which has none,
+/// starts with it off.
+#[test]
+fn the_textures_checkbox_starts_on_for_a_textured_scene_and_turns_them_off() {
+    let dir = temp_dir("textures");
+    let room = write_checkered_room(&dir);
+    let mut h = harness(&room, Some(20), &dir);
+    step_until(&mut h, "20 shots on screen", |a| a.shown.as_ref().is_some_and(|s| s.solution.shots == 20));
+    assert!(h.state().view.textures, "on for a scene with a texture");
+    let textured = {
+        let renderer = h.state().render_state.renderer.read();
+        renderer.callback_resources.get::<SceneRenderer>().is_some_and(SceneRenderer::has_textures)
+    };
+    assert!(textured, "the floor is drawn textured");
+    // Distinct grey levels in the view: a checkerboard, filtered, has many more than the
+    // evenly lit plain floor.
+    let levels = |h: &mut Harness<'static, ViewerApp>, name: &str| {
+        h.key_press(Key::P);
+        h.step();
+        let path = std::fs::read_dir(&dir)
+            .unwrap()
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .find(|p| p.file_name().is_some_and(|n| n.to_string_lossy().ends_with(&format!("{name}.png"))))
+            .unwrap_or_else(|| panic!("no screenshot: {:?}", h.state().message));
+        let img = image::open(&path).unwrap().to_rgb8();
+        std::fs::remove_file(path).unwrap();
+        img.pixels().map(|p| p[0]).collect::<std::collections::BTreeSet<u8>>().len()
+    };
+    let on = levels(&mut h, "20shots");
+    // The still (G) shows the texture too.
+    h.key_press(Key::G);
+    h.step();
+    step_until(&mut h, "the still", |a| a.still.is_some());
+    let (_, _, srgb) = h.state().still.as_ref().unwrap();
+    let still_levels = srgb.pixels.iter().map(|p| p[0]).collect::<std::collections::BTreeSet<u8>>().len();
+    assert!(still_levels > 50, "the still shows the texture: {still_levels} red levels");
+    h.get_by_label("textures").click();
+    h.step();
+    assert!(!h.state().view.textures);
+    let off = levels(&mut h, "20shots");
+    assert!(on > 50 && off < 20, "textures on: {on} red levels in the view; off: {off}");
+
+    let cornell = harness("cornell", Some(5), &dir);
+    assert!(!cornell.state().view.textures, "off for a scene without textures");
+    let _ = std::fs::remove_dir_all(dir);
+}
