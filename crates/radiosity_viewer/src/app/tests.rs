@@ -257,20 +257,30 @@ fn g_renders_a_still_in_the_background_and_save_writes_it() {
     let _ = std::fs::remove_dir_all(dir);
 }
 
-/// A 2 × 2 floor with a 4 × 4 black and white checkerboard texture under a small lamp, as an
-/// OBJ with its MTL and PNG in `dir`; returns the OBJ's path.
+/// A 4 × 4 floor tiled twice each way with an 8 × 8 black and white checkerboard, lit by a
+/// lamp 2 above its middle, as an OBJ with its MTL and PNG in `dir`; returns the OBJ's path.
 fn write_checkered_room(dir: &std::path::Path) -> String {
     let texels =
-        (0..16).map(|i: u32| if (i % 4 + i / 4).is_multiple_of(2) { [255; 3] } else { [0; 3] }).collect();
-    radiosity_image::write_png(&dir.join("checker.png"), &SrgbImage { width: 4, height: 4, pixels: texels })
+        (0..64).map(|i: u32| if (i % 8 + i / 8).is_multiple_of(2) { [250; 3] } else { [10; 3] }).collect();
+    radiosity_image::write_png(&dir.join("tiles.png"), &SrgbImage { width: 8, height: 8, pixels: texels })
         .unwrap();
-    let mtl = "newmtl floor\nKd 0.5 0.5 0.5\nmap_Kd checker.png\nnewmtl lamp\nKd 0 0 0\nKe 10 10 10\n";
-    std::fs::write(dir.join("room.mtl"), mtl).unwrap();
-    let obj = "mtllib room.mtl\n\
-        o floor\nv 0 0 0\nv 0 0 2\nv 2 0 2\nv 2 0 0\n\
-        vt 0 0\nvt 0 1\nvt 1 1\nvt 1 0\nusemtl floor\nf 1/1 2/2 3/3 4/4\n\
-        o lamp\nv 0.75 1.5 0.75\nv 1.25 1.5 0.75\nv 1.25 1.5 1.25\nv 0.75 1.5 1.25\nusemtl lamp\nf 5 6 7 8\n";
-    let path = dir.join("room.obj");
+    std::fs::write(
+        dir.join("tiled.mtl"),
+        "newmtl tiles\nKd 0.6 0.6 0.6\nmap_Kd tiles.png\nnewmtl light\nKd 0 0 0\nKe 5 5 5\n",
+    )
+    .unwrap();
+    // The floor's corners run so its normal points up; the lamp's, reversed, so it faces down.
+    let corners = [[0.0, 0.0], [0.0, 4.0], [4.0, 4.0], [4.0, 0.0]];
+    let mut obj = String::from("mtllib tiled.mtl\no tiles\n");
+    for [x, z] in corners {
+        obj += &format!("v {x} 0 {z}\nvt {} {}\n", x / 2.0, z / 2.0);
+    }
+    obj += "usemtl tiles\nf 1/1 2/2 3/3 4/4\no light\n";
+    for [x, z] in corners.iter().rev() {
+        obj += &format!("v {} 2 {}\n", 1.5 + x / 4.0, 1.5 + z / 4.0);
+    }
+    obj += "usemtl light\nf 5 6 7 8\n";
+    let path = dir.join("tiled.obj");
     std::fs::write(&path, obj).unwrap();
     path.to_string_lossy().into_owned()
 }
