@@ -229,35 +229,43 @@ fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     })
 }
 
-/// One mip level: its size and its texels as linear RGB.
+/// One mip level: its size and its texels as the GPU takes them, sRGB-encoded RGBA.
 struct Level {
     width: u32,
     height: u32,
-    linear: Vec<[f32; 3]>,
+    rgba: Vec<u8>,
 }
 
-/// The texture's mip chain down to 1 × 1, level 0 the texels as decoded: each level a box
+/// The texture's mip chain down to 1 × 1, level 0 the file's own codes: each level a box
 /// filter of the one above in linear light (an sRGB average would darken a fine pattern as it
 /// recedes). Odd sizes round down, each texel averaging the whole run of texels it covers.
+/// Only one level is held in linear light at a time, and level 0 never is: a 4096² texture
+/// would take 200 MB as floats.
 fn mip_chain(texture: &Texture) -> Vec<Level> {
     let decode: Vec<f32> = (0..=255u8).map(|v| srgb_decode(f64::from(v) / 255.0) as f32).collect();
-    let linear = texture.texels.iter().map(|t| t.map(|v| decode[v as usize])).collect();
-    let mut levels = vec![Level { width: texture.width.max(1), height: texture.height.max(1), linear }];
-    loop {
-        let above = levels.last().expect("level 0 is there");
-        if above.width == 1 && above.height == 1 {
-            return levels;
-        }
-        let (w, h) = ((above.width / 2).max(1), (above.height / 2).max(1));
+    let encode = |v: f32| (srgb_encode(f64::from(v)) * 255.0).round().clamp(0.0, 255.0) as u8;
+    let (mut w, mut h) = (texture.width.max(1), texture.height.max(1));
+    let rgba = texture.texels.iter().flat_map(|t| [t[0], t[1], t[2], 255]).collect();
+    let mut levels = vec![Level { width: w, height: h, rgba }];
+    let mut above: Option<Vec<[f32; 3]>> = None;
+    while w > 1 || h > 1 {
+        let (w2, h2) = ((w / 2).max(1), (h / 2).max(1));
+        let texel = |x: u32, y: u32| {
+            let i = (y * w + x) as usize;
+            match &above {
+                Some(linear) => linear[i],
+                None => texture.texels[i].map(|v| decode[v as usize]),
+            }
+        };
         let span = |i: u32, n: u32, from: u32| (i * from / n)..((i + 1) * from / n);
-        let mut linear = Vec::with_capacity((w * h) as usize);
-        for y in 0..h {
-            for x in 0..w {
+        let mut linear = Vec::with_capacity((w2 * h2) as usize);
+        for y in 0..h2 {
+            for x in 0..w2 {
                 let mut sum = [0.0f32; 3];
                 let mut count = 0.0f32;
-                for sy in span(y, h, above.height) {
-                    for sx in span(x, w, above.width) {
-                        let t = above.linear[(sy * above.width + sx) as usize];
+                for sy in span(y, h2, h) {
+                    for sx in span(x, w2, w) {
+                        let t = texel(sx, sy);
                         for c in 0..3 {
                             sum[c] += t[c];
                         }
@@ -267,8 +275,11 @@ fn mip_chain(texture: &Texture) -> Vec<Level> {
                 linear.push(sum.map(|s| s / count));
             }
         }
-        levels.push(Level { width: w, height: h, linear });
+        let rgba = linear.iter().flat_map(|t| [encode(t[0]), encode(t[1]), encode(t[2]), 255]).collect();
+        levels.push(Level { width: w2, height: h2, rgba });
+        (w, h, above) = (w2, h2, Some(linear));
     }
+    levels
 }
 
 /// Uploads `texture` with its mip chain; a texture larger than the device allows starts at
@@ -289,15 +300,6 @@ fn upload(device: &wgpu::Device, queue: &wgpu::Queue, texture: &Texture) -> wgpu
         view_formats: &[],
     });
     for (mip, level) in levels.iter().enumerate() {
-        // Level 0 keeps the file's own codes where it is the image itself; the others are
-        // encoded from their linear averages.
-        let exact = mip == 0 && level.width == texture.width && level.height == texture.height;
-        let rgba: Vec<u8> = if exact {
-            texture.texels.iter().flat_map(|t| [t[0], t[1], t[2], 255]).collect()
-        } else {
-            let encode = |v: f32| (srgb_encode(f64::from(v)) * 255.0).round().clamp(0.0, 255.0) as u8;
-            level.linear.iter().flat_map(|t| [encode(t[0]), encode(t[1]), encode(t[2]), 255]).collect()
-        };
         queue.write_texture(
             wgpu::TexelCopyTextureInfo {
                 texture: &gpu,
@@ -305,7 +307,7 @@ fn upload(device: &wgpu::Device, queue: &wgpu::Queue, texture: &Texture) -> wgpu
                 origin: wgpu::Origin3d::ZERO,
                 aspect: wgpu::TextureAspect::All,
             },
-            &rgba,
+            &level.rgba,
             wgpu::TexelCopyBufferLayout {
                 offset: 0,
                 bytes_per_row: Some(4 * level.width),
@@ -325,17 +327,24 @@ mod tests {
         Texture { width, height, texels, factor: [1.0; 3], wrap: [Wrap::Repeat; 2] }
     }
 
+    /// The 8-bit code of linear value `v`, as the chain encodes it.
+    fn code(v: f64) -> u8 {
+        (srgb_encode(v) * 255.0).round() as u8
+    }
+
     /// A 4 × 2 black and white pattern: level 1 is 2 × 1, level 2 is 1 × 1, every level
-    /// half white in linear light (not sRGB 50 % grey, which is 21 % in linear light).
+    /// half white in linear light (code 188, not sRGB 50 % grey, 128, which is 21 % in linear
+    /// light); level 0 is the texels as they are.
     #[test]
     fn mips_average_in_linear_light_down_to_one_texel() {
         let t = texture(4, 2, (0..8).map(|i| if i % 2 == 0 { [255; 3] } else { [0; 3] }).collect());
         let levels = mip_chain(&t);
         let sizes: Vec<(u32, u32)> = levels.iter().map(|l| (l.width, l.height)).collect();
         assert_eq!(sizes, [(4, 2), (2, 1), (1, 1)]);
+        assert_eq!(&levels[0].rgba[..8], [255, 255, 255, 255, 0, 0, 0, 255]);
         for level in &levels[1..] {
-            for t in &level.linear {
-                assert!(t.iter().all(|&v| (v - 0.5).abs() < 1e-6), "{t:?}");
+            for texel in level.rgba.chunks(4) {
+                assert_eq!(texel, [code(0.5), code(0.5), code(0.5), 255]);
             }
         }
     }
@@ -346,7 +355,7 @@ mod tests {
         let t = texture(3, 1, vec![[255; 3], [0; 3], [0; 3]]);
         let levels = mip_chain(&t);
         assert_eq!(levels.len(), 2);
-        assert!((levels[1].linear[0][0] - 1.0 / 3.0).abs() < 1e-6, "{:?}", levels[1].linear);
+        assert_eq!(levels[1].rgba[0], code(1.0 / 3.0), "{:?}", levels[1].rgba);
     }
 
     /// The scale per channel is the factor over the mean, and −1 (ratio 1) where the mean is
