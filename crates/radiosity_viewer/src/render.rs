@@ -14,17 +14,24 @@
 //! A big mesh also gets a coarse copy ([`crate::coarse`]) with its own buffers; the viewer
 //! draws it while the camera moves or the solve runs on a CPU rasteriser, and only its
 //! colours are uploaded at each snapshot meanwhile.
+//!
+//! Textured elements (see [`SceneRenderer::set_textured_mesh`] and `render/textured.rs`) come
+//! last in the buffers, grouped by material: the untextured ones are one draw with the plain
+//! pipeline, as without textures, and each textured material one draw with the textured
+//! pipeline, which scales the interpolated radiosity by the texel's albedo over the mean.
 
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use eframe::wgpu;
 use glam::{DMat4, DVec3};
 use radiosity_core::Rgb;
-use radiosity_image::ToneOperator;
+use radiosity_image::{ElementUvs, ToneOperator};
 use radiosity_mesh::Mesh;
 use radiosity_solver::Solution;
 
 use crate::coarse::{COARSE_TRIANGLES, CoarseTriangle};
+use textured::{TextureCache, TexturedDraw};
 
 /// WGSL source of the tone-map functions (shared with the CPU/GPU agreement test).
 pub const TONEMAP_WGSL: &str = include_str!("shaders/tonemap.wgsl");
@@ -36,121 +43,6 @@ pub const SCENE_WGSL: &str = include_str!("shaders/scene.wgsl");
 pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 /// Depth format: 32-bit float for reversed z (see [`crate::camera`]).
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-
-/// The operator's id in the shader (`OP_*` in `tonemap.wgsl`).
-pub fn shader_operator(op: ToneOperator) -> u32 {
-    match op {
-        ToneOperator::Linear => 0,
-        ToneOperator::Reinhard => 1,
-        ToneOperator::Aces => 2,
-    }
-}
-
-/// What the surfaces show.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum DisplayMode {
-    /// Vertex radiosity interpolated across elements, tone mapped.
-    #[default]
-    Smooth,
-    /// Each element's own radiosity, tone mapped: shows the subdivision.
-    FlatElements,
-    /// False colour of log luminance of the (smooth) radiosity, with a legend.
-    FalseColour,
-    /// False colour of each element's unshot radiosity ΔB: where light still waits.
-    Unshot,
-}
-
-impl DisplayMode {
-    /// Every mode, in panel order.
-    pub const ALL: [DisplayMode; 4] =
-        [DisplayMode::Smooth, DisplayMode::FlatElements, DisplayMode::FalseColour, DisplayMode::Unshot];
-
-    /// Label in the panel.
-    pub fn label(self) -> &'static str {
-        match self {
-            DisplayMode::Smooth => "smooth",
-            DisplayMode::FlatElements => "flat elements",
-            DisplayMode::FalseColour => "false colour",
-            DisplayMode::Unshot => "unshot energy",
-        }
-    }
-
-    /// One sentence for the panel's tooltip.
-    pub fn description(self) -> &'static str {
-        match self {
-            DisplayMode::Smooth => "vertex radiosity interpolated across elements, as `render` shows it",
-            DisplayMode::FlatElements => "each element's own radiosity: shows the subdivision",
-            DisplayMode::FalseColour => "log luminance of the radiosity on a colour scale, with a legend",
-            DisplayMode::Unshot => "radiosity still waiting to be shot, on a log colour scale",
-        }
-    }
-
-    /// Whether the mode is drawn in false colour with a legend.
-    pub fn is_false_colour(self) -> bool {
-        matches!(self, DisplayMode::FalseColour | DisplayMode::Unshot)
-    }
-}
-
-/// Which subdivision lines are drawn over the surfaces.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Wireframe {
-    /// None.
-    #[default]
-    Off,
-    /// Patch outlines (the shooters).
-    Patches,
-    /// Element outlines, patch outlines on top.
-    Elements,
-}
-
-impl Wireframe {
-    /// Every choice, in panel order.
-    pub const ALL: [Wireframe; 3] = [Wireframe::Off, Wireframe::Patches, Wireframe::Elements];
-
-    /// Label in the panel.
-    pub fn label(self) -> &'static str {
-        match self {
-            Wireframe::Off => "off",
-            Wireframe::Patches => "patches",
-            Wireframe::Elements => "elements",
-        }
-    }
-
-    fn shader_bits(self) -> u32 {
-        match self {
-            Wireframe::Off => 0,
-            Wireframe::Patches => 2,
-            Wireframe::Elements => 3,
-        }
-    }
-}
-
-/// How much of a big mesh is drawn (see [`crate::coarse`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Detail {
-    /// On a CPU rasteriser, the coarse copy while the camera moves or the solve runs and the
-    /// whole mesh once the view rests; on a GPU, always the whole mesh.
-    #[default]
-    Auto,
-    /// Always every element.
-    Full,
-    /// Always the coarse copy (when the mesh has one).
-    Coarse,
-}
-
-impl Detail {
-    /// Every choice, in panel order.
-    pub const ALL: [Detail; 3] = [Detail::Auto, Detail::Full, Detail::Coarse];
-
-    /// Label in the panel.
-    pub fn label(self) -> &'static str {
-        match self {
-            Detail::Auto => "auto",
-            Detail::Full => "full",
-            Detail::Coarse => "coarse",
-        }
-    }
-}
 
 /// Everything a frame needs besides the mesh and its colours.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -169,6 +61,9 @@ pub struct FrameParams {
     pub log_range: (f64, f64),
     /// Clear colour, display (sRGB-encoded) values.
     pub background: [f32; 4],
+    /// Whether textured materials show their textures (in the tone-mapped modes; false
+    /// colour always shows the radiosity itself). Off: every surface its mean colour.
+    pub textures: bool,
 }
 
 #[repr(C)]
@@ -364,9 +259,15 @@ struct Geometry {
     coarse: Option<CoarseGeometry>,
     /// Whether `colours` lags the last solution (only the coarse copy's were uploaded).
     full_stale: bool,
+    /// Whether texture coordinates came with the mesh (they may still texture nothing).
+    uvs_given: bool,
+    /// The textured triangles, the last in the buffers; `None` when there are none.
+    textured: Option<TexturedDraw>,
 }
 
-/// The coarse copy of a big mesh on the GPU.
+/// The coarse copy of a big mesh on the GPU. It is drawn untextured, each surface in its mean
+/// colour: its triangles merge elements, so no element's texture coordinates fit them, and it
+/// is shown only while the view moves.
 struct CoarseGeometry {
     triangles: Vec<CoarseTriangle>,
     vertices: wgpu::Buffer,
@@ -376,7 +277,15 @@ struct CoarseGeometry {
 /// Draws a [`Mesh`] lit by a [`Solution`].
 pub struct SceneRenderer {
     mesh_pipeline: wgpu::RenderPipeline,
+    /// The mesh pipeline with texture coordinates and a textured material (group 1).
+    textured_pipeline: wgpu::RenderPipeline,
     background_pipeline: wgpu::RenderPipeline,
+    /// Textures and samplers uploaded so far, and the layout of a material's bind group.
+    texture_cache: TextureCache,
+    /// Whether the frame last prepared shows textures. [`Self::prepare`] and [`Self::paint`]
+    /// both borrow the renderer shared (egui's paint callback hands it out so), and what is
+    /// painted is the frame that was prepared.
+    textures_shown: AtomicBool,
     uniforms: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
     format: wgpu::TextureFormat,
@@ -427,10 +336,22 @@ impl SceneRenderer {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let pipeline = |label, vs, fs, buffers: &[Option<wgpu::VertexBufferLayout<'_>>], cull, compare| {
+        let texture_cache = TextureCache::new(device);
+        let textured_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("radiosity textured pipeline layout"),
+            bind_group_layouts: &[Some(&layout), Some(texture_cache.layout())],
+            immediate_size: 0,
+        });
+        let pipeline = |label,
+                        layout: &wgpu::PipelineLayout,
+                        vs,
+                        fs,
+                        buffers: &[Option<wgpu::VertexBufferLayout<'_>>],
+                        cull,
+                        compare| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(label),
-                layout: Some(&pipeline_layout),
+                layout: Some(layout),
                 vertex: wgpu::VertexState {
                     module: &module,
                     entry_point: Some(vs),
@@ -461,30 +382,45 @@ impl SceneRenderer {
                 cache: None,
             })
         };
+        let static_vertices = wgpu::VertexBufferLayout {
+            array_stride: std::mem::size_of::<StaticVertex>() as u64,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Uint32],
+        };
+        let colours = wgpu::VertexBufferLayout {
+            array_stride: 12,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &wgpu::vertex_attr_array![2 => Float32x3],
+        };
+        let uvs = wgpu::VertexBufferLayout {
+            array_stride: 8,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &wgpu::vertex_attr_array![3 => Float32x2],
+        };
         let mesh_pipeline = pipeline(
             "radiosity mesh pipeline",
+            &pipeline_layout,
             "vs_main",
             "fs_main",
-            &[
-                Some(wgpu::VertexBufferLayout {
-                    array_stride: std::mem::size_of::<StaticVertex>() as u64,
-                    step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Uint32],
-                }),
-                Some(wgpu::VertexBufferLayout {
-                    array_stride: 12,
-                    step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &wgpu::vertex_attr_array![2 => Float32x3],
-                }),
-            ],
+            &[Some(static_vertices.clone()), Some(colours.clone())],
             // Surfaces are one-sided (lit from the side their normal points to): from outside a
             // room you see into it, like a doll's house.
             Some(wgpu::Face::Back),
             // Reversed z: nearer is greater.
             wgpu::CompareFunction::Greater,
         );
+        let textured_pipeline = pipeline(
+            "radiosity textured pipeline",
+            &textured_layout,
+            "vs_textured",
+            "fs_textured",
+            &[Some(static_vertices), Some(colours), Some(uvs)],
+            Some(wgpu::Face::Back),
+            wgpu::CompareFunction::Greater,
+        );
         let background_pipeline = pipeline(
             "radiosity background pipeline",
+            &pipeline_layout,
             "vs_background",
             "fs_background",
             &[],
@@ -493,7 +429,10 @@ impl SceneRenderer {
         );
         Self {
             mesh_pipeline,
+            textured_pipeline,
             background_pipeline,
+            texture_cache,
+            textures_shown: AtomicBool::new(false),
             uniforms,
             bind_group,
             format,
@@ -519,14 +458,57 @@ impl SceneRenderer {
         self.geometry.as_ref().map(|g| &g.mesh)
     }
 
-    /// Uploads `mesh` (if it is not the one already uploaded); colours start black.
+    /// Uploads `mesh` (if it is not the one already uploaded) to be drawn untextured; colours
+    /// start black.
     pub fn set_mesh(&mut self, device: &wgpu::Device, mesh: &Arc<Mesh>) {
-        if self.geometry.as_ref().is_some_and(|g| Arc::ptr_eq(&g.mesh, mesh)) {
+        self.upload_mesh(device, None, mesh, &[]);
+    }
+
+    /// Uploads `mesh` (if it is not the one already uploaded with texture coordinates) with
+    /// the texture coordinates of its elements' corners, `uvs` ([`radiosity_image::element_uvs`]
+    /// of the scene it was built from): elements that have them and whose material has a
+    /// texture show it (see [`FrameParams::textures`]). Each distinct texture is uploaded once,
+    /// with its mip chain, and kept for the next mesh of the same scene. Colours start black.
+    pub fn set_textured_mesh(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        mesh: &Arc<Mesh>,
+        uvs: &[Option<ElementUvs>],
+    ) {
+        self.upload_mesh(device, Some(queue), mesh, uvs);
+    }
+
+    /// Whether the uploaded mesh has textured elements.
+    pub fn has_textures(&self) -> bool {
+        self.geometry.as_ref().is_some_and(|g| g.textured.is_some())
+    }
+
+    fn upload_mesh(
+        &mut self,
+        device: &wgpu::Device,
+        queue: Option<&wgpu::Queue>,
+        mesh: &Arc<Mesh>,
+        uvs: &[Option<ElementUvs>],
+    ) {
+        let uvs = if queue.is_some() { uvs } else { &[] };
+        if self.geometry.as_ref().is_some_and(|g| Arc::ptr_eq(&g.mesh, mesh) && g.uvs_given != uvs.is_empty())
+        {
             return;
         }
         let (lo, hi) = mesh.bounds();
         let origin = if lo.is_finite() && hi.is_finite() { (lo + hi) * 0.5 } else { DVec3::ZERO };
-        let triangles = oriented_triangles(mesh);
+        let mut triangles = oriented_triangles(mesh);
+        // Untextured first, in mesh order (an untextured mesh keeps its order exactly), then
+        // the textured ones by material, so each material is one draw.
+        let material = |e: u32| {
+            textured::texture_of(mesh, uvs, e).map(|_| {
+                let patch = &mesh.patches[mesh.elements[e as usize].patch as usize];
+                mesh.surfaces[patch.surface as usize].material
+            })
+        };
+        triangles.sort_by_key(|&(e, _)| material(e));
+        let first_textured = triangles.partition_point(|&(e, _)| material(e).is_none());
         let edges = edge_flags(mesh, &triangles);
         let vertex = |v: u32, edges: u32| StaticVertex {
             position: (mesh.positions[v as usize] - origin).as_vec3().to_array(),
@@ -553,6 +535,9 @@ impl SceneRenderer {
                     triangles: coarse.triangles,
                 }
             });
+        let textured = queue.and_then(|queue| {
+            TexturedDraw::new(device, queue, &mut self.texture_cache, mesh, uvs, &triangles, first_textured)
+        });
         self.geometry = Some(Geometry {
             mesh: mesh.clone(),
             triangles,
@@ -562,6 +547,8 @@ impl SceneRenderer {
             scratch: Vec::new(),
             coarse,
             full_stale: false,
+            uvs_given: !uvs.is_empty(),
+            textured,
         });
     }
 
@@ -648,6 +635,7 @@ impl SceneRenderer {
             output_linear: u32::from(self.format.is_srgb()),
         };
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
+        self.textures_shown.store(frame.textures && !frame.mode.is_false_colour(), Ordering::Relaxed);
     }
 
     /// Records the frame into `pass`, within the pass's current viewport: first the background
@@ -662,11 +650,29 @@ impl SceneRenderer {
             Some(c) if self.coarse => (&c.vertices, &c.colours, c.triangles.len()),
             _ => (&g.vertices, &g.colours, g.triangles.len()),
         };
-        if triangles > 0 {
+        let textured = g
+            .textured
+            .as_ref()
+            .filter(|_| !(self.coarse && g.coarse.is_some()) && self.textures_shown.load(Ordering::Relaxed));
+        let plain = textured.map_or(triangles, |t| t.first_triangle as usize);
+        if plain > 0 {
             pass.set_pipeline(&self.mesh_pipeline);
             pass.set_vertex_buffer(0, vertices.slice(..));
             pass.set_vertex_buffer(1, colours.slice(..));
-            pass.draw(0..(triangles * 3) as u32, 0..1);
+            pass.draw(0..(plain * 3) as u32, 0..1);
+        }
+        if let Some(t) = textured {
+            // The textured triangles' vertices, counted from the first: the texture
+            // coordinates cover only them.
+            let corner = u64::from(t.first_triangle) * 3;
+            pass.set_pipeline(&self.textured_pipeline);
+            pass.set_vertex_buffer(0, vertices.slice(corner * std::mem::size_of::<StaticVertex>() as u64..));
+            pass.set_vertex_buffer(1, colours.slice(corner * 12..));
+            pass.set_vertex_buffer(2, t.uvs.slice(..));
+            for (range, bind_group) in &t.batches {
+                pass.set_bind_group(1, bind_group, &[]);
+                pass.draw(range.start * 3..range.end * 3, 0..1);
+            }
         }
     }
 
@@ -742,44 +748,12 @@ fn colour_buffer(device: &wgpu::Device, label: &str, corners: usize) -> wgpu::Bu
     })
 }
 
-/// The false-colour range, log10 of luminance, of what `mode` shows: four decades below the
-/// brightest value (a dark corner must not squash the whole scale), or `(−1, 0)` when nothing
-/// is lit yet.
-pub fn false_colour_range(solution: &Solution, mode: DisplayMode) -> (f64, f64) {
-    let values: &[Rgb] = match mode {
-        DisplayMode::Unshot => &solution.element_unshot,
-        _ => &solution.vertex_radiosity,
-    };
-    let max = values.iter().map(|c| c.abs().luminance()).filter(|l| l.is_finite()).fold(0.0, f64::max);
-    if max <= 0.0 {
-        return (-1.0, 0.0);
-    }
-    let min = values
-        .iter()
-        .map(|c| c.abs().luminance())
-        .filter(|l| l.is_finite() && *l > 0.0)
-        .fold(max, f64::min)
-        .max(max * 1e-4);
-    let (lo, hi) = (min.log10(), max.log10());
-    if hi - lo < 1e-3 { (hi - 0.5, hi + 0.5) } else { (lo, hi) }
-}
-
-/// The Turbo false-colour ramp at t in [0, 1], display values in [0, 1]; the same polynomial
-/// as `false_colour` in `tonemap.wgsl` (for the legend drawn by egui).
-pub fn false_colour(t: f64) -> [f64; 3] {
-    let t = t.clamp(0.0, 1.0);
-    let v = [1.0, t, t * t, t * t * t, t.powi(4), t.powi(5)];
-    let dot = |k: [f64; 6]| v.iter().zip(k).map(|(a, b)| a * b).sum::<f64>().clamp(0.0, 1.0);
-    [
-        dot([0.13572138, 4.61539260, -42.66032258, 132.13108234, -152.94239396, 59.28637943]),
-        dot([0.09140261, 2.19418839, 4.84296658, -14.18503333, 4.27729857, 2.82956604]),
-        dot([0.10667330, 12.64194608, -60.58204836, 110.36276771, -89.90310912, 27.34824973]),
-    ]
-}
-
+mod display;
 mod exposure;
+mod textured;
 mod triangles;
 
+pub use display::{Detail, DisplayMode, Wireframe, false_colour, false_colour_range, shader_operator};
 pub use exposure::{AUTO_EXPOSURE_SAMPLES, auto_exposure_ev};
 pub use triangles::{edge_flags, oriented_triangles};
 

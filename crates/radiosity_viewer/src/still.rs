@@ -10,7 +10,7 @@ use std::sync::Arc;
 use std::sync::mpsc::{Receiver, TryRecvError, channel};
 use std::time::Instant;
 
-use radiosity_core::Camera;
+use radiosity_core::{Camera, Scene};
 use radiosity_image::{Gather, HdrImage, RenderParams, Renderer};
 use radiosity_mesh::Mesh;
 use radiosity_solver::Solution;
@@ -48,9 +48,12 @@ pub(crate) enum StillPoll {
 
 impl StillJob {
     /// Starts rendering `solution` on `mesh` from `camera` at `size` pixels (capped at
-    /// [`MAX_STILL_SIDE`], aspect kept), with `gather`; `notify` is called when it is done.
+    /// [`MAX_STILL_SIDE`], aspect kept), with `gather`, showing the colour textures of
+    /// `textures`, the scene `mesh` was built from, when given; `notify` is called when it is
+    /// done.
     pub(crate) fn spawn(
         mesh: Arc<Mesh>,
+        textures: Option<Arc<Scene>>,
         solution: Solution,
         camera: Camera,
         size: [u32; 2],
@@ -62,7 +65,12 @@ impl StillJob {
         std::thread::spawn(move || {
             let start = Instant::now();
             let params = RenderParams { width, height, gather, ..RenderParams::default() };
-            let result = Renderer::new(mesh)
+            // The textured faces' ray structure is built here, off the window's thread.
+            let renderer = match textures {
+                Some(scene) => Renderer::new(mesh).with_textures(&scene),
+                None => Renderer::new(mesh),
+            };
+            let result = renderer
                 .render(&solution, &camera, &params)
                 .map(|r| Still {
                     radiance: r.radiance,
@@ -123,7 +131,7 @@ mod tests {
         let mut solver = problem.solver(SolverParams::default()).unwrap();
         solver.step(StepBudget::Shots(u64::MAX));
         let camera = Camera::try_new(DVec3::splat(0.5), DVec3::new(1.0, 0.7, 1.0), DVec3::Y, 90.0).unwrap();
-        let job = StillJob::spawn(mesh, solver.solution(), camera, [32, 24], Gather::Direct, || {});
+        let job = StillJob::spawn(mesh, None, solver.solution(), camera, [32, 24], Gather::Direct, || {});
         let still = loop {
             match job.poll() {
                 StillPoll::Running => std::thread::sleep(std::time::Duration::from_millis(10)),

@@ -14,6 +14,7 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use radiosity_core::{MeshParams, Scene};
+use radiosity_image::ElementUvs;
 use radiosity_mesh::Mesh;
 use radiosity_solver::{Problem, Solution, Solver, SolverParams, StepBudget, StopReason};
 
@@ -138,6 +139,9 @@ pub struct Snapshot {
     pub generation: u64,
     /// The mesh the solution is on.
     pub mesh: Arc<Mesh>,
+    /// Texture coordinates of the mesh's element corners ([`radiosity_image::element_uvs`]);
+    /// empty when the scene has no texture. Shared by every snapshot of the mesh.
+    pub element_uvs: Arc<Vec<Option<ElementUvs>>>,
     /// The job that produced it.
     pub job: SolveJob,
     /// Radiosity per element and vertex, linear.
@@ -289,10 +293,15 @@ impl Drop for SolveWorker {
     }
 }
 
+/// Texture coordinates of a mesh's element corners, shared by its snapshots.
+type SharedUvs = Arc<Vec<Option<ElementUvs>>>;
+
 /// A job that meshed, with its solver.
 struct Run {
     job: SolveJob,
     problem: Problem,
+    /// Texture coordinates of the problem's mesh, found once per mesh: a ray per element.
+    element_uvs: SharedUvs,
     solver: Solver,
 }
 
@@ -418,15 +427,19 @@ impl Worker {
 
     fn start(&mut self, job: SolveJob) {
         self.set_state(WorkerState::Meshing);
-        let reuse = self.run.as_ref().filter(|r| r.job.same_mesh(&job)).map(|r| r.problem.clone());
+        let reuse = self
+            .run
+            .as_ref()
+            .filter(|r| r.job.same_mesh(&job))
+            .map(|r| (r.problem.clone(), r.element_uvs.clone()));
         let built = match reuse {
             Some(p) => Ok(p),
             None => self.in_pool(|| build_problem(&job)),
         };
-        let started = built.and_then(|problem| {
+        let started = built.and_then(|(problem, element_uvs)| {
             problem
                 .solver(job.solver_params.clone())
-                .map(|solver| Run { job, problem, solver })
+                .map(|solver| Run { job, problem, element_uvs, solver })
                 .map_err(|e| format!("cannot start the solver: {e}"))
         });
         match started {
@@ -527,6 +540,7 @@ impl Worker {
             (Some(r), true) => Some(Arc::new(Snapshot {
                 generation: self.generation,
                 mesh: r.problem.mesh().clone(),
+                element_uvs: r.element_uvs.clone(),
                 job: r.job.clone(),
                 solution: r.solver.solution(),
                 progress: status.progress.clone(),
@@ -547,11 +561,15 @@ impl Worker {
     }
 }
 
-/// Meshes the job's scene (light scale applied) and builds its ray-query structure.
-fn build_problem(job: &SolveJob) -> Result<Problem, String> {
+/// Meshes the job's scene (light scale applied) and builds its ray-query structure; finds the
+/// texture coordinates of the mesh's elements here too, off the window's thread.
+fn build_problem(job: &SolveJob) -> Result<(Problem, SharedUvs), String> {
     let mut scene = (*job.scene).clone();
     scene.scale_emission(job.light_scale);
-    Problem::new(&scene, &job.mesh_params).map_err(|e| format!("cannot mesh the scene: {e}"))
+    let problem =
+        Problem::new(&scene, &job.mesh_params).map_err(|e| format!("cannot mesh the scene: {e}"))?;
+    let element_uvs = Arc::new(radiosity_image::element_uvs(&scene, problem.mesh()));
+    Ok((problem, element_uvs))
 }
 
 #[cfg(test)]

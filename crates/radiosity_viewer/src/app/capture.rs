@@ -65,6 +65,8 @@ impl ViewerApp {
         let ctx = ctx.clone();
         self.still_job = Some(StillJob::spawn(
             snap.mesh.clone(),
+            // The still shows textures when the view does.
+            self.view.textures.then(|| snap.job.scene.clone()),
             snap.solution.clone(),
             camera,
             self.view_size,

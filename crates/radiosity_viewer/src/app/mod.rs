@@ -32,7 +32,7 @@ mod worker_link;
 
 pub(crate) use state::Outcome;
 pub use state::ViewState;
-use state::{Capture, FpsCounter, REST, Subdivision};
+use state::{Capture, FpsCounter, REST, Subdivision, has_textures};
 
 /// The key hint shown under the 3D view.
 pub const KEY_HINT: &str = "WASD/arrows move · Q/E or Ctrl/Space down/up · drag to look · wheel: speed · \
@@ -144,6 +144,7 @@ impl ViewerApp {
                 mode: options.display,
                 wireframe: options.wireframe,
                 detail: options.detail,
+                textures: has_textures(&scene),
             },
             render_state,
             view_size: [1, 1],

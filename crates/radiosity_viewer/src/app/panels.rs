@@ -115,10 +115,20 @@ impl ViewerApp {
                     .on_hover_text("outlines of the patches (which shoot) or the elements (which receive)");
             }
         });
-        let counts = {
+        let (counts, textured) = {
             let egui_renderer = self.render_state.renderer.read();
-            egui_renderer.callback_resources.get::<SceneRenderer>().map(SceneRenderer::triangle_counts)
+            let renderer = egui_renderer.callback_resources.get::<SceneRenderer>();
+            (renderer.map(SceneRenderer::triangle_counts), renderer.is_some_and(SceneRenderer::has_textures))
         };
+        // False colour shows the radiosity itself, never a texture.
+        ui.add_enabled_ui(textured && !self.view.mode.is_false_colour(), |ui| {
+            ui.checkbox(&mut self.view.textures, "textures").on_hover_text(if textured {
+                "the models' colour textures over the radiosity, as `render` shows them; off: each \
+                 surface in the mean colour the solve uses"
+            } else {
+                "the scene has no colour textures"
+            });
+        });
         if let Some((full, Some(coarse))) = counts {
             ui.horizontal(|ui| {
                 ui.label("detail");

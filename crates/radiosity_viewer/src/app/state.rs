@@ -57,6 +57,14 @@ pub struct ViewState {
     pub wireframe: Wireframe,
     /// How much of a big mesh is drawn.
     pub detail: Detail,
+    /// Whether textured materials show their textures (on when a scene that has any is
+    /// opened); off, every surface shows its mean colour, as the solve sees it.
+    pub textures: bool,
+}
+
+/// Whether any material of `scene` has a colour texture: the textures checkbox starts on.
+pub(super) fn has_textures(scene: &radiosity_core::Scene) -> bool {
+    scene.materials.iter().any(|m| m.texture.is_some())
 }
 
 /// Frames per second over the last second of drawn frames.

@@ -256,3 +256,79 @@ fn g_renders_a_still_in_the_background_and_save_writes_it() {
     assert!(dir.join("still.png").exists(), "{:?}", h.state().message);
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// A 4 × 4 floor tiled twice each way with an 8 × 8 black and white checkerboard, lit by a
+/// lamp 2 above its middle, as an OBJ with its MTL and PNG in `dir`; returns the OBJ's path.
+fn write_checkered_room(dir: &std::path::Path) -> String {
+    let texels =
+        (0..64).map(|i: u32| if (i % 8 + i / 8).is_multiple_of(2) { [250; 3] } else { [10; 3] }).collect();
+    radiosity_image::write_png(&dir.join("tiles.png"), &SrgbImage { width: 8, height: 8, pixels: texels })
+        .unwrap();
+    std::fs::write(
+        dir.join("tiled.mtl"),
+        "newmtl tiles\nKd 0.6 0.6 0.6\nmap_Kd tiles.png\nnewmtl light\nKd 0 0 0\nKe 5 5 5\n",
+    )
+    .unwrap();
+    // The floor's corners run so its normal points up; the lamp's, reversed, so it faces down.
+    let corners = [[0.0, 0.0], [0.0, 4.0], [4.0, 4.0], [4.0, 0.0]];
+    let mut obj = String::from("mtllib tiled.mtl\no tiles\n");
+    for [x, z] in corners {
+        obj += &format!("v {x} 0 {z}\nvt {} {}\n", x / 2.0, z / 2.0);
+    }
+    obj += "usemtl tiles\nf 1/1 2/2 3/3 4/4\no light\n";
+    for [x, z] in corners.iter().rev() {
+        obj += &format!("v {} 2 {}\n", 1.5 + x / 4.0, 1.5 + z / 4.0);
+    }
+    obj += "usemtl light\nf 5 6 7 8\n";
+    let path = dir.join("tiled.obj");
+    std::fs::write(&path, obj).unwrap();
+    path.to_string_lossy().into_owned()
+}
+
+/// A scene with a texture opens with the textures checkbox on and shows the texture, in the
+/// view and in a still; turned off, the view shows the floor's mean colour instead. The Cornell box, which has none,
+/// starts with it off.
+#[test]
+fn the_textures_checkbox_starts_on_for_a_textured_scene_and_turns_them_off() {
+    let dir = temp_dir("textures");
+    let room = write_checkered_room(&dir);
+    let mut h = harness(&room, Some(20), &dir);
+    step_until(&mut h, "20 shots on screen", |a| a.shown.as_ref().is_some_and(|s| s.solution.shots == 20));
+    assert!(h.state().view.textures, "on for a scene with a texture");
+    let textured = {
+        let renderer = h.state().render_state.renderer.read();
+        renderer.callback_resources.get::<SceneRenderer>().is_some_and(SceneRenderer::has_textures)
+    };
+    assert!(textured, "the floor is drawn textured");
+    // Distinct grey levels in the view: a checkerboard, filtered, has many more than the
+    // evenly lit plain floor.
+    let levels = |h: &mut Harness<'static, ViewerApp>, name: &str| {
+        h.key_press(Key::P);
+        h.step();
+        let path = std::fs::read_dir(&dir)
+            .unwrap()
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .find(|p| p.file_name().is_some_and(|n| n.to_string_lossy().ends_with(&format!("{name}.png"))))
+            .unwrap_or_else(|| panic!("no screenshot: {:?}", h.state().message));
+        let img = image::open(&path).unwrap().to_rgb8();
+        std::fs::remove_file(path).unwrap();
+        img.pixels().map(|p| p[0]).collect::<std::collections::BTreeSet<u8>>().len()
+    };
+    let on = levels(&mut h, "20shots");
+    // The still (G) shows the texture too.
+    h.key_press(Key::G);
+    h.step();
+    step_until(&mut h, "the still", |a| a.still.is_some());
+    let (_, _, srgb) = h.state().still.as_ref().unwrap();
+    let still_levels = srgb.pixels.iter().map(|p| p[0]).collect::<std::collections::BTreeSet<u8>>().len();
+    assert!(still_levels > 50, "the still shows the texture: {still_levels} red levels");
+    h.get_by_label("textures").click();
+    h.step();
+    assert!(!h.state().view.textures);
+    let off = levels(&mut h, "20shots");
+    assert!(on > 50 && off < 20, "textures on: {on} red levels in the view; off: {off}");
+
+    let cornell = harness("cornell", Some(5), &dir);
+    assert!(!cornell.state().view.textures, "off for a scene without textures");
+    let _ = std::fs::remove_dir_all(dir);
+}

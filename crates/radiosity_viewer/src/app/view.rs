@@ -44,6 +44,7 @@ impl ViewerApp {
             wireframe: self.view.wireframe,
             log_range: self.log_range,
             background: BACKGROUND,
+            textures: self.view.textures,
         }
     }
 

@@ -13,7 +13,7 @@ use crate::render::{Detail, SceneRenderer, Wireframe, false_colour_range};
 use crate::worker::{SolveJob, WorkerState};
 
 use super::ViewerApp;
-use super::state::{REST, Subdivision};
+use super::state::{REST, Subdivision, has_textures};
 
 impl ViewerApp {
     /// Starts a new job, keeping the paused/running state.
@@ -127,7 +127,8 @@ impl ViewerApp {
         {
             let mut egui_renderer = self.render_state.renderer.write();
             if let Some(renderer) = egui_renderer.callback_resources.get_mut::<SceneRenderer>() {
-                renderer.set_mesh(&self.render_state.device, &snap.mesh);
+                let (device, queue) = (&self.render_state.device, &self.render_state.queue);
+                renderer.set_textured_mesh(device, queue, &snap.mesh, &snap.element_uvs);
                 renderer.set_solution(&self.render_state.queue, &snap.solution, self.view.mode);
             }
         }
@@ -143,6 +144,7 @@ impl ViewerApp {
                 &radiosity_image::camera_or_framing(&snap.job.scene),
                 &self.extent,
             );
+            self.view.textures = has_textures(&snap.job.scene);
             self.camera_scene = Some(snap.job.scene.clone());
         }
         self.shown = Some(snap);
