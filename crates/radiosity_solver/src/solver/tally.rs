@@ -172,7 +172,7 @@ impl Tally {
     /// # Errors
     /// [`SolverError::NoEmission`] when nothing emits and there is no luminaire,
     /// [`SolverError::DarkLuminaires`] when nothing emits and no luminaire lights anything,
-    /// [`SolverError::DarkSun`] when a sun alone lights nothing.
+    /// [`SolverError::DarkDaylight`] when a sun or sky alone lights nothing.
     pub(super) fn lit(mesh: &Mesh, luminaires: Option<&LuminaireLight>) -> Result<Self, SolverError> {
         let n = mesh.elements.len();
         let emission: Vec<Rgb> = (0..n).map(|e| mesh.element_material(e).emission).collect();
@@ -180,7 +180,7 @@ impl Tally {
         if emitted.sum() <= 0.0 {
             match luminaires {
                 None => return Err(SolverError::NoEmission),
-                Some(light) if light.is_dark() && light.count == 0 => return Err(SolverError::DarkSun),
+                Some(light) if light.is_dark() && light.count == 0 => return Err(SolverError::DarkDaylight),
                 Some(light) if light.is_dark() => {
                     return Err(SolverError::DarkLuminaires { count: light.count });
                 }
