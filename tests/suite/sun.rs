@@ -163,3 +163,66 @@ fn a_sun_that_lights_nothing_is_refused_with_a_reason() {
     let message = radiosity_solver::SolverError::DarkDaylight.to_string();
     assert!(message.contains("sun") && !message.contains('\n'), "{message}");
 }
+
+/// Writes a one-floor scene with `[sun]` table `sun` (and `extra` before it) and loads it.
+fn load_sun(extra: &str, sun: &str) -> Result<Scene, String> {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scene.toml");
+    let text = format!(
+        "{extra}\n[sun]\n{sun}\n[[material]]\nname = \"g\"\nreflectance = [0.5, 0.5, 0.5]\n[[object]]\nname = \"f\"\n\
+         type = \"polygon\"\nmaterial = \"g\"\nvertices = [[0, 0, 0], [0, 0, 1], [1, 0, 1], [1, 0, 0]]\n"
+    );
+    std::fs::write(&path, text).unwrap();
+    radiosity_io::load_scene(&path).map(|l| l.scene).map_err(|e| e.to_string())
+}
+
+/// A sun placed by latitude, longitude and time: at Greenwich's solar noon on the 2026 June
+/// solstice it stands 90° − 51.48° + 23.44° = 61.96° high, due south, which in a y-up file
+/// whose north is −z (the default) is +z; in a z-up file (north +y by default) the same
+/// sun, turned to y-up, stands as high. Within 0.05° of elevation and 0.5° of azimuth.
+#[test]
+fn a_sun_placed_by_place_and_time_stands_where_the_almanac_puts_it() {
+    let sun = "latitude = 51.4779\nlongitude = 0\ntime = 2026-06-21T12:01:50Z\nilluminance = 100000";
+    let elevation = (90.0f64 - 51.4779 + 23.437).to_radians();
+    for extra in ["", "up = \"z\""] {
+        let towards = load_sun(extra, sun).unwrap().lighting.sun.expect("a sun").towards;
+        assert!((towards.y.asin() - elevation).abs() < 0.05f64.to_radians(), "{extra:?}: {towards}");
+        assert!(towards.x.abs() < 0.01, "due south: {towards}");
+    }
+    let south_y_up = load_sun("", sun).unwrap().lighting.sun.unwrap().towards;
+    assert!(south_y_up.z > 0.4, "north is −z, so south is +z: {south_y_up}");
+    // North given as +x: south is −x.
+    let turned = load_sun("", &format!("{sun}\nnorth = [1, 0, 0]")).unwrap().lighting.sun.unwrap().towards;
+    assert!(turned.x < -0.4 && turned.z.abs() < 0.01, "{turned}");
+}
+
+/// A sun placed by time refuses, in one line naming the key: a time without its offset from
+/// UTC, a time when the sun is below the horizon, a latitude out of range or missing, and a
+/// direction given as well.
+#[test]
+fn a_sun_placed_by_time_refuses_what_cannot_place_it() {
+    let cases = [
+        ("latitude = 48.85\nlongitude = 2.35\ntime = 2026-06-21T12:00:00\nilluminance = 1000", "sun.time"),
+        (
+            "latitude = 48.85\nlongitude = 2.35\ntime = 2026-06-21T23:00:00+02:00\nilluminance = 1000",
+            "below the horizon",
+        ),
+        ("latitude = 98\nlongitude = 2.35\ntime = 2026-06-21T12:00:00Z\nilluminance = 1000", "sun.latitude"),
+        ("longitude = 2.35\ntime = 2026-06-21T12:00:00Z\nilluminance = 1000", "sun.latitude"),
+        (
+            "direction = [0, 1, 0]\nlatitude = 48.85\nlongitude = 2.35\ntime = 2026-06-21T12:00:00Z\nilluminance = 1000",
+            "sun.direction",
+        ),
+        (
+            "latitude = 48.85\nlongitude = 2.35\ntime = 2026-06-21T12:00:00Z\nnorth = [0, 1, 0]\nilluminance = 1000",
+            "sun.north",
+        ),
+    ];
+    for (sun, key) in cases {
+        let message = match load_sun("", sun) {
+            Ok(_) => panic!("[sun] {sun:?} was taken"),
+            Err(e) => e,
+        };
+        assert!(message.contains(key) && !message.contains('\n'), "[sun] {sun:?}: {message}");
+    }
+}

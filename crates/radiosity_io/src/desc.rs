@@ -122,6 +122,16 @@ pub(crate) struct SunDesc {
     /// Direction from the scene towards the sun, in the file's frame.
     #[serde(deserialize_with = "point_opt", default)]
     pub(crate) direction: Option<Spanned<[f64; 3]>>,
+    /// Instead of `direction`: the site's latitude, degrees north...
+    pub(crate) latitude: Option<Spanned<f64>>,
+    /// ... its longitude, degrees east ...
+    pub(crate) longitude: Option<Spanned<f64>>,
+    /// ... and the date and time with its offset from UTC (a TOML offset date-time).
+    pub(crate) time: Option<Spanned<toml::value::Datetime>>,
+    /// Which way north is, in the file's frame: default −z (y-up files), the file's up
+    /// axis turned to y otherwise.
+    #[serde(deserialize_with = "point_opt", default)]
+    pub(crate) north: Option<Spanned<[f64; 3]>>,
     /// Illuminance on a plane facing the sun, lx (clear noon: about 100 000).
     pub(crate) illuminance: Option<Spanned<f64>>,
     /// Irradiance on a plane facing the sun, W/unit² per channel, as `emission` is given.

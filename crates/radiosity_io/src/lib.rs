@@ -39,6 +39,7 @@ mod obj;
 mod photometric;
 mod scene_file;
 mod scene_settings;
+mod sun_position;
 mod texture_map;
 mod up_guess;
 

@@ -185,17 +185,92 @@ fn direction(loc: &Locator, key: String, v: &Spanned<[f64; 3]>) -> Result<DVec3,
     }
 }
 
-/// The `[sun]` table: a direction and either lux (with a colour) or W/unit².
-fn sun(loc: &Locator, d: &Spanned<SunDesc>, unit: LengthUnit) -> Result<Sun, LoadError> {
+/// The `[sun]` table: a direction, or a place and a time, and either lux (with a colour) or
+/// W/unit². `up` is the file's up axis.
+fn sun(loc: &Locator, d: &Spanned<SunDesc>, unit: LengthUnit, up: UpAxis) -> Result<Sun, LoadError> {
     let (span, d) = (d.span(), d.get_ref());
-    let Some(towards) = &d.direction else {
-        return Err(loc.at(span, "sun.direction", "the sun needs direction = [x, y, z] (towards the sun)"));
+    let towards = match (&d.direction, &d.time) {
+        (Some(towards), None) => direction(loc, "sun.direction".into(), towards)?,
+        (None, Some(time)) => sun_at(loc, d, time, up)?,
+        (Some(towards), Some(_)) => {
+            return Err(loc.at(
+                towards.span(),
+                "sun.direction",
+                "give direction or latitude, longitude and time, not both",
+            ));
+        }
+        (None, None) => {
+            return Err(loc.at(
+                span,
+                "sun.direction",
+                "the sun needs direction = [x, y, z] (towards the sun), or latitude, longitude and time",
+            ));
+        }
     };
-    let towards = direction(loc, "sun.direction".into(), towards)?;
     let amount =
         Amount { illuminance: &d.illuminance, irradiance: &d.irradiance, colour: &d.colour, cct: &d.cct };
     let irradiance = amount.irradiance(loc, span, "sun", "on a plane facing it", unit)?;
     Ok(Sun { towards, irradiance })
+}
+
+/// The direction towards the sun from the `[sun]` table's place and `time`, in the file's
+/// frame: east is north × up.
+fn sun_at(
+    loc: &Locator,
+    d: &SunDesc,
+    time: &Spanned<toml::value::Datetime>,
+    up: UpAxis,
+) -> Result<DVec3, LoadError> {
+    let degrees = |key: &str, v: &Option<Spanned<f64>>, limit: f64| -> Result<f64, LoadError> {
+        let Some(v) = v else {
+            return Err(loc.at(
+                time.span(),
+                format!("sun.{key}"),
+                format!("a sun placed by time needs {key}"),
+            ));
+        };
+        let x = *v.get_ref();
+        if x.is_finite() && x.abs() <= limit {
+            Ok(x)
+        } else {
+            Err(loc.at(v.span(), format!("sun.{key}"), format!("expected degrees from −{limit} to {limit}")))
+        }
+    };
+    let latitude = degrees("latitude", &d.latitude, 90.0)?;
+    let longitude = degrees("longitude", &d.longitude, 180.0)?;
+    let position = crate::sun_position::solar_position(latitude, longitude, time.get_ref()).map_err(|e| {
+        let why = match e {
+            crate::sun_position::TimeError::Incomplete => {
+                "expected a date and a time, such as 2026-06-21T12:00:00+02:00"
+            }
+            crate::sun_position::TimeError::NoOffset => {
+                "the time needs its offset from UTC, such as 2026-06-21T12:00:00+02:00 or …Z"
+            }
+        };
+        loc.at(time.span(), "sun.time", why)
+    })?;
+    if position.elevation <= 0.0 {
+        return Err(loc.at(
+            time.span(),
+            "sun.time",
+            format!("the sun is {:.1}° below the horizon at that place and time", -position.elevation),
+        ));
+    }
+    let file_up = up.from_y_up(DVec3::Y);
+    let north = match &d.north {
+        Some(n) => direction(loc, "sun.north".into(), n)?,
+        None => up.from_y_up(DVec3::NEG_Z),
+    };
+    // North as given may lean: only its horizontal part counts.
+    let north = north - file_up * north.dot(file_up);
+    if north.length() < 1e-9 {
+        let span = d.north.as_ref().map_or(time.span(), |n| n.span());
+        return Err(loc.at(span, "sun.north", "north must not point straight up or down"));
+    }
+    let north = north.normalize();
+    let east = north.cross(file_up);
+    let (el, az) = (position.elevation.to_radians(), position.azimuth.to_radians());
+    Ok((east * az.sin() + north * az.cos()) * el.cos() + file_up * el.sin())
 }
 
 /// The `[sky]` table: a model and its unobstructed horizontal light, lux (with a colour) or
@@ -480,7 +555,7 @@ pub(crate) fn lighting(
         });
         grids.push(Grid { name, origin, u, v, divisions, normal, height });
     }
-    let sun = desc.sun.as_ref().map(|d| sun(loc, d, unit)).transpose()?;
+    let sun = desc.sun.as_ref().map(|d| sun(loc, d, unit, up)).transpose()?;
     let sky = desc.sky.as_ref().map(|d| sky(loc, d, unit, file_up)).transpose()?;
     Ok(Lighting { units, luminaires, grids, sun, sky })
 }
