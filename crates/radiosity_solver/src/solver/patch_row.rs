@@ -10,7 +10,7 @@ use super::Solver;
 use super::mesh_tables::MeshTables;
 use super::near_field::near_field;
 use super::parallel::{for_each_block_mut, for_each_maybe_parallel, map_blocks};
-use super::penumbra::wants_penumbra_rays;
+use super::penumbra::{heavy, wants_penumbra_rays};
 use super::plans::{PatchPlan, plan_patches};
 use super::ray_ends::draw_ray_ends;
 use super::rays::{Rays, SINGLE_STREAM, trace};
@@ -194,7 +194,8 @@ fn first_pass(
 }
 
 /// Penumbrae: more rays where the neighbours' pilot rays disagree (see
-/// [`wants_penumbra_rays`]), added to `factors`; `flags` is scratch, one per element.
+/// [`wants_penumbra_rays`]) or where the receiver takes a large share of the shot (see
+/// [`heavy`]), added to `factors`; `flags` is scratch, one per element.
 fn penumbra_pass(
     shot: &Shot,
     plans: &[PatchPlan],
@@ -203,8 +204,10 @@ fn penumbra_pass(
     factors: &mut [Received],
 ) {
     let first: &[Received] = factors;
+    let shooter_area = shot.shooter.area;
     for_each_maybe_parallel(flags, |e, out| {
-        *out = wants_penumbra_rays(first, e, tables.neighbours_of(e));
+        *out = wants_penumbra_rays(first, e, tables.neighbours_of(e))
+            || heavy(first, e, tables.element_area[e], shooter_area);
     });
     let flags: &[bool] = flags;
     for_each_maybe_parallel(factors, |e, out| {
