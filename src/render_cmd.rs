@@ -196,7 +196,9 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let start = Instant::now();
     // The solve used each material's mean reflectance; the picture shows its texture.
     let renderer = spinning("preparing the renderer", || {
-        Renderer::new(prepared.problem.mesh().clone()).with_textures(&prepared.scene)
+        Renderer::new(prepared.problem.mesh().clone())
+            .with_textures(&prepared.scene)
+            .with_sky(prepared.scene.lighting.sky)
     });
     // The irradiance cache is gathered before the first row: say so, and keep the line
     // ticking meanwhile, so a long gather does not look like a hang.

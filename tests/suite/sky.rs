@@ -227,3 +227,39 @@ vertices = [[-1, 1, -1], [2, 1, -1], [2, 1, 2], [-1, 1, 2]]"#;
     let err = Problem::new(&scene, &scene.mesh_params()).unwrap().solver(SolverParams::default()).err();
     assert_eq!(err, Some(radiosity_solver::SolverError::DarkDaylight));
 }
+
+/// A picture shows the sky where its view leaves the scene: from above the open floor,
+/// looking at the horizon, the top rows see a uniform sky of irradiance 1 at radiance 1/π,
+/// and the bottom rows the floor (B = 0.5, radiance 0.5/π).
+/// Without the sky the top rows are black.
+#[test]
+fn a_picture_shows_the_sky_where_the_view_leaves_the_scene() {
+    use radiosity_core::glam::DVec3;
+    use radiosity_image::{RenderParams, Renderer, Shading};
+    let (_dir, scene) = well("uniform", "irradiance = [1, 1, 1]", 16, false, "");
+    let problem = Problem::new(&scene, &scene.mesh_params()).unwrap();
+    let mut solver = problem.solver(SolverParams::default()).unwrap();
+    solver.solve();
+    let solution = solver.solution();
+    let camera =
+        radiosity_core::Camera::try_new(DVec3::new(0.5, 0.1, 0.0), DVec3::new(0.5, 0.1, 1.0), DVec3::Y, 60.0)
+            .unwrap();
+    let params = RenderParams {
+        width: 32,
+        height: 32,
+        samples_per_pixel: 1,
+        shading: Shading::Flat,
+        ..RenderParams::default()
+    };
+    let renderer = Renderer::new(problem.mesh().clone());
+    let dark = renderer.render(&solution, &camera, &params).unwrap().radiance;
+    let lit = renderer.with_sky(scene.lighting.sky).render(&solution, &camera, &params).unwrap().radiance;
+    let (sky, floor) = (1.0 / PI, 0.5 / PI);
+    assert_eq!(dark.pixel(16, 0).g, 0.0, "no sky: nothing seen above the horizon");
+    assert!((lit.pixel(16, 0).g - sky).abs() < 1e-9, "sky pixel {} against {sky}", lit.pixel(16, 0).g);
+    assert!(
+        (lit.pixel(16, 31).g - floor).abs() < 1e-6,
+        "floor pixel {} against {floor}",
+        lit.pixel(16, 31).g
+    );
+}

@@ -32,7 +32,11 @@ pub(crate) fn render(
                     Some(hit) if hit.front => {
                         g.radiosity_at(hit.point, u32::MAX, &mut rng) * std::f64::consts::FRAC_1_PI
                     }
-                    _ => Rgb::ZERO,
+                    Some(_) => Rgb::ZERO,
+                    // The sky where the view leaves the scene, as the solve's picture shows it.
+                    None => {
+                        g.sky.map_or(Rgb::ZERO, |s| s.radiosity_towards(dir) * std::f64::consts::FRAC_1_PI)
+                    }
                 };
                 sum += l;
                 sum_sq += l * l;

@@ -205,6 +205,8 @@ impl Renderer {
                                 ) / PI
                             }
                         };
+                    } else {
+                        sum += self.background(dir);
                     }
                 }
                 row[x] = sum / f64::from(n);

@@ -95,9 +95,23 @@ pub struct Renderer {
     /// The scene's textured faces ([`Renderer::with_textures`]); `None`: every surface shows
     /// its material's mean colour.
     textures: Option<texture::Textures>,
+    /// The sky seen where a view ray leaves the scene ([`Renderer::with_sky`]).
+    sky: Option<radiosity_core::Sky>,
 }
 
 impl Renderer {
+    /// The renderer showing `sky` where a view ray leaves the scene (the scene's `[sky]`; the
+    /// solve has its light on the surfaces already). Without one, nothing is seen there.
+    pub fn with_sky(mut self, sky: Option<radiosity_core::Sky>) -> Self {
+        self.sky = sky;
+        self
+    }
+
+    /// The radiance a view ray along `dir` that leaves the scene meets: the sky's, or none.
+    fn background(&self, dir: DVec3) -> Rgb {
+        self.sky.map_or(Rgb::ZERO, |s| s.radiosity_towards(dir) * (1.0 / std::f64::consts::PI))
+    }
+
     /// The renderer showing the colour textures of `scene`'s materials, which must be the
     /// scene `mesh` was built from: where a ray meets a textured face, the light it reflects
     /// is scaled by the texel's albedo over the material's mean reflectance (which the solve

@@ -30,7 +30,17 @@ impl Renderer {
         let (lo, hi) = mesh.bounds();
         let lift = 1e-6 * (hi - lo).length().max(f64::MIN_POSITIVE);
         let shading_normals = shading_normals(&mesh);
-        Self { mesh, accel, triangle_element, blockers, emitters, lift, shading_normals, textures: None }
+        Self {
+            mesh,
+            accel,
+            triangle_element,
+            blockers,
+            emitters,
+            lift,
+            shading_normals,
+            textures: None,
+            sky: None,
+        }
     }
 
     /// The element a ray along `dir` sees at BVH triangle `triangle`: where a two-sided
