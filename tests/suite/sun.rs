@@ -136,16 +136,9 @@ fn a_sun_missing_its_direction_or_light_is_refused_by_key() {
         ("direction = [0, 1, 0]\nirradiance = [1, 1, 1]\ncolour = [1, 0, 0]", "sun.colour"),
     ];
     for (sun, key) in cases {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("scene.toml");
-        let text = format!(
-            "[sun]\n{sun}\n[[material]]\nname = \"g\"\nreflectance = [0.5, 0.5, 0.5]\n[[object]]\nname = \"f\"\n\
-             type = \"polygon\"\nmaterial = \"g\"\nvertices = [[0, 0, 0], [0, 0, 1], [1, 0, 1], [1, 0, 0]]\n"
-        );
-        std::fs::write(&path, text).unwrap();
-        let message = match radiosity_io::load_scene(&path) {
+        let message = match load_sun("", sun) {
             Ok(_) => panic!("[sun] {sun:?} was taken"),
-            Err(e) => e.to_string(),
+            Err(e) => e,
         };
         assert!(message.contains(key) && !message.contains('\n'), "[sun] {sun:?}: {message}");
     }
@@ -166,10 +159,16 @@ fn a_sun_that_lights_nothing_is_refused_with_a_reason() {
 
 /// Writes a one-floor scene with `[sun]` table `sun` (and `extra` before it) and loads it.
 fn load_sun(extra: &str, sun: &str) -> Result<Scene, String> {
+    load_with_table(extra, "sun", sun)
+}
+
+/// Writes a one-floor scene with table `[name]` holding `body` (and `extra` before it) and
+/// loads it; the error's text when it does not load.
+pub(crate) fn load_with_table(extra: &str, name: &str, body: &str) -> Result<Scene, String> {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("scene.toml");
     let text = format!(
-        "{extra}\n[sun]\n{sun}\n[[material]]\nname = \"g\"\nreflectance = [0.5, 0.5, 0.5]\n[[object]]\nname = \"f\"\n\
+        "{extra}\n[{name}]\n{body}\n[[material]]\nname = \"g\"\nreflectance = [0.5, 0.5, 0.5]\n[[object]]\nname = \"f\"\n\
          type = \"polygon\"\nmaterial = \"g\"\nvertices = [[0, 0, 0], [0, 0, 1], [1, 0, 1], [1, 0, 0]]\n"
     );
     std::fs::write(&path, text).unwrap();

@@ -201,14 +201,7 @@ impl Problem {
     /// triangles, exactly as [`Problem::new`] does.
     pub fn from_mesh(mesh: Arc<Mesh>) -> Self {
         let ray_queries = Arc::new(Bvh::new(&occluder_triangles(&mesh)));
-        let unrefined_elements = mesh.elements.len();
-        Self {
-            mesh,
-            ray_queries,
-            unrefined_elements,
-            luminaires: Arc::from([]),
-            daylight: Daylight::default(),
-        }
+        Self::with_ray_queries(mesh, ray_queries)
     }
 
     /// The same problem lit by the sun and sky of `daylight` too (they shoot first in every

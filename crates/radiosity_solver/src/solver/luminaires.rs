@@ -114,6 +114,10 @@ fn element_irradiance(
     luminaires: &[Luminaire],
     lift: f64,
 ) -> Rgb {
+    // Daylight alone: no points to sample for luminaires.
+    if luminaires.is_empty() {
+        return Rgb::ZERO;
+    }
     let n = mesh.elements[e].normal;
     let (points, count) = sample_points(mesh, e);
     let mut sum = Rgb::ZERO;
