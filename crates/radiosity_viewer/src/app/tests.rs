@@ -326,7 +326,9 @@ fn the_textures_checkbox_starts_on_for_a_textured_scene_and_turns_them_off() {
     h.step();
     assert!(!h.state().view.textures);
     let off = levels(&mut h, "20shots");
-    assert!(on > 50 && off < 20, "textures on: {on} red levels in the view; off: {off}");
+    // The view's count depends on the frame the capture lands on (188 here, 37 once on a
+    // loaded machine); a flat floor gives 2, so 25 still tells a texture from none.
+    assert!(on > 25 && off < 10, "textures on: {on} red levels in the view; off: {off}");
 
     let cornell = harness("cornell", Some(5), &dir);
     assert!(!cornell.state().view.textures, "off for a scene without textures");
