@@ -87,6 +87,11 @@ pub fn lighting_json(prepared: &Prepared, grids: &[GridIlluminance]) -> Value {
             "aim": file(l.nadir),
             "lumens": l.flux(),
             "max_candela": l.scale * l.table.max_candela(),
+            "opening": json!({
+                "length": l.opening.length,
+                "width": l.opening.width,
+                "round": l.opening.round,
+            }),
         })).collect::<Vec<_>>(),
         "grids": grids.iter().map(|g| json!({
             "name": g.name,

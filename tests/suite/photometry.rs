@@ -70,7 +70,7 @@ adaptive_levels = 0
 }
 
 /// Solves `scene` to convergence and returns its grids' lux.
-fn grids_of(scene: &Scene) -> Vec<radiosity_image::GridIlluminance> {
+pub(crate) fn grids_of(scene: &Scene) -> Vec<radiosity_image::GridIlluminance> {
     let problem = Problem::new(scene, &scene.mesh_params()).unwrap();
     let mut solver =
         problem.solver(SolverParams { unshot_threshold: 1e-5, ..SolverParams::default() }).unwrap();

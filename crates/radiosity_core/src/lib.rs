@@ -31,8 +31,8 @@ pub use mesh_params::{
 };
 pub use one_line::{MAX_PART_CHARS, escape_controls, one_line};
 pub use photometry::{
-    Daylight, Grid, IntensityError, IntensityTable, LUMENS_PER_WATT, LengthUnit, Lighting, Luminaire, Sky,
-    SkyModel, Sun, colour_of_cct, photometric_y, unit_luminance,
+    Daylight, Grid, IntensityError, IntensityTable, LUMENS_PER_WATT, LengthUnit, Lighting, Luminaire,
+    NEAR_FIELD_RATIO, Opening, Sky, SkyModel, Sun, colour_of_cct, photometric_y, unit_luminance,
 };
 pub use scene::{
     Camera, Facing, Material, Object, Polygon, PolygonMesh, Scene, Shape, Sides, SolverSettings, Sphere,

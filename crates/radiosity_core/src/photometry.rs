@@ -25,6 +25,13 @@
 //!
 //! Between the table's angles I is interpolated bilinearly in C and γ (periodic in C), so
 //! neither plane nor cone shows steps.
+//!
+//! A luminaire with a luminous opening ([`Opening`]) is a point only far away. Nearer than
+//! [`NEAR_FIELD_RATIO`] times the opening's size, a receiver sees it as cells of the
+//! opening, each a point source with its share of the intensity, each far enough for the
+//! inverse-square law ([`Luminaire::sources_towards`]): the near-field calculation of
+//! CIE 121 and of the lighting-design programs, whose point approximation alone is 1 % off at
+//! five times the size and 12 % at twice it.
 
 use std::f64::consts::PI;
 use std::sync::Arc;
@@ -279,8 +286,31 @@ fn bracket(a: &[f64], x: f64) -> (usize, f64) {
     (i, t)
 }
 
-/// A placed point luminaire: a type C distribution, scaled, coloured and turned into the
-/// scene.
+/// Receivers at least this many times a cell's size from the opening (its nearest point)
+/// take the cell as a point. The cells' midpoint rule was checked against the exact
+/// illuminance of a uniform rectangle (configuration factor B-3, Howell) from 0.25 to 2 of
+/// its length below it, under it and up to three lengths aside: within 0.5 % everywhere,
+/// the worst at grazing incidence (1.5 % at a ratio of 8 measured from the centre instead).
+pub const NEAR_FIELD_RATIO: f64 = 10.0;
+
+/// Most cells along a side of an opening (a receiver touching the opening).
+const MAX_OPENING_CELLS: u32 = 32;
+
+/// A luminaire's luminous opening, flat across its nadir, scene units: `length` along C0,
+/// `width` along C90 (IES LM-63's width, length; EULUMDAT's luminous area). Both zero: a
+/// point. `round`: an ellipse (a disc when both are equal) inside that rectangle.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Opening {
+    /// Extent along C0.
+    pub length: f64,
+    /// Extent along C90.
+    pub width: f64,
+    /// An ellipse instead of a rectangle.
+    pub round: bool,
+}
+
+/// A placed luminaire: a type C distribution, scaled, coloured and turned into the scene,
+/// shining from a point or a luminous [`Opening`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct Luminaire {
     /// Name, for reports (the file stem and its number).
@@ -300,6 +330,8 @@ pub struct Luminaire {
     pub scale: f64,
     /// Colour at luminance Y = 1.
     pub colour: Rgb,
+    /// Where the light leaves from; a point by default.
+    pub opening: Opening,
 }
 
 impl Luminaire {
@@ -321,7 +353,59 @@ impl Luminaire {
         let c90 = c0.cross(nadir);
         let (s, c) = rotation_deg.to_radians().sin_cos();
         let (c0, c90) = (c0 * c + c90 * s, c90 * c - c0 * s);
-        Self { name: name.into(), position, nadir, c0, c90, table, scale, colour }
+        Self {
+            name: name.into(),
+            position,
+            nadir,
+            c0,
+            c90,
+            table,
+            scale,
+            colour,
+            opening: Opening::default(),
+        }
+    }
+
+    /// The point of the opening at `(u, v)` ∈ [0, 1]²: a rectangle's bilinear map, an
+    /// ellipse's concentric map (Shirley & Chiu 1997), both area-preserving, so uniform
+    /// `(u, v)` give uniform points and a grid's cell centres equal cells.
+    pub fn point_on_opening(&self, u: f64, v: f64) -> DVec3 {
+        let (mut a, mut b) = (2.0 * u - 1.0, 2.0 * v - 1.0);
+        if self.opening.round && (a != 0.0 || b != 0.0) {
+            let (r, phi) =
+                if a.abs() > b.abs() { (a, PI / 4.0 * b / a) } else { (b, PI / 2.0 - PI / 4.0 * a / b) };
+            (a, b) = (r * phi.cos(), r * phi.sin());
+        }
+        self.position + self.c0 * (0.5 * self.opening.length * a) + self.c90 * (0.5 * self.opening.width * b)
+    }
+
+    /// The point sources a receiver at `p` sees the luminaire as, with their shares of its
+    /// intensity (summing to 1): its centre alone at [`NEAR_FIELD_RATIO`] times the
+    /// opening's size and beyond; nearer, the centres of the opening cut into cells that
+    /// far from `p` each.
+    pub fn sources_towards(&self, p: DVec3) -> impl Iterator<Item = (DVec3, f64)> + '_ {
+        // Distance to the opening's nearest point: an oblique receiver beside a long
+        // opening is nearer its end than its centre.
+        let w = p - self.position;
+        let (x, y) = (w.dot(self.c0), w.dot(self.c90));
+        let (half_l, half_w) = (0.5 * self.opening.length, 0.5 * self.opening.width);
+        let (dx, dy) = (x - x.clamp(-half_l, half_l), y - y.clamp(-half_w, half_w));
+        let d = (dx * dx + dy * dy + w.dot(self.nadir).powi(2)).sqrt();
+        let cells = |side: f64| {
+            let n = (NEAR_FIELD_RATIO * side / d).ceil();
+            if n.is_finite() { (n as u32).clamp(1, MAX_OPENING_CELLS) } else { MAX_OPENING_CELLS }
+        };
+        let (mut na, mut nb) = (cells(self.opening.length), cells(self.opening.width));
+        if self.opening.round {
+            // The concentric map needs a square grid.
+            (na, nb) = (na.max(nb), na.max(nb));
+        }
+        let share = 1.0 / f64::from(na * nb);
+        (0..na * nb).map(move |k| {
+            let (i, j) = (k % na, k / na);
+            let (u, v) = ((f64::from(i) + 0.5) / f64::from(na), (f64::from(j) + 0.5) / f64::from(nb));
+            (self.point_on_opening(u, v), share)
+        })
     }
 
     /// Intensity towards unit direction `dir` (from the luminaire), cd.
@@ -378,9 +462,10 @@ impl Luminaire {
         if mean.length() >= 0.1 { self.position + mean.normalize() * step } else { self.position }
     }
 
-    /// Irradiance (W/unit²) at `p` with unit normal `n` when nothing is in the way.
-    pub fn irradiance_unblocked(&self, p: DVec3, n: DVec3) -> Rgb {
-        let w = self.position - p;
+    /// Irradiance (W/unit²) at `p` with unit normal `n` from its intensity leaving `source`
+    /// (its centre, or a point of its opening), when nothing is in the way.
+    pub fn irradiance_from(&self, source: DVec3, p: DVec3, n: DVec3) -> Rgb {
+        let w = source - p;
         let d2 = w.length_squared();
         if d2 <= 0.0 {
             return Rgb::ZERO;

@@ -2,10 +2,9 @@
 
 use radiosity_core::glam::DVec3;
 use radiosity_core::{
-    Facing, IntensityTable, Luminaire, MAX_POLYGON_VERTICES, Material, Object, Polygon, Rgb, Scene, SceneError,
-    Shape, box_faces,
+    Facing, IntensityTable, Luminaire, MAX_POLYGON_VERTICES, Material, Object, Polygon, Rgb, Scene,
+    SceneError, Shape, box_faces,
 };
-
 
 /// A [`MAX_POLYGON_VERTICES`]-gon (a disc) is valid, and one corner more is refused before
 /// any other work (a 10⁶-gon as fast as a 1025-gon).
@@ -39,12 +38,8 @@ fn bad_polygons_are_rejected() {
     assert!(matches!(Polygon::try_new(col), Err(SceneError::DegeneratePolygon { .. })));
     let bent = vec![DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.3), DVec3::Y];
     assert!(matches!(Polygon::try_new(bent), Err(SceneError::NonPlanarPolygon { .. })));
-    let dart = vec![
-        DVec3::ZERO,
-        DVec3::new(2.0, 0.0, 0.0),
-        DVec3::new(1.0, 0.3, 0.0),
-        DVec3::new(1.0, 2.0, 0.0),
-    ];
+    let dart =
+        vec![DVec3::ZERO, DVec3::new(2.0, 0.0, 0.0), DVec3::new(1.0, 0.3, 0.0), DVec3::new(1.0, 2.0, 0.0)];
     assert!(matches!(Polygon::try_new(dart), Err(SceneError::NonConvexPolygon { .. })));
     let nan = vec![DVec3::ZERO, DVec3::X, DVec3::new(f64::NAN, 0.0, 0.0)];
     assert!(matches!(Polygon::try_new(nan), Err(SceneError::NonFiniteCoordinate { .. })));
@@ -89,4 +84,3 @@ fn inward_box_faces_point_inside() {
         assert!((centre - f.vertices()[0]).dot(f.normal()) < 0.0);
     }
 }
-

@@ -77,20 +77,19 @@ pub fn grid_statistics(values: &[f64]) -> (f64, f64, f64, f64) {
     (min, avg, max, if avg > 0.0 { min / avg } else { 0.0 })
 }
 
-/// The luminaires' direct irradiance (W/unit²) at `p` facing `n`, shadowed by `blockers`.
+/// The luminaires' direct irradiance (W/unit²) at `p` facing `n`, shadowed by `blockers`:
+/// each luminaire's point sources as `p` sees them ([`radiosity_core::Luminaire::sources_towards`]).
 pub fn luminaire_irradiance(lighting: &Lighting, blockers: &dyn RayQuery, p: DVec3, n: DVec3) -> Rgb {
-    lighting
-        .luminaires
-        .iter()
-        .map(|l| {
-            let h = l.irradiance_unblocked(p, n);
-            if h.max_channel() > 0.0 && !blockers.occluded(l.position.as_vec3(), p.as_vec3()) {
-                h
-            } else {
-                Rgb::ZERO
+    let mut sum = Rgb::ZERO;
+    for l in &lighting.luminaires {
+        for (source, share) in l.sources_towards(p) {
+            let h = l.irradiance_from(source, p, n);
+            if h.max_channel() > 0.0 && !blockers.occluded(source.as_vec3(), p.as_vec3()) {
+                sum += h * share;
             }
-        })
-        .sum()
+        }
+    }
+    sum
 }
 
 /// The illuminance of every point of `grid`: the luminaires' and the sun's direct light by shadow rays

@@ -322,6 +322,8 @@ pub(crate) struct LuminaireDesc {
     pub(crate) colour: Option<Spanned<[f64; 3]>>,
     /// Colour as a correlated colour temperature, K.
     pub(crate) cct: Option<Spanned<f64>>,
+    /// Whether receivers near the luminaire see its luminous opening (default) or a point.
+    pub(crate) near_field: Option<bool>,
 }
 
 /// One `[[grid]]`.

@@ -9,8 +9,8 @@ use std::sync::Arc;
 
 use radiosity_core::glam::DVec3;
 use radiosity_core::{
-    Grid, IntensityTable, LUMENS_PER_WATT, LengthUnit, Lighting, Luminaire, Material, Object, Rgb, Shape,
-    Sides, Sky, SkyModel, Sun, UpAxis, colour_of_cct, unit_luminance,
+    Grid, IntensityTable, LUMENS_PER_WATT, LengthUnit, Lighting, Luminaire, Material, Object, Opening, Rgb,
+    Shape, Sides, Sky, SkyModel, Sun, UpAxis, colour_of_cct, unit_luminance,
 };
 use toml::Spanned;
 
@@ -377,7 +377,7 @@ pub(crate) fn lighting(
     let unit = units.unwrap_or_default();
     let folder = Path::new(loc.origin).parent().unwrap_or(Path::new(""));
     let mut luminaires = Vec::new();
-    let mut tables: Vec<(String, Arc<IntensityTable>, f64)> = Vec::new();
+    let mut tables: Vec<(String, Arc<IntensityTable>, f64, Opening)> = Vec::new();
     for (i, l) in desc.luminaire.iter().enumerate() {
         let key = format!("luminaire[{i}]");
         let l = l.get_ref();
@@ -385,15 +385,22 @@ pub(crate) fn lighting(
         let stem = Path::new(l.file.get_ref())
             .file_stem()
             .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
-        let (table, file_flux) = match tables.iter().find(|t| t.0 == *l.file.get_ref()) {
-            Some(t) => (t.1.clone(), t.2),
+        let (table, file_flux, opening) = match tables.iter().find(|t| t.0 == *l.file.get_ref()) {
+            Some(t) => (t.1.clone(), t.2, t.3),
             None => {
                 let p = load_photometry(&path)?;
                 let table = Arc::new(p.table);
                 let flux = table.flux();
-                tables.push((l.file.get_ref().clone(), table.clone(), flux));
-                (table, flux)
+                tables.push((l.file.get_ref().clone(), table.clone(), flux, p.opening));
+                (table, flux, p.opening)
             }
+        };
+        // The file's opening is in metres; a point when asked for.
+        let opening = if l.near_field == Some(false) {
+            Opening::default()
+        } else {
+            let s = unit.metres();
+            Opening { length: opening.length / s, width: opening.width / s, ..opening }
         };
         let mut scale = l
             .multiplier
@@ -458,7 +465,8 @@ pub(crate) fn lighting(
                 return Err(loc.at(l.file.span(), key, format!("more than {MAX_LUMINAIRES} luminaires")));
             }
             let name = if many { format!("{name} #{}", k + 1) } else { name.clone() };
-            luminaires.push(Luminaire::aimed(name, p, aim, rotation, table.clone(), scale, colour));
+            let luminaire = Luminaire::aimed(name, p, aim, rotation, table.clone(), scale, colour);
+            luminaires.push(Luminaire { opening, ..luminaire });
         }
     }
     let mut grids = Vec::new();

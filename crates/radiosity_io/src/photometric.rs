@@ -19,7 +19,7 @@
 
 use std::path::Path;
 
-use radiosity_core::IntensityTable;
+use radiosity_core::{IntensityTable, Opening};
 
 use crate::LoadError;
 
@@ -42,7 +42,15 @@ pub struct Photometry {
     pub lamp_lumens: Option<f64>,
     /// Luminaire name or catalogue number as the file gives it, possibly empty.
     pub label: String,
+    /// The luminous opening, metres (IES: width and length, negative for a round one;
+    /// EULUMDAT: the luminous area's length and width, width 0 for a round one). Its height
+    /// (a luminous box or cylinder) is not read: the opening is taken flat.
+    pub opening: Opening,
 }
+
+/// Openings wider than this (metres) are refused: no luminaire is a hundred metres across, and
+/// a file that says so has its units wrong.
+pub const MAX_OPENING_METRES: f64 = 100.0;
 
 /// Which format a file is in, by its extension (`.ies`, `.ldt`; any case).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -108,6 +116,14 @@ pub fn parse_photometry(
 }
 
 type Failed = (usize, String);
+
+/// A luminous opening's size `metres` (any sign) checked against [`MAX_OPENING_METRES`].
+fn opening_size(line: usize, metres: f64, what: &str) -> Result<f64, Failed> {
+    if metres.abs() > MAX_OPENING_METRES {
+        return Err((line, format!("{what} is {metres} m across, more than {MAX_OPENING_METRES} m")));
+    }
+    Ok(metres.abs())
+}
 
 /// Numbers of the IES data section, each with its 1-based line.
 struct Tokens<'a> {
@@ -206,8 +222,8 @@ fn parse_ies(text: &str) -> Result<Photometry, Failed> {
     let (_, n_horizontal) = tokens.count("the number of horizontal angles", 1)?;
     let (type_line, kind) = tokens.number("the photometric type")?;
     let (units_line, units) = tokens.number("the units type")?;
-    tokens.number("the luminous opening's width")?;
-    tokens.number("the luminous opening's length")?;
+    let width = tokens.number("the luminous opening's width")?;
+    let length = tokens.number("the luminous opening's length")?;
     tokens.number("the luminous opening's height")?;
     let (ballast_line, ballast) = tokens.number("the ballast factor")?;
     tokens.number("the ballast-lamp photometric factor (future use)")?;
@@ -226,6 +242,19 @@ fn parse_ies(text: &str) -> Result<Photometry, Failed> {
     if units != 1.0 && units != 2.0 {
         return Err((units_line, format!("units type must be 1 (feet) or 2 (metres), got {units}")));
     }
+    let metres = if units == 1.0 { 0.3048 } else { 1.0 };
+    for (line, v) in [width, length] {
+        opening_size(line, v * metres, "the luminous opening")?;
+    }
+    // LM-63-2002 §5.10: negative dimensions are a round opening (a disc when only the width
+    // is given).
+    let (w, l) = (width.1.abs() * metres, length.1.abs() * metres);
+    let round = width.1 < 0.0 || length.1 < 0.0;
+    let opening = if round {
+        Opening { length: if l > 0.0 { l } else { w }, width: if w > 0.0 { w } else { l }, round }
+    } else {
+        Opening { length: l, width: w, round }
+    };
     if multiplier <= 0.0 {
         return Err((mult_line, format!("candela multiplier must be > 0, got {multiplier}")));
     }
@@ -300,7 +329,7 @@ fn parse_ies(text: &str) -> Result<Photometry, Failed> {
     };
     let table = table_of(full, gammas).map_err(|e| (tokens.last_line, e))?;
     let lamp_lumens = (lumens > 0.0).then_some(lumens * lamps.max(1.0));
-    Ok(Photometry { table, lamp_lumens, label })
+    Ok(Photometry { table, lamp_lumens, label, opening })
 }
 
 /// 0–90° planes to the full circle: I(180 − C) = I(C), I(360 − C) = I(C).
@@ -413,12 +442,23 @@ fn parse_ldt(text: &str) -> Result<Photometry, Failed> {
     for what in ["the luminaire number", "the file name", "the date/user"] {
         next(what)?;
     }
+    for what in ["the luminaire length", "the luminaire width", "the luminaire height"] {
+        num(next(what)?, what)?;
+    }
+    // Millimetres; a width of 0 is a round area of that diameter.
+    let mut area = [0.0; 2];
+    for (k, what) in ["the luminous area's length", "the luminous area's width"].into_iter().enumerate() {
+        let (line, v) = num(next(what)?, what)?;
+        if v < 0.0 {
+            return Err((line, format!("{what} must be ≥ 0 mm, got {v}")));
+        }
+        area[k] = opening_size(line, v / 1000.0, what)?;
+    }
+    let opening = match area {
+        [l, 0.0] => Opening { length: l, width: l, round: true },
+        [l, w] => Opening { length: l, width: w, round: false },
+    };
     for what in [
-        "the luminaire length",
-        "the luminaire width",
-        "the luminaire height",
-        "the luminous area's length",
-        "the luminous area's width",
         "the luminous area's height at C0",
         "the luminous area's height at C90",
         "the luminous area's height at C180",
@@ -528,7 +568,7 @@ fn parse_ldt(text: &str) -> Result<Photometry, Failed> {
         }
     };
     let table = table_of(full, gammas).map_err(|e| (last_line, e))?;
-    Ok(Photometry { table, lamp_lumens: Some(flux), label })
+    Ok(Photometry { table, lamp_lumens: Some(flux), label, opening })
 }
 
 #[cfg(test)]
@@ -627,5 +667,39 @@ mod tests {
         let text = ldt(1, 4, 90.0, &c, &[0.0, 90.0], &[100.0]);
         let e = parse_photometry(&text, "t.ldt", PhotometricFormat::Eulumdat).unwrap_err().to_string();
         assert!(e.contains("ends before intensity 2 of 2"), "{e}");
+    }
+
+    /// The luminous opening: IES in feet or metres, negative for round (a disc from the
+    /// width alone); EULUMDAT in millimetres, width 0 for round; sizes out of range refused
+    /// on their line.
+    #[test]
+    fn luminous_openings_read_in_metres() {
+        let opening =
+            |body: &str| parse_photometry(&ies(body), "t.ies", PhotometricFormat::Ies).map(|p| p.opening);
+        let o = opening(LAMBERT).unwrap();
+        assert_eq!((o.length, o.width, o.round), (0.2, 0.2, false));
+        let o = opening(&LAMBERT.replace("1 1 2 0.2 0.2 0", "1 1 1 1.5 4 0")).unwrap();
+        assert!((o.width - 0.4572).abs() < 1e-12 && (o.length - 1.2192).abs() < 1e-12 && !o.round, "{o:?}");
+        let o = opening(&LAMBERT.replace("1 1 2 0.2 0.2 0", "1 1 2 -0.3 0 0")).unwrap();
+        assert_eq!((o.length, o.width, o.round), (0.3, 0.3, true));
+        let o = opening(&LAMBERT.replace("1 1 2 0.2 0.2 0", "1 1 2 0 0 0")).unwrap();
+        assert_eq!(o, Opening::default(), "a point");
+        let e = error(&ies(&LAMBERT.replace("1 1 2 0.2 0.2 0", "1 1 2 0.2 1e9 0")));
+        assert!(e.starts_with("bad.ies:5:") && e.contains("more than 100 m"), "{e}");
+
+        let c: Vec<f64> = (0..4).map(|i| f64::from(i) * 90.0).collect();
+        let text = ldt(1, 4, 90.0, &c, &[0.0, 90.0], &[100.0, 10.0]);
+        let o = parse_photometry(&text, "t.ldt", PhotometricFormat::Eulumdat).unwrap().opening;
+        assert_eq!((o.length, o.width, o.round), (0.1, 0.1, false));
+        // Lines 16 and 17: the luminous area's length and width.
+        let lines = |f: &dyn Fn(usize, &str) -> String| {
+            text.lines().enumerate().map(|(i, l)| f(i, l) + "\n").collect::<String>()
+        };
+        let round = lines(&|i, l| if i == 16 { "0".to_owned() } else { l.to_owned() });
+        let o = parse_photometry(&round, "t.ldt", PhotometricFormat::Eulumdat).unwrap().opening;
+        assert_eq!((o.length, o.width, o.round), (0.1, 0.1, true));
+        let negative = lines(&|i, l| if i == 15 { "-5".to_owned() } else { l.to_owned() });
+        let e = parse_photometry(&negative, "t.ldt", PhotometricFormat::Eulumdat).unwrap_err().to_string();
+        assert!(e.starts_with("t.ldt:16:") && e.contains("≥ 0 mm"), "{e}");
     }
 }

@@ -23,9 +23,9 @@
 
 use std::f64::consts::PI;
 
-use radiosity_core::Rgb;
 use radiosity_core::glam::DVec3;
 use radiosity_core::random::Rng;
+use radiosity_core::{Opening, Rgb};
 
 use crate::geometry::{Geometry, SurfacePoint, pick};
 
@@ -58,17 +58,24 @@ impl Geometry {
         self.objects[y_object as usize].emission.sum() / total * r2 / cos_y
     }
 
-    /// Irradiance at `p` (unit normal `n`) straight from the point luminaires: each one's
-    /// I(C, γ) · cos θ / d² when a shadow ray to it is clear (a point light cannot be met by
-    /// a bounce, so its next-event estimate is the whole of it, with no noise but visibility);
-    /// and from the sun, E cos θ when a shadow ray towards it leaves the scene (a direction,
-    /// met by no bounce either).
-    pub(crate) fn luminaire_irradiance(&self, p: DVec3, n: DVec3) -> Rgb {
+    /// Irradiance at `p` (unit normal `n`) straight from the luminaires: each one's
+    /// I(C, γ) · cos θ / d² when a shadow ray to it is clear (a luminaire cannot be met by
+    /// a bounce, so its next-event estimate is the whole of it, with no noise but visibility),
+    /// from a uniformly drawn point of its opening when it has one (the intensity spread
+    /// evenly over the opening: the solver's cells are the midpoint rule of the same
+    /// integral, this its Monte Carlo estimate); and from the sun, E cos θ when a shadow ray
+    /// towards it leaves the scene (a direction, met by no bounce either).
+    pub(crate) fn luminaire_irradiance(&self, p: DVec3, n: DVec3, rng: &mut Rng) -> Rgb {
         let mut sum = Rgb::ZERO;
         let from = p + n * self.offset;
         for l in &self.luminaires {
-            let h = l.irradiance_unblocked(p, n);
-            if h.max_channel() > 0.0 && !self.occluded(from, l.position) {
+            let source = if l.opening == Opening::default() {
+                l.position
+            } else {
+                l.point_on_opening(rng.next_f64(), rng.next_f64())
+            };
+            let h = l.irradiance_from(source, p, n);
+            if h.max_channel() > 0.0 && !self.occluded(from, source) {
                 sum += h;
             }
         }
@@ -86,7 +93,7 @@ impl Geometry {
     /// plus the radiosity B(y) (emission included) met by one cosine-weighted ray, whose
     /// density makes the estimate of ∫ B/π cos θ dω simply B(y).
     pub(crate) fn irradiance_at(&self, p: DVec3, n: DVec3, rng: &mut Rng) -> Rgb {
-        let mut h = self.luminaire_irradiance(p, n);
+        let mut h = self.luminaire_irradiance(p, n, rng);
         let dir = cosine_direction(n, rng.next_f64(), rng.next_f64());
         match self.intersect(p + n * self.offset, dir) {
             Some(hit) if hit.front => h += self.radiosity_at(hit.point, u32::MAX, rng),
@@ -110,7 +117,7 @@ impl Geometry {
         let luminaires = if self.luminaires.is_empty() && self.sun.is_none() {
             Rgb::ZERO
         } else {
-            self.luminaire_irradiance(x.p, x.n)
+            self.luminaire_irradiance(x.p, x.n, rng)
         };
         if self.emitters.is_empty() {
             return luminaires;

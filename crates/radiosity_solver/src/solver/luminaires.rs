@@ -1,7 +1,8 @@
 //! Luminaires shoot first, exactly: before the first shot, every element receives the
-//! direct irradiance of every point luminaire (inverse-square law with the luminaire's
+//! direct irradiance of every luminaire (inverse-square law with the luminaire's
 //! goniometric intensity, E = I(C, γ) · cos θ / d², CIE 171:2006 test case 5.2), each sample
-//! point tested by a shadow ray to the luminaire. The element then holds ρ·E as radiosity and
+//! point tested by a shadow ray to the luminaire, or to each cell of its opening that the
+//! point is near enough to see apart (`Luminaire::sources_towards`). The element then holds ρ·E as radiosity and
 //! as unshot radiosity, and the surfaces' shooting carries the inter-reflections as for any
 //! other light.
 //!
@@ -123,12 +124,11 @@ fn element_irradiance(
     let mut sum = Rgb::ZERO;
     for l in luminaires {
         for &(p, w) in &points[..count] {
-            let h = l.irradiance_unblocked(p, n);
-            if h.max_channel() <= 0.0 {
-                continue;
-            }
-            if !rays.occluded(l.position.as_vec3(), (p + n * lift).as_vec3()) {
-                sum += h * w;
+            for (source, share) in l.sources_towards(p) {
+                let h = l.irradiance_from(source, p, n);
+                if h.max_channel() > 0.0 && !rays.occluded(source.as_vec3(), (p + n * lift).as_vec3()) {
+                    sum += h * (w * share);
+                }
             }
         }
     }
