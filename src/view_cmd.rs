@@ -24,6 +24,8 @@ pub enum DisplayArg {
     FalseColour,
     /// False colour of the unshot radiosity still waiting to be shot.
     Unshot,
+    /// False colour of the light arriving: lux in a photometric scene.
+    Illuminance,
 }
 
 /// Subdivision lines on the command line.
@@ -122,6 +124,7 @@ pub fn run(a: ViewArgs) -> Result<()> {
         DisplayArg::Flat => DisplayMode::FlatElements,
         DisplayArg::FalseColour => DisplayMode::FalseColour,
         DisplayArg::Unshot => DisplayMode::Unshot,
+        DisplayArg::Illuminance => DisplayMode::Illuminance,
     };
     options.wireframe = match a.wireframe {
         WireframeArg::Off => Wireframe::Off,

@@ -594,6 +594,9 @@ impl SceneRenderer {
             DisplayMode::Smooth | DisplayMode::FalseColour => f(solution.vertex_radiosity[v as usize]),
             DisplayMode::FlatElements => f(solution.element_radiosity[e as usize]),
             DisplayMode::Unshot => f(solution.element_unshot[e as usize].abs()),
+            DisplayMode::Illuminance => {
+                f(irradiance_of(&g.mesh, e as usize, solution.vertex_radiosity[v as usize]))
+            }
         };
         g.scratch.clear();
         if let Some(c) = &g.coarse {
@@ -753,7 +756,9 @@ mod exposure;
 mod textured;
 mod triangles;
 
-pub use display::{Detail, DisplayMode, Wireframe, false_colour, false_colour_range, shader_operator};
+pub use display::{
+    Detail, DisplayMode, Wireframe, false_colour, false_colour_range, irradiance_of, shader_operator,
+};
 pub use exposure::{AUTO_EXPOSURE_SAMPLES, auto_exposure_ev};
 pub use triangles::{edge_flags, oriented_triangles};
 

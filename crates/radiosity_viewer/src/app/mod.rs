@@ -55,6 +55,8 @@ pub struct ViewerApp {
     camera_scene: Option<Arc<Scene>>,
     extent: SceneExtent,
     log_range: (f64, f64),
+    /// Lux per W/unit² of the shown scene, when it is photometric (the illuminance legend).
+    lux_per_irradiance: Option<f64>,
     /// The automatic exposure as it adapts, stops.
     auto_ev: Option<f64>,
     subdivision: Subdivision,
@@ -164,6 +166,7 @@ impl ViewerApp {
             camera_scene: Some(scene),
             extent,
             log_range: (-1.0, 0.0),
+            lux_per_irradiance: None,
             auto_ev: None,
             loading: None,
             load_error: None,

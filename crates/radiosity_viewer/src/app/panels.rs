@@ -273,9 +273,12 @@ impl ViewerApp {
         }
         painter.add(egui::Shape::mesh(mesh));
         let font = egui::FontId::proportional(11.0);
-        let title = match self.view.mode {
-            DisplayMode::Unshot => "unshot ΔB, W/unit²",
-            _ => "radiosity (Y), W/unit²",
+        // The shader shows log10 Y of what was uploaded; in lux, the labels are scaled.
+        let (title, scale) = match (self.view.mode, self.lux_per_irradiance) {
+            (DisplayMode::Unshot, _) => ("unshot ΔB, W/unit²", 1.0),
+            (DisplayMode::Illuminance, Some(lux)) => ("illuminance, lx", lux),
+            (DisplayMode::Illuminance, None) => ("irradiance (Y), W/unit²", 1.0),
+            _ => ("radiosity (Y), W/unit²", 1.0),
         };
         painter.text(
             bar.left_top() + Vec2::new(-2.0, -8.0),
@@ -286,12 +289,17 @@ impl ViewerApp {
         );
         for k in 0..=4 {
             let t = k as f64 / 4.0;
-            let value = 10f64.powf(lo + t * (hi - lo));
+            let value = 10f64.powf(lo + t * (hi - lo)) * scale;
             let y = bar.bottom() - t as f32 * bar.height();
             painter.text(
                 Pos2::new(bar.right() + 6.0, y),
                 egui::Align2::LEFT_CENTER,
-                format!("{value:.3e}"),
+                match value {
+                    _ if scale == 1.0 => format!("{value:.3e}"),
+                    v if v >= 100.0 => format!("{v:.0} lx"),
+                    v if v >= 1.0 => format!("{v:.1} lx"),
+                    v => format!("{v:.3} lx"),
+                },
                 font.clone(),
                 Color32::WHITE,
             );

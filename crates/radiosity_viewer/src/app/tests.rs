@@ -334,3 +334,25 @@ fn the_textures_checkbox_starts_on_for_a_textured_scene_and_turns_them_off() {
     assert!(!cornell.state().view.textures, "off for a scene without textures");
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// The illuminance mode of a photometric scene (the office, in metres) reads in lux: 683 lx
+/// per W/m², and the brightest light arriving after 200 shots is that of the floor and walls
+/// under six 3 000 lm downlights (hundreds of lux, not thousands nor tens).
+#[test]
+fn the_illuminance_mode_reads_lux_in_a_photometric_scene() {
+    let dir = temp_dir("lux");
+    let office = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/photometry/office.toml");
+    let mut h = harness(office, Some(200), &dir);
+    h.get_by_label("illuminance").click();
+    step_until(&mut h, "200 shots on screen", |a| a.shown.as_ref().is_some_and(|s| s.solution.shots == 200));
+    h.step();
+    let app = h.state();
+    assert_eq!(app.view.mode, DisplayMode::Illuminance);
+    assert_eq!(app.lux_per_irradiance, Some(683.0));
+    let top = 10f64.powf(app.log_range.1) * 683.0;
+    assert!((200.0..2000.0).contains(&top), "brightest {top} lx");
+    let mut cornell = harness("cornell", Some(5), &dir);
+    step_until(&mut cornell, "the box on screen", |a| a.shown.is_some());
+    assert_eq!(cornell.state().lux_per_irradiance, None, "no units: no lux");
+    let _ = std::fs::remove_dir_all(dir);
+}

@@ -133,8 +133,10 @@ impl ViewerApp {
             }
         }
         self.shown_mode = self.view.mode;
+        let lighting = &snap.job.scene.lighting;
+        self.lux_per_irradiance = lighting.is_photometric().then(|| lighting.unit().lux_per_irradiance());
         if self.view.mode.is_false_colour() {
-            self.log_range = false_colour_range(&snap.solution, self.view.mode);
+            self.log_range = false_colour_range(&snap.solution, &snap.mesh, self.view.mode);
         }
         // A new scene (not a re-mesh of the same one) gets its own camera.
         if self.camera_scene.as_ref().is_none_or(|s| !Arc::ptr_eq(s, &snap.job.scene)) {

@@ -3,6 +3,7 @@
 
 use radiosity_core::Rgb;
 use radiosity_image::ToneOperator;
+use radiosity_mesh::Mesh;
 use radiosity_solver::Solution;
 
 /// The operator's id in the shader (`OP_*` in `tonemap.wgsl`).
@@ -26,12 +27,20 @@ pub enum DisplayMode {
     FalseColour,
     /// False colour of each element's unshot radiosity ΔB: where light still waits.
     Unshot,
+    /// False colour of log illuminance, the light arriving ([`irradiance_of`]): lux in a
+    /// photometric scene, what a lighting designer reads.
+    Illuminance,
 }
 
 impl DisplayMode {
     /// Every mode, in panel order.
-    pub const ALL: [DisplayMode; 4] =
-        [DisplayMode::Smooth, DisplayMode::FlatElements, DisplayMode::FalseColour, DisplayMode::Unshot];
+    pub const ALL: [DisplayMode; 5] = [
+        DisplayMode::Smooth,
+        DisplayMode::FlatElements,
+        DisplayMode::FalseColour,
+        DisplayMode::Illuminance,
+        DisplayMode::Unshot,
+    ];
 
     /// Label in the panel.
     pub fn label(self) -> &'static str {
@@ -40,6 +49,7 @@ impl DisplayMode {
             DisplayMode::FlatElements => "flat elements",
             DisplayMode::FalseColour => "false colour",
             DisplayMode::Unshot => "unshot energy",
+            DisplayMode::Illuminance => "illuminance",
         }
     }
 
@@ -50,12 +60,16 @@ impl DisplayMode {
             DisplayMode::FlatElements => "each element's own radiosity: shows the subdivision",
             DisplayMode::FalseColour => "log luminance of the radiosity on a colour scale, with a legend",
             DisplayMode::Unshot => "radiosity still waiting to be shot, on a log colour scale",
+            DisplayMode::Illuminance => {
+                "the light arriving, (B − emission) / ρ, on a log colour scale: lux in a scene with units \
+                 (black surfaces show none)"
+            }
         }
     }
 
     /// Whether the mode is drawn in false colour with a legend.
     pub fn is_false_colour(self) -> bool {
-        matches!(self, DisplayMode::FalseColour | DisplayMode::Unshot)
+        matches!(self, DisplayMode::FalseColour | DisplayMode::Unshot | DisplayMode::Illuminance)
     }
 }
 
@@ -121,12 +135,30 @@ impl Detail {
     }
 }
 
-/// The false-colour range, log10 of luminance, of what `mode` shows: four decades below the
-/// brightest value (a dark corner must not squash the whole scale), or `(−1, 0)` when nothing
-/// is lit yet.
-pub fn false_colour_range(solution: &Solution, mode: DisplayMode) -> (f64, f64) {
+/// The irradiance (W/unit²) at a point of element `e` of `mesh` whose radiosity is `b`:
+/// E = (B − emission) / ρ per channel (B = emission + ρE), none where ρ is 0 (what a black
+/// surface receives cannot be read back from its radiosity).
+pub fn irradiance_of(mesh: &Mesh, e: usize, b: Rgb) -> Rgb {
+    let m = mesh.element_material(e);
+    (b - m.emission).zip_map(m.reflectance, |x, r| if r > 0.0 { (x / r).max(0.0) } else { 0.0 })
+}
+
+/// The false-colour range, log10 of luminance, of what `mode` shows on `mesh`: four decades
+/// below the brightest value (a dark corner must not squash the whole scale), or `(−1, 0)`
+/// when nothing is lit yet.
+pub fn false_colour_range(solution: &Solution, mesh: &Mesh, mode: DisplayMode) -> (f64, f64) {
+    let irradiance: Vec<Rgb>;
     let values: &[Rgb] = match mode {
         DisplayMode::Unshot => &solution.element_unshot,
+        DisplayMode::Illuminance if solution.element_radiosity.len() == mesh.elements.len() => {
+            irradiance = solution
+                .element_radiosity
+                .iter()
+                .enumerate()
+                .map(|(e, b)| irradiance_of(mesh, e, *b))
+                .collect();
+            &irradiance
+        }
         _ => &solution.vertex_radiosity,
     };
     let max = values.iter().map(|c| c.abs().luminance()).filter(|l| l.is_finite()).fold(0.0, f64::max);

@@ -91,16 +91,35 @@ fn auto_exposure_agrees_with_the_cpu_renderer() {
 
 #[test]
 fn false_colour_range_spans_four_decades_at_most() {
+    let mesh = furnace_mesh();
     let s = Solution {
         vertex_radiosity: vec![Rgb::splat(1e-9), Rgb::splat(0.5), Rgb::splat(100.0), Rgb::ZERO],
         element_unshot: vec![Rgb::splat(-2.0), Rgb::ZERO],
         ..Default::default()
     };
-    let (lo, hi) = false_colour_range(&s, DisplayMode::FalseColour);
+    let (lo, hi) = false_colour_range(&s, &mesh, DisplayMode::FalseColour);
     assert!((hi - 2.0).abs() < 1e-9 && (lo + 2.0).abs() < 1e-9, "{lo} {hi}");
-    let (lo, hi) = false_colour_range(&s, DisplayMode::Unshot);
+    let (lo, hi) = false_colour_range(&s, &mesh, DisplayMode::Unshot);
     assert!(lo < hi && (hi - 2f64.log10()).abs() < 0.51);
-    assert_eq!(false_colour_range(&Solution::default(), DisplayMode::Smooth), (-1.0, 0.0));
+    assert_eq!(false_colour_range(&Solution::default(), &mesh, DisplayMode::Smooth), (-1.0, 0.0));
+}
+
+/// The furnace (ρ = 0.5, emission 1, B = 2 everywhere) receives E = (B − emission)/ρ = 2:
+/// what the illuminance mode shows and the middle of its scale; a black surface shows none.
+#[test]
+fn illuminance_is_radiosity_less_emission_over_reflectance() {
+    let mut mesh = furnace_mesh();
+    let s = Solution { element_radiosity: vec![Rgb::splat(2.0); mesh.elements.len()], ..Default::default() };
+    for e in 0..mesh.elements.len() {
+        assert!((irradiance_of(&mesh, e, Rgb::splat(2.0)) - Rgb::splat(2.0)).max_channel().abs() < 1e-12);
+    }
+    // One value everywhere: the scale is a decade centred on it.
+    let (lo, hi) = false_colour_range(&s, &mesh, DisplayMode::Illuminance);
+    assert!(((lo + hi) / 2.0 - 2f64.log10()).abs() < 1e-9, "{lo} {hi}");
+    mesh.materials[0].reflectance = Rgb::ZERO;
+    let black =
+        (0..mesh.elements.len()).find(|&e| mesh.element_material(e).reflectance == Rgb::ZERO).unwrap();
+    assert_eq!(irradiance_of(&mesh, black, Rgb::splat(2.0)), Rgb::ZERO);
 }
 
 #[test]
