@@ -231,7 +231,7 @@ fn offscreen_cornell_shows_red_left_and_green_right() {
             operator: ToneOperator::Aces,
             mode,
             wireframe,
-            log_range: radiosity_viewer::render::false_colour_range(solution, mode),
+            log_range: radiosity_viewer::render::false_colour_range(solution, mesh, mode),
             background: [0.1, 0.1, 0.1, 1.0],
             textures: true,
         };
