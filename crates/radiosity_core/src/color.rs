@@ -133,21 +133,3 @@ impl std::iter::Sum for Rgb {
         iter.fold(Rgb::ZERO, |a, b| a + b)
     }
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn luminance_of_white_is_one() {
-        assert!((Rgb::ONE.luminance() - 1.0).abs() < 1e-12);
-    }
-
-    #[test]
-    fn arithmetic_is_channel_wise() {
-        let a = Rgb::new(1.0, 2.0, 3.0);
-        assert_eq!(a * a, Rgb::new(1.0, 4.0, 9.0));
-        assert_eq!(a - a, Rgb::ZERO);
-        assert_eq!((a * 2.0).sum(), 12.0);
-    }
-}

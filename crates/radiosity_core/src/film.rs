@@ -62,21 +62,3 @@ impl CameraRays {
         self.direction(f64::from(x) + sx, f64::from(y) + sy)
     }
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The centre of the film looks at `look_at`; the top-left corner is up and to the left
-    /// by half the field of view.
-    #[test]
-    fn the_film_maps_centre_and_corners() {
-        let camera = Camera::try_new(DVec3::ZERO, DVec3::Z, DVec3::Y, 90.0).unwrap();
-        let rays = CameraRays::new(&camera, 200, 100);
-        assert!((rays.direction(100.0, 50.0) - DVec3::Z).length() < 1e-12);
-        let corner = rays.direction(0.0, 0.0);
-        // tan 45° = 1 up, aspect 2 to the left (+x: right = z × y = −x).
-        let expected = DVec3::new(2.0, 1.0, 1.0).normalize();
-        assert!((corner - expected).length() < 1e-12, "{corner}");
-    }
-}

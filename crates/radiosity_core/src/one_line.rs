@@ -41,35 +41,3 @@ pub fn escape_controls(s: &str) -> String {
 /// Longest part of an error message kept whole, in characters; a longer one (a 1 MB key
 /// echoed by the TOML parser) is cut, saying how long it was.
 pub const MAX_PART_CHARS: usize = 1000;
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[derive(Debug)]
-    struct Outer(std::io::Error);
-
-    impl std::fmt::Display for Outer {
-        fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-            f.write_str("cannot load\nthe scene")
-        }
-    }
-
-    impl std::error::Error for Outer {
-        fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-            Some(&self.0)
-        }
-    }
-
-    #[test]
-    fn causes_are_joined_and_control_characters_escaped() {
-        let e = Outer(std::io::Error::other("no such file"));
-        assert_eq!(one_line(&e), "cannot load\\nthe scene: no such file");
-    }
-
-    #[test]
-    fn plain_text_is_kept() {
-        assert_eq!(escape_controls("a\nb\tc"), "a\\nb\\tc");
-        assert_eq!(escape_controls("plain"), "plain");
-    }
-}

@@ -138,24 +138,3 @@ impl Scene {
         self.lighting.map_exactly(&f);
     }
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Each turn takes its axis to +y, is a rotation (keeps a right-handed frame) and is
-    /// undone by its inverse.
-    #[test]
-    fn every_turn_takes_its_axis_up_and_back() {
-        for up in UpAxis::ALL {
-            assert_eq!(up.to_y_up(up.direction()), DVec3::Y, "{up}");
-            let (x, y, z) = (up.to_y_up(DVec3::X), up.to_y_up(DVec3::Y), up.to_y_up(DVec3::Z));
-            assert_eq!(x.cross(y), z, "{up}: not a rotation");
-            let p = DVec3::new(1.5, -2.25, 3.125);
-            assert_eq!(up.from_y_up(up.to_y_up(p)), p, "{up}");
-            assert_eq!(UpAxis::parse(up.as_str()), Some(up));
-        }
-        assert_eq!(UpAxis::parse("+Z"), Some(UpAxis::Z));
-        assert_eq!(UpAxis::parse("w"), None);
-    }
-}
