@@ -556,8 +556,8 @@ impl Daylight {
     }
 }
 
-/// How a sky's radiance varies with height above the horizon.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// How a sky's radiance varies over the dome.
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum SkyModel {
     /// The same radiance everywhere above the horizon.
     Uniform,
@@ -565,24 +565,60 @@ pub enum SkyModel {
     /// L(θ) = L_z (1 + 2 cos θ) / 3, θ from the zenith, three times brighter at the zenith
     /// than at the horizon. The sky of daylight factors.
     CieOvercast,
+    /// The CIE standard clear sky (CIE S 011/E:2003, sky type 12, Kittler, Perez & Darula
+    /// 1998): brightest around the sun, darkest about 90° from it, with the gradation
+    /// φ(Z) = 1 + a e^(b / cos Z) and the scattering indicatrix
+    /// f(χ) = 1 + c (e^(dχ) − e^(dπ/2)) + e cos²χ, a = −1, b = −0.32, c = 10, d = −3,
+    /// e = 0.45; L / L_z = f(χ) φ(Z) / (f(Z_s) φ(0)), χ the angle to the sun, Z_s its zenith
+    /// angle. The sun's own disc is not in it: give a `[sun]` for that.
+    CieClear {
+        /// Unit direction towards the sun.
+        sun: DVec3,
+    },
 }
 
 impl SkyModel {
-    /// The radiance at `cos_zenith` (cosine of the angle from the zenith, > 0) over the
-    /// zenith's.
-    pub fn relative_radiance(self, cos_zenith: f64) -> f64 {
+    /// The radiance along unit `towards` over the zenith's (`towards` above the horizon of
+    /// the unit `zenith`).
+    pub fn relative_radiance(self, towards: DVec3, zenith: DVec3) -> f64 {
+        let cos_z = towards.dot(zenith);
         match self {
             Self::Uniform => 1.0,
-            Self::CieOvercast => (1.0 + 2.0 * cos_zenith) / 3.0,
+            Self::CieOvercast => (1.0 + 2.0 * cos_z) / 3.0,
+            Self::CieClear { sun } => {
+                let gradation = |cos_z: f64| if cos_z > 0.0 { 1.0 - (-0.32 / cos_z).exp() } else { 1.0 };
+                let indicatrix = |chi: f64| {
+                    1.0 + 10.0 * ((-3.0 * chi).exp() - (-1.5 * PI).exp()) + 0.45 * chi.cos().powi(2)
+                };
+                let chi = towards.dot(sun).clamp(-1.0, 1.0).acos();
+                let sun_zenith = sun.dot(zenith).clamp(-1.0, 1.0).acos();
+                indicatrix(chi) * gradation(cos_z) / (indicatrix(sun_zenith) * gradation(1.0))
+            }
         }
     }
 
-    /// The irradiance on an unobstructed horizontal plane over π L_z: ∫ g(θ) cos θ dω / π,
-    /// 1 for the uniform sky, 2 ∫₀¹ (1 + 2μ)/3 μ dμ = 7/9 for the overcast one.
-    pub fn horizontal_factor(self) -> f64 {
+    /// The irradiance on an unobstructed horizontal plane over π L_z: ∫ g(ω) cos θ dω / π,
+    /// 1 for the uniform sky, 2 ∫₀¹ (1 + 2μ)/3 μ dμ = 7/9 for the overcast one; for the
+    /// clear sky by the midpoint rule over 256 rings of μ = cos θ and 512 azimuths (dω = dμ dφ).
+    pub fn horizontal_factor(self, zenith: DVec3) -> f64 {
         match self {
             Self::Uniform => 1.0,
             Self::CieOvercast => 7.0 / 9.0,
+            Self::CieClear { .. } => {
+                let (t, b) = zenith.any_orthonormal_pair();
+                let (rings, around) = (256, 512);
+                let mut sum = 0.0;
+                for i in 0..rings {
+                    let mu = (f64::from(i) + 0.5) / f64::from(rings);
+                    let s = (1.0 - mu * mu).sqrt();
+                    for j in 0..around {
+                        let phi = 2.0 * PI * (f64::from(j) + 0.5) / f64::from(around);
+                        let towards = zenith * mu + (t * phi.cos() + b * phi.sin()) * s;
+                        sum += self.relative_radiance(towards, zenith) * mu;
+                    }
+                }
+                sum * 2.0 / f64::from(rings * around)
+            }
         }
     }
 }
@@ -610,19 +646,22 @@ impl Sky {
 
     /// A sky of `model` whose unobstructed horizontal irradiance is `horizontal`.
     pub fn from_horizontal(model: SkyModel, zenith: DVec3, horizontal: Rgb, rays: u32) -> Self {
-        Self { zenith, model, zenith_radiosity: horizontal * (1.0 / model.horizontal_factor()), rays }
+        Self { zenith, model, zenith_radiosity: horizontal * (1.0 / model.horizontal_factor(zenith)), rays }
     }
 
     /// π times the radiance seen along unit direction `towards` (0 at and below the horizon):
     /// what a ray escaping the scene that way brings, in radiosity units.
     pub fn radiosity_towards(&self, towards: DVec3) -> Rgb {
-        let c = towards.dot(self.zenith);
-        if c > 0.0 { self.zenith_radiosity * self.model.relative_radiance(c) } else { Rgb::ZERO }
+        if towards.dot(self.zenith) > 0.0 {
+            self.zenith_radiosity * self.model.relative_radiance(towards, self.zenith)
+        } else {
+            Rgb::ZERO
+        }
     }
 
     /// Irradiance on an unobstructed horizontal plane facing the zenith.
     pub fn horizontal_irradiance(&self) -> Rgb {
-        self.zenith_radiosity * self.model.horizontal_factor()
+        self.zenith_radiosity * self.model.horizontal_factor(self.zenith)
     }
 }
 

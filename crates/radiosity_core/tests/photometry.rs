@@ -16,10 +16,11 @@ fn sky_horizontal_factors_are_the_integrals_of_their_radiance() {
         let integral: f64 = (0..n)
             .map(|i| {
                 let mu = (f64::from(i) + 0.5) / f64::from(n);
-                model.relative_radiance(mu) * mu * 2.0 * PI / f64::from(n)
+                let towards = DVec3::new((1.0 - mu * mu).sqrt(), mu, 0.0);
+                model.relative_radiance(towards, DVec3::Y) * mu * 2.0 * PI / f64::from(n)
             })
             .sum();
-        assert!((integral / PI - model.horizontal_factor()).abs() < 1e-8, "{model:?}");
+        assert!((integral / PI - model.horizontal_factor(DVec3::Y)).abs() < 1e-8, "{model:?}");
     }
     let sky = Sky::from_horizontal(SkyModel::CieOvercast, DVec3::Y, Rgb::splat(10.0), 64);
     assert!((sky.horizontal_irradiance().g - 10.0).abs() < 1e-12);
@@ -116,4 +117,38 @@ fn cct_white_points_are_plausible() {
 fn standard_spacing_follows_en_12464() {
     assert!((Grid::standard_spacing(1.0) - 0.2).abs() < 1e-12);
     assert!((Grid::standard_spacing(10.0) - 1.0).abs() < 1e-12);
+}
+
+/// The CIE clear sky (type 12) with the sun 40° up: 1 at the zenith, brightest towards the
+/// sun, darker 90° from it than near the sun or at the horizon opposite; its horizontal factor
+/// by the ring rule agrees with an independent estimate, the mean of its radiance over
+/// 400 000 cosine-distributed random directions (E_h / π L_z = E[g], standard error ≈ 0.1 %),
+/// within 4 standard errors.
+#[test]
+fn the_clear_sky_peaks_at_the_sun_and_integrates_the_same_two_ways() {
+    let el = 40f64.to_radians();
+    let sun = DVec3::new(el.cos(), el.sin(), 0.0);
+    let clear = SkyModel::CieClear { sun };
+    let g = |d: DVec3| clear.relative_radiance(d.normalize(), DVec3::Y);
+    assert!((g(DVec3::Y) - 1.0).abs() < 1e-12);
+    let near_sun = g(sun + DVec3::new(0.0, 0.0, 0.05));
+    let (side, behind) = (g(DVec3::new(0.0, 1.0, 1.0)), g(DVec3::new(-1.0, 0.2, 0.0)));
+    assert!(g(sun) > near_sun && near_sun > 3.0 * side, "sun {} near {near_sun} side {side}", g(sun));
+    assert!(behind > side, "the horizon opposite the sun is brighter than 90° from it");
+
+    let factor = clear.horizontal_factor(DVec3::Y);
+    let mut rng = radiosity_core::random::Rng::for_task(7, 0, 0);
+    let n = 400_000;
+    let (mut sum, mut sum2) = (0.0, 0.0);
+    for _ in 0..n {
+        let (u, v) = (rng.next_f64(), rng.next_f64());
+        let (r, phi) = (u.sqrt(), 2.0 * PI * v);
+        let value = g(DVec3::new(r * phi.cos(), (1.0 - u).sqrt(), r * phi.sin()));
+        sum += value;
+        sum2 += value * value;
+    }
+    let mean = sum / f64::from(n);
+    let se = ((sum2 / f64::from(n) - mean * mean) / f64::from(n)).sqrt();
+    assert!((mean - factor).abs() < 4.0 * se, "rings {factor}, random {mean} ± {se}");
+    assert!(se < 2e-3 * mean);
 }

@@ -274,18 +274,37 @@ fn sun_at(
 }
 
 /// The `[sky]` table: a model and its unobstructed horizontal light, lux (with a colour) or
-/// W/unit²; the zenith is the file's up axis.
-fn sky(loc: &Locator, d: &Spanned<SkyDesc>, unit: LengthUnit, zenith: DVec3) -> Result<Sky, LoadError> {
+/// W/unit²; the zenith is the file's up axis; the clear sky takes the `[sun]`'s position.
+fn sky(
+    loc: &Locator,
+    d: &Spanned<SkyDesc>,
+    unit: LengthUnit,
+    zenith: DVec3,
+    sun: Option<&Sun>,
+) -> Result<Sky, LoadError> {
     let (span, d) = (d.span(), d.get_ref());
     let model = match d.model.as_ref().map(|m| (m.span(), m.get_ref().as_str())) {
         None | Some((_, "cie-overcast")) => SkyModel::CieOvercast,
         Some((_, "uniform")) => SkyModel::Uniform,
+        Some((span, "cie-clear")) => match sun {
+            Some(sun) if sun.towards.dot(zenith) > 0.0 => SkyModel::CieClear { sun: sun.towards },
+            Some(_) => {
+                return Err(loc.at(span, "sky.model", "a clear sky needs the [sun] above the horizon"));
+            }
+            None => {
+                return Err(loc.at(
+                    span,
+                    "sky.model",
+                    "a clear sky is brightest around the sun: give a [sun] (direction or place and time)",
+                ));
+            }
+        },
         Some((span, other)) => {
             let other = radiosity_core::escape_controls(other);
             return Err(loc.at(
                 span,
                 "sky.model",
-                format!("unknown sky model '{other}' (cie-overcast or uniform)"),
+                format!("unknown sky model '{other}' (cie-overcast, cie-clear or uniform)"),
             ));
         }
     };
@@ -564,7 +583,7 @@ pub(crate) fn lighting(
         grids.push(Grid { name, origin, u, v, divisions, normal, height });
     }
     let sun = desc.sun.as_ref().map(|d| sun(loc, d, unit, up)).transpose()?;
-    let sky = desc.sky.as_ref().map(|d| sky(loc, d, unit, file_up)).transpose()?;
+    let sky = desc.sky.as_ref().map(|d| sky(loc, d, unit, file_up, sun.as_ref())).transpose()?;
     Ok(Lighting { units, luminaires, grids, sun, sky })
 }
 
