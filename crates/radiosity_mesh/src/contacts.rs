@@ -40,6 +40,14 @@ pub(crate) struct PolygonId {
 /// those are meshed whole, as without contacts.
 const MAX_FOOTPRINT_CORNERS: usize = 8;
 
+/// A solid set into a surface by at most this share of its height above it stands on it: its
+/// footprint is where its faces cross the surface. Exported models often sink doors, table
+/// legs and cupboards a centimetre into the floor so that no crack shows; their footprints
+/// went unfound, the floor ran on under them, and a floor element under a door took the
+/// light of the lit room on one side and gave it to the dark room on the other (Bitterli's
+/// *Veach, Ajar*). A box sunk a third of its height is another case (it passes through).
+const SHALLOW_SINK: f64 = 0.05;
+
 /// Most polygon pairs looked at while finding contacts (bounding boxes first): a model of
 /// many large faces would otherwise cost targets × faces. Past it, surfaces are meshed uncut.
 const PAIR_BUDGET: u64 = 200_000_000;
@@ -444,8 +452,18 @@ impl<'a> Contacts<'a> {
             }
             let pv = p.vertices();
             let heights: Vec<f64> = pv.iter().map(|&q| height(q)).collect();
-            // Standing on the plane: nothing below it, something above it.
-            if heights.iter().any(|&h| h < -eps) || heights.iter().all(|&h| h <= eps) {
+            let (below, above) = heights.iter().fold((0.0_f64, 0.0_f64), |(b, a), &h| (b.min(h), a.max(h)));
+            if above <= eps {
+                continue;
+            }
+            if below < -eps {
+                // Set a little into the surface: its line across the plane is its edge on it.
+                if -below <= SHALLOW_SINK * above
+                    && let Some((a, b)) = crossing(pv, &heights, n, eps)
+                {
+                    let centre = pv.iter().copied().sum::<DVec3>() / pv.len() as f64;
+                    edges.push((a, b, p.normal(), centre));
+                }
                 continue;
             }
             for i in 0..pv.len() {
@@ -499,6 +517,33 @@ impl<'a> Contacts<'a> {
             };
         }
         first.is_some_and(|(_, from_behind)| from_behind)
+    }
+}
+
+/// Where a convex face of corners `pv` at `heights` above a plane of unit normal `n` crosses
+/// it: the two points, in the face's order, projected onto the plane; `None` unless exactly
+/// two. A crossing on an edge is computed from its corners in a fixed order, so that the two
+/// faces sharing the edge find the same point bit for bit and their segments chain.
+fn crossing(pv: &[DVec3], heights: &[f64], n: DVec3, eps: f64) -> Option<(DVec3, DVec3)> {
+    let mut points = Vec::with_capacity(2);
+    for i in 0..pv.len() {
+        let j = (i + 1) % pv.len();
+        let (hi, hj) = (heights[i], heights[j]);
+        if hi.abs() <= eps {
+            points.push(pv[i] - n * hi);
+        } else if hj.abs() > eps && (hi < 0.0) != (hj < 0.0) {
+            let ((a, ha), (b, hb)) = if lexicographic(pv[i], pv[j]).is_lt() {
+                ((pv[i], hi), (pv[j], hj))
+            } else {
+                ((pv[j], hj), (pv[i], hi))
+            };
+            let q = a + (b - a) * (ha / (ha - hb));
+            points.push(q - n * n.dot(q - a + n * ha));
+        }
+    }
+    match points[..] {
+        [a, b] if a != b => Some((a, b)),
+        _ => None,
     }
 }
 

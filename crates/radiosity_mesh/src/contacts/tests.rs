@@ -80,7 +80,7 @@ fn hidden_under(block: Vec<Polygon>) -> Option<f64> {
 }
 
 /// A box floating above the floor, or one sunk through it, or open at the bottom in a way
-/// that leaves no closed outline: nothing is cut.
+/// that leaves no closed outline: nothing is cut. One set a little into the floor cuts.
 #[test]
 fn only_solids_standing_on_the_surface_cut_it() {
     let floating =
@@ -89,6 +89,12 @@ fn only_solids_standing_on_the_surface_cut_it() {
     let sunk =
         box_faces(DVec3::new(1.0, -0.5, 1.0), DVec3::new(2.0, 1.0, 2.0), Facing::Outward, 0.0).unwrap();
     assert_eq!(hidden_under(sunk), None);
+    // Set a centimetre into the floor, as exported doors and table legs are, turned so that
+    // no edge lies along an axis: it stands on its footprint where its sides cross the floor.
+    let set_in =
+        box_faces(DVec3::new(1.0, -0.01, 1.0), DVec3::new(2.0, 1.0, 2.0), Facing::Outward, 20.0).unwrap();
+    let hidden = hidden_under(set_in).expect("the floor cut around it");
+    assert!((hidden - 1.0).abs() < 1e-9, "hidden {hidden}");
     // Three sides of a box: the outline does not close.
     let mut open =
         box_faces(DVec3::new(1.0, 0.0, 1.0), DVec3::new(2.0, 1.0, 2.0), Facing::Outward, 0.0).unwrap();
