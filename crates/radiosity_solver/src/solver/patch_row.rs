@@ -282,14 +282,24 @@ fn receive_shared(shot: &Shot, plans: &[PatchPlan], element_area: &[f64], factor
             let seen = trace(shot, plan_of(e), e, Rays::Pilot);
             (seen.visible, seen.traced)
         });
+    // Members of a unit whose rays disagree trace their own.
+    let own = std::sync::atomic::AtomicU64::new(0);
     for_each_maybe_parallel(factors, |e, r| {
         if let Some((u, k)) = sharing.member(clusters, e) {
             let f = received[u].factors[k];
             (r.unoccluded, r.unweighted) = (f, f);
-            (r.visible, r.traced) = if f > 0.0 { received[u].seen } else { (0, 0) };
+            (r.visible, r.traced) = if f <= 0.0 {
+                (0, 0)
+            } else if received[u].mixed() {
+                let seen = trace(shot, plan_of(e), e, Rays::Pilot);
+                own.fetch_add(u64::from(seen.traced), std::sync::atomic::Ordering::Relaxed);
+                (seen.visible, seen.traced)
+            } else {
+                received[u].seen
+            };
         }
     });
-    rays
+    rays + own.into_inner()
 }
 
 /// The row of the live patches' factors (those that receive anything), and the rays traced

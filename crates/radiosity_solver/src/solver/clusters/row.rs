@@ -89,12 +89,25 @@ impl Clusters {
                 },
             );
             traced += rays;
+            // Members of a unit whose rays disagree trace their own (see `Shared::mixed`).
+            let own = AtomicU64::new(0);
             for_each_maybe_parallel(factors, |e, out| {
                 if let Some((u, k)) = sharing.member(self, e) {
                     let r = &received[u];
-                    *out = (r.factors[k] * r.visibility()) as f32;
+                    *out = if r.mixed() && r.factors[k] > 0.0 {
+                        let el = &mesh.elements[e];
+                        let mut scratch = [0.0; POINTS];
+                        let p = tables.vertex_means[e];
+                        let (f, shares) = unoccluded(group, frozen, p, el.normal, el.patch, &mut scratch);
+                        let (visible, n) = aim.trace(e, f, shares);
+                        own.fetch_add(u64::from(n), Ordering::Relaxed);
+                        if n == 0 { f as f32 } else { (f * f64::from(visible) / f64::from(n)) as f32 }
+                    } else {
+                        (r.factors[k] * r.visibility()) as f32
+                    };
                 }
             });
+            traced += own.into_inner();
         }
         let factors: &[f32] = factors;
         let (row, _) = Row::by_blocks(tables, |q, row| {
