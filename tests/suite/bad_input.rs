@@ -240,6 +240,44 @@ fn picture_headers_are_checked_before_allocating() {
         assert_input_error(&o, name, &[name]);
     }
     assert!(!out.exists());
+    // An OpenEXR header declaring 4096 × 4096 pixels (within the pixel limit) and then no
+    // data: refused by its size against the file's before a pixel is allocated.
+    let path = dir.path().join("hollow.exr");
+    std::fs::write(&path, exr_header(4096, 4096)).unwrap();
+    let o = run(&["tonemap", path.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert_input_error(&o, "hollow.exr", &["hollow.exr", "4096×4096", "bytes can hold"]);
+    assert!(!out.exists());
+}
+
+/// A scan-line OpenEXR header (RGB half floats, no compression) of a `width` × `height`
+/// picture, and no pixel data.
+fn exr_header(width: i32, height: i32) -> Vec<u8> {
+    let mut b = vec![0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0];
+    let mut attribute = |name: &str, kind: &str, value: &[u8]| {
+        for text in [name, kind] {
+            b.extend_from_slice(text.as_bytes());
+            b.push(0);
+        }
+        b.extend_from_slice(&(value.len() as i32).to_le_bytes());
+        b.extend_from_slice(value);
+    };
+    let mut channels = Vec::new();
+    for c in ["B", "G", "R"] {
+        channels.extend_from_slice(c.as_bytes());
+        channels.extend_from_slice(&[0, 1, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0]);
+    }
+    channels.push(0);
+    let window: Vec<u8> = [0, 0, width - 1, height - 1].iter().flat_map(|v: &i32| v.to_le_bytes()).collect();
+    attribute("channels", "chlist", &channels);
+    attribute("compression", "compression", &[0]);
+    attribute("dataWindow", "box2i", &window);
+    attribute("displayWindow", "box2i", &window);
+    attribute("lineOrder", "lineOrder", &[0]);
+    attribute("pixelAspectRatio", "float", &1f32.to_le_bytes());
+    attribute("screenWindowCenter", "v2f", &[0; 8]);
+    attribute("screenWindowWidth", "float", &1f32.to_le_bytes());
+    b.push(0);
+    b
 }
 
 /// A polygon of `n` corners on the unit circle, as a scene file's `vertices`.

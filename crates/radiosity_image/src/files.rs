@@ -79,6 +79,22 @@ pub enum ImageFileError {
         /// Declared height.
         height: u64,
     },
+    /// A header declares more pixels than the file's bytes could hold at any compression.
+    #[error(
+        "{path}: the header declares a {width}×{height} picture, more than its {bytes} bytes can hold \
+         (at least one byte per {} pixels)",
+        EXR_MOST_PIXELS_PER_BYTE
+    )]
+    Truncated {
+        /// The file.
+        path: PathBuf,
+        /// Declared width.
+        width: u64,
+        /// Declared height.
+        height: u64,
+        /// The file's size.
+        bytes: u64,
+    },
     /// The path is a folder, a FIFO or a device, not a regular file.
     #[error("{path}: not a regular file")]
     NotAFile {
@@ -114,6 +130,14 @@ pub const MAX_PICTURE_PIXELS: u64 = 1 << 26;
 
 /// Bytes of the largest picture file read: the largest PFM (12 bytes per pixel) and a header.
 const MAX_PICTURE_FILE_BYTES: u64 = MAX_PICTURE_PIXELS * 12 + 4096;
+
+/// Most pixels an OpenEXR file's byte may stand for. Deflate compresses at most about
+/// 1 032 : 1 and the leanest pixel is one half-float channel (2 bytes), so even a flat picture
+/// needs a byte per 516 pixels; RLE, PIZ and B44 compress less. A header declaring more than
+/// this many per byte of the file cannot be read whole: refused before its pixels are
+/// allocated (a 567-byte file declared a picture of 1.5 GB, which was allocated before the
+/// missing data was found).
+pub const EXR_MOST_PIXELS_PER_BYTE: u64 = 4096;
 
 fn check_size(path: &Path, width: u64, height: u64) -> Result<(), ImageFileError> {
     if width.saturating_mul(height) > MAX_PICTURE_PIXELS {
@@ -304,7 +328,12 @@ pub fn read_exr(path: &Path) -> Result<HdrImage, ImageFileError> {
     let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(&bytes), false).map_err(exr_err)?;
     for header in &meta.headers {
         let size = header.layer_size;
-        check_size(path, size.width() as u64, size.height() as u64)?;
+        let (width, height) = (size.width() as u64, size.height() as u64);
+        check_size(path, width, height)?;
+        let bytes = bytes.len() as u64;
+        if width.saturating_mul(height) > bytes.saturating_mul(EXR_MOST_PIXELS_PER_BYTE) {
+            return Err(ImageFileError::Truncated { path: path.to_owned(), width, height, bytes });
+        }
     }
     let img = exr::prelude::read()
         .no_deep_data()
