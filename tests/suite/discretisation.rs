@@ -288,3 +288,57 @@ fn corner_strips_see_the_part_of_the_wall_beside_them() {
         );
     }
 }
+
+/// A receiver as large as its gap to a lamp weighs its visibility by the form factor's
+/// kernel, not by the lamp's area: a 20 cm grey plate 8 mm under a black mask with a hole of
+/// its size, the 1 × 1 m lamp 2 mm above the mask, one patch. The plate sees the lamp only
+/// through the hole, a twenty-fifth of the lamp's area but nearly all of its own hemisphere:
+/// B = ρ M F with F the plate's view factor to the hole (Howell C-11, 0.9253). Ends spread
+/// over the lamp and counted ray by ray gave it 6–9 % of that (seeds 1–3); rays drawn by
+/// solid angle from the plate give −0.5 … +0.7 % over those seeds, with 16 elements of 5 cm
+/// and their rays (bound: 3 %, a few standard errors of 16 elements' binomial visibility).
+#[test]
+fn a_plate_under_a_hole_sees_the_lamp_through_it() {
+    use crate::photometry::load;
+    use crate::sky::{mean_radiosity, opposed_rectangles, solved};
+    let text = r#"
+[[material]]
+name = "lamp"
+reflectance = [0, 0, 0]
+emission = [1, 1, 1]
+[[material]]
+name = "black"
+reflectance = [0, 0, 0]
+[[material]]
+name = "grey"
+reflectance = [0.5, 0.5, 0.5]
+[[object]]
+name = "lamp"
+type = "polygon"
+material = "lamp"
+vertices = [[-0.5, 0.01, -0.5], [0.5, 0.01, -0.5], [0.5, 0.01, 0.5], [-0.5, 0.01, 0.5]]
+[[object]]
+name = "mask"
+type = "polygons"
+material = "black"
+faces = [
+  [[-0.6, 0.008, -0.6], [-0.6, 0.008, 0.6], [-0.1, 0.008, 0.6], [-0.1, 0.008, -0.6]],
+  [[0.1, 0.008, -0.6], [0.1, 0.008, 0.6], [0.6, 0.008, 0.6], [0.6, 0.008, -0.6]],
+  [[-0.1, 0.008, -0.6], [-0.1, 0.008, -0.1], [0.1, 0.008, -0.1], [0.1, 0.008, -0.6]],
+  [[-0.1, 0.008, 0.1], [-0.1, 0.008, 0.6], [0.1, 0.008, 0.6], [0.1, 0.008, 0.1]],
+]
+[[object]]
+name = "plate"
+type = "polygon"
+material = "grey"
+vertices = [[-0.1, 0, -0.1], [-0.1, 0, 0.1], [0.1, 0, 0.1], [0.1, 0, -0.1]]
+[mesh]
+patch_size = 1.5
+element_size = 0.05
+"#;
+    let (_dir, scene) = load(text, &[]);
+    let expected = 0.5 * opposed_rectangles(0.2, 0.2, 0.008);
+    let b = mean_radiosity(&solved(&scene), "plate");
+    eprintln!("plate under a hole: {b:.5} against {expected:.5} ({:+.2} %)", (b / expected - 1.0) * 100.0);
+    assert!((b / expected - 1.0).abs() < 0.03, "plate {b} against {expected}");
+}

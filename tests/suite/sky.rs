@@ -57,7 +57,7 @@ element_size = 0.05
 }
 
 /// `scene` solved with the default parameters.
-fn solved(scene: &Scene) -> Solver {
+pub(crate) fn solved(scene: &Scene) -> Solver {
     let mut solver =
         Problem::new(scene, &scene.mesh_params()).unwrap().solver(SolverParams::default()).unwrap();
     solver.solve();
@@ -65,7 +65,7 @@ fn solved(scene: &Scene) -> Solver {
 }
 
 /// The area-weighted mean radiosity (green) of object `name` in a solve.
-fn mean_radiosity(solver: &Solver, name: &str) -> f64 {
+pub(crate) fn mean_radiosity(solver: &Solver, name: &str) -> f64 {
     let mesh = solver.mesh().clone();
     let radiosity = solver.solution().element_radiosity;
     let (mut power, mut area) = (0.0, 0.0);
@@ -78,7 +78,7 @@ fn mean_radiosity(solver: &Solver, name: &str) -> f64 {
 
 /// View factor between two directly opposed parallel rectangles a × b at distance c
 /// (Howell's catalogue, C-11).
-fn opposed_rectangles(a: f64, b: f64, c: f64) -> f64 {
+pub(crate) fn opposed_rectangles(a: f64, b: f64, c: f64) -> f64 {
     let (x, y) = (a / c, b / c);
     let (x2, y2) = (x * x, y * y);
     2.0 / (PI * x * y)

@@ -116,6 +116,16 @@ pub(super) fn draw(
     mut ray: impl FnMut(Vec3, Vec3, f32),
 ) {
     let (seed, key) = (shot.params.seed, e as u64);
+    if by_solid_angle(shot, e) {
+        let (count, mut rng) = match rays {
+            Rays::Pilot => (shot.pilot_for(e).count(), Rng::for_task(seed, shot.stream, key)),
+            Rays::Penumbra => {
+                (shot.penumbra.count(), Rng::for_task(seed, shot.stream, key | PENUMBRA_STREAM))
+            }
+        };
+        draw_by_solid_angle(shot, e, count, &mut rng, |from, to| ray(from, to, 1.0));
+        return;
+    }
     let near = near_ends(shot, e);
     let ends = Ends { shot, near: near.as_ref() };
     let (n, ns) = (shot.mesh.elements[e].normal.as_vec3(), shot.shooter.normal.as_vec3());
@@ -140,6 +150,79 @@ pub(super) fn draw(
         }
     }
 }
+
+/// Whether element `e` draws its rays by solid angle from its own points
+/// ([`draw_by_solid_angle`]): it is [`near`] an even shooter and large beside its distance
+/// to it, where neither the kernel's ends nor its weights can stand for the whole element.
+fn by_solid_angle(shot: &Shot, e: usize) -> bool {
+    if shot.uneven.is_some() || !near(shot, e) {
+        return false;
+    }
+    let distance = distance_to_polygon(shot.vertex_means[e], shot.shooter.normal, shot.shooter.corners());
+    shot.element_radii[e] > SMALL * distance
+}
+
+/// Draws `count` rays of element `e` by the projected solid angle: a uniform point of the
+/// element, a cosine-distributed direction from it (stratified), kept where it meets the
+/// shooter's front (redrawn up to [`SOLID_ANGLE_REDRAWS`] times, else given up). The share
+/// of such rays that are unblocked is the visibility weighted by the form factor kernel over
+/// the whole element, Σ V cos θ cos θ' / r² dA dA' over Σ cos θ cos θ' / r² dA dA' (the
+/// cosine-weighted hemisphere is the kernel's own measure: Cohen & Wallace §4.9.2), which the
+/// form factor without visibility multiplies.
+///
+/// For an element as large as its distance to the shooter the kernel varies by orders of
+/// magnitude over the pair: ends spread by the shooter's area, counted ray by ray, measure
+/// the shooter's *area* that each point sees. A lamp panel through a shallow ceiling fitting
+/// lights the fitting's inside from 3 mm away: the points there see the panel's part within
+/// the fitting, a seventh of its area and nearly all of their hemisphere, and they received
+/// 3 % of their light (the panel's row lost 6 % of its power).
+fn draw_by_solid_angle(shot: &Shot, e: usize, count: u32, rng: &mut Rng, mut ray: impl FnMut(Vec3, Vec3)) {
+    let Shot { mesh, shooter, offset, .. } = *shot;
+    let el = &mesh.elements[e];
+    let pts = corners_of(mesh, e);
+    let receiver = &pts[..el.vertex_count as usize];
+    let corners = shooter.corners();
+    let (sn, c0) = (shooter.normal, corners[0]);
+    // The winding of the shooter's corners about its normal, for the inside test.
+    let winding: f64 = (1..corners.len() - 1)
+        .map(|k| sn.dot((corners[k] - c0).cross(corners[k + 1] - c0)))
+        .sum::<f64>()
+        .signum();
+    let inside = |p: DVec3| {
+        (0..corners.len()).all(|k| {
+            let (a, b) = (corners[k], corners[(k + 1) % corners.len()]);
+            winding * sn.dot((b - a).cross(p - a)) >= 0.0
+        })
+    };
+    let (t, b) = el.normal.any_orthonormal_pair();
+    let mut strata = Strata::new(count);
+    for _ in 0..count {
+        let stratum = strata.next();
+        for _ in 0..SOLID_ANGLE_REDRAWS {
+            let x = point_on(receiver, rng.next_f64(), rng.next_f64());
+            let height = sn.dot(x - c0);
+            if height <= 0.0 {
+                continue;
+            }
+            let (u, v) = strata.jitter(stratum, rng);
+            let (r, phi) = (f64::from(u).sqrt(), std::f64::consts::TAU * f64::from(v));
+            let d =
+                t * (r * phi.cos()) + b * (r * phi.sin()) + el.normal * (1.0 - f64::from(u)).max(0.0).sqrt();
+            let towards = -sn.dot(d);
+            if towards <= 0.0 {
+                continue;
+            }
+            let p = x + d * (height / towards);
+            if inside(p) {
+                ray((x + el.normal * offset).as_vec3(), (p + sn * offset).as_vec3());
+                break;
+            }
+        }
+    }
+}
+
+/// Tries per ray of [`draw_by_solid_angle`] at a direction that meets the shooter.
+const SOLID_ANGLE_REDRAWS: u32 = 32;
 
 /// Whether element `e`'s rays to the shooter weigh by the kernel (see [`draw`]). Not when it
 /// is [`near`] the shooter: its ends follow the kernel already, or it is as large as its
