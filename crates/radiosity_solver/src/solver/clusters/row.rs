@@ -67,6 +67,16 @@ impl Clusters {
         });
         let mut traced = traced.into_inner();
         if sharing.any() {
+            // A member's own unoccluded factor and its rays: what a unit's chosen members
+            // trace for it, and every member of a unit whose rays disagree.
+            let own_rays = |e: usize| {
+                let el = &mesh.elements[e];
+                let mut scratch = [0.0; POINTS];
+                let p = tables.vertex_means[e];
+                let (f, shares) = unoccluded(group, frozen, p, el.normal, el.patch, &mut scratch);
+                let (visible, n) = aim.trace(e, f, shares);
+                (f, visible, n)
+            };
             let (received, rays) = sharing.receive(
                 self,
                 &tables.element_area,
@@ -81,11 +91,8 @@ impl Clusters {
                         .collect()
                 },
                 |e| {
-                    let el = &mesh.elements[e];
-                    let mut scratch = [0.0; POINTS];
-                    let p = tables.vertex_means[e];
-                    let (f, shares) = unoccluded(group, frozen, p, el.normal, el.patch, &mut scratch);
-                    aim.trace(e, f, shares)
+                    let (_, visible, n) = own_rays(e);
+                    (visible, n)
                 },
             );
             traced += rays;
@@ -95,11 +102,7 @@ impl Clusters {
                 if let Some((u, k)) = sharing.member(self, e) {
                     let r = &received[u];
                     *out = if r.mixed() && r.factors[k] > 0.0 {
-                        let el = &mesh.elements[e];
-                        let mut scratch = [0.0; POINTS];
-                        let p = tables.vertex_means[e];
-                        let (f, shares) = unoccluded(group, frozen, p, el.normal, el.patch, &mut scratch);
-                        let (visible, n) = aim.trace(e, f, shares);
+                        let (f, visible, n) = own_rays(e);
                         own.fetch_add(u64::from(n), Ordering::Relaxed);
                         if n == 0 { f as f32 } else { (f * f64::from(visible) / f64::from(n)) as f32 }
                     } else {
