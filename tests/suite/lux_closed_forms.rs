@@ -11,7 +11,7 @@ use radiosity_image::{GridParams, Renderer, grid_illuminance};
 use radiosity_mesh::Mesh;
 use radiosity_solver::{Problem, SolverParams};
 
-use crate::photometry::{grids_of, ies, load};
+use crate::photometry::{grids_of, ies, load, over_black_plane_with};
 
 /// Illuminance (lx) of every element from its radiosity, E = B / ρ (scenes in metres).
 fn element_lux(mesh: &Mesh, radiosity: &[radiosity_core::Rgb]) -> Vec<f64> {
@@ -322,41 +322,11 @@ fn a_luminous_opening_lights_like_a_lambertian_rectangle() {
     // IES: width (along C90) then length (along C0), metres.
     let file = ies(&gammas, &candela).replace("1 1 2 0 0 0\n", &format!("1 1 2 {width} {length} 0\n"));
     let scene = |near: bool| {
-        let text = format!(
-            r#"
-units = "m"
-[[material]]
-name = "black"
-reflectance = [0, 0, 0]
-[[object]]
-name = "floor"
-type = "polygon"
-vertices = [[-20, 0, -20], [-20, 0, 20], [20, 0, 20], [20, 0, -20]]
-material = "black"
-[[luminaire]]
-file = "lambert.ies"
-position = [0, {h}, 0]
-near_field = {near}
-[[grid]]
-name = "under"
-origin = [-0.9, 0, -0.6]
-u = [1.8, 0, 0]
-v = [0, 0, 1.2]
-divisions = [6, 4]
-height = 0.0001
-[[grid]]
-name = "far"
-origin = [9.5, 0, -0.5]
-u = [1, 0, 0]
-v = [0, 0, 1]
-divisions = [2, 2]
-height = 0.0001
-[mesh]
-patch_size = 10
-element_size = 5
-adaptive_levels = 0
-"#
-        );
+        let grids = "[[grid]]\nname = \"under\"\norigin = [-0.9, 0, -0.6]\nu = [1.8, 0, 0]\n\
+                     v = [0, 0, 1.2]\ndivisions = [6, 4]\nheight = 0.0001\n\
+                     [[grid]]\nname = \"far\"\norigin = [9.5, 0, -0.5]\nu = [1, 0, 0]\n\
+                     v = [0, 0, 1]\ndivisions = [2, 2]\nheight = 0.0001\n";
+        let text = over_black_plane_with("lambert.ies", h, &format!("near_field = {near}"), grids);
         load(&text, &[("lambert.ies", file.clone())])
     };
     let (_dir, near) = scene(true);

@@ -40,6 +40,15 @@ pub(crate) fn load(scene: &str, files: &[(&str, String)]) -> (tempfile::TempDir,
 /// A black floor 40 × 40 m (so nothing reflects), a luminaire `h` above its centre, and a
 /// 9 × 9 grid of 8 × 8 m on it.
 fn over_black_plane(file: &str, h: f64) -> String {
+    let grid = "[[grid]]\nname = \"floor\"\norigin = [-4, 0, -4]\nu = [8, 0, 0]\nv = [0, 0, 8]\n\
+                divisions = [9, 9]\nheight = 0.0001\n";
+    over_black_plane_with(file, h, "", grid)
+}
+
+/// A black 40 × 40 m floor, the luminaire of `file` at height `h` over its centre (with the
+/// `[[luminaire]]` keys of `luminaire`), the `grids` given and one element per 5 m: a scene
+/// where every lux is direct light.
+pub(crate) fn over_black_plane_with(file: &str, h: f64, luminaire: &str, grids: &str) -> String {
     format!(
         r#"
 units = "m"
@@ -54,13 +63,8 @@ material = "black"
 [[luminaire]]
 file = "{file}"
 position = [0, {h}, 0]
-[[grid]]
-name = "floor"
-origin = [-4, 0, -4]
-u = [8, 0, 0]
-v = [0, 0, 8]
-divisions = [9, 9]
-height = 0.0001
+{luminaire}
+{grids}
 [mesh]
 patch_size = 10
 element_size = 5
