@@ -38,12 +38,15 @@ failed=()
 for t in "${targets[@]}"; do
     mkdir -p "fuzz/corpus/$t"
     echo "== $t: ${seconds} s"
-    # -rss_limit_mb: an input that makes a run allocate past 2 GB is a finding (the bad-input
-    # aborts were allocations of gigabytes); -timeout: one input running 30 s is a hang. The
+    # -malloc_limit_mb: an input that makes a run allocate past 2 GB at once is a finding (the
+    # bad-input aborts were allocations of gigabytes); -rss_limit_mb is set apart from it and
+    # higher, since the sanitiser's own memory creeps up over an hour of runs (an OpenEXR run
+    # stopped at 2 GB of RSS with 29 MB live, its last input replaying at 7 MB); -timeout:
+    # one input running 30 s is a hang. The
     # targets run under AddressSanitizer, about ten times slower than a release build: a
     # Cornell box with one wall stretched meshes in 1.1 s released and took 13 s here.
     if ! cargo +nightly fuzz run "$t" "fuzz/corpus/$t" "fuzz/seeds/$t" -- \
-        -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=30 -max_len=1048576; then
+        -max_total_time="$seconds" -malloc_limit_mb=2048 -rss_limit_mb=4096 -timeout=30 -max_len=1048576; then
         failed+=("$t")
     fi
 done
