@@ -9,6 +9,7 @@
 #   libx11-6, libx11-xcb1, libxcursor1, libxrandr2, libxi6, libxkbcommon-x11-0
 #                          X11 client libraries winit opens at run time (dlopen)
 #   imagemagick            to inspect screenshots by hand (identify, compare)
+#   python3                scripts/real_rooms.py, run by tests/suite/rooms.rs
 #   nodejs, npm            (only when npm is missing) to install and run the glTF validator
 set -euo pipefail
 
@@ -18,6 +19,7 @@ packages=(
   libgl1-mesa-dri libegl1
   libx11-6 libx11-xcb1 libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0
   imagemagick
+  python3
 )
 
 missing=()

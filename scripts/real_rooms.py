@@ -49,7 +49,10 @@ How the lamp is placed (the ceiling is found from the OBJ's faces alone, y up, a
    ceiling (hanging lamps and shelves below the ceiling are passed over).
 3. The ceiling is the median of the rays' ceilings; the lamp is centred on the ray nearest
    the centre that found it, 1 cm below it, its long side along x.
-4. With no ceiling above the centre (an atrium open to the sky, such as Sponza's), the lamp
+4. A fitting hanging from the ceiling over the lamp's footprint (a recessed light, a shallow
+   fixture: every triangle of it within 10 cm under the ceiling) puts the lamp 1 cm under
+   the fitting's bottom instead, so that the panel does not cut through it.
+5. With no ceiling above the centre (an atrium open to the sky, such as Sponza's), the lamp
    goes 1 cm below the highest point of the model above the centre, with a warning.
 
 Scene units are guessed from the room's height (floor to ceiling): over 60 units it is taken
@@ -83,6 +86,9 @@ GRID = 5
 GRID_STEP_M = 0.25
 #: |n_y| above this counts as horizontal (about 18 degrees).
 HORIZONTAL = 0.95
+#: Fittings hanging at most this far under the ceiling (metres) over the lamp's footprint
+#: lower the lamp to LAMP_DROP_M under their bottom, so that it does not cut through them.
+FITTING_M = 0.1
 
 
 def load_obj(path):
@@ -210,7 +216,31 @@ def place_lamp(vertices, faces, args):
         "ceiling y = %g (%d of %d rays found one; floor y = %g, model top y = %g)"
         % (ceiling, len(found), GRID * GRID, floor, top)
     )
-    return x, ceiling - LAMP_DROP_M * unit, z, unit, notes
+    return x, clear_of_fittings(tris, x, z, ceiling, unit, notes), z, unit, notes
+
+
+def clear_of_fittings(tris, x, z, ceiling, unit, notes):
+    """The lamp's height: LAMP_DROP_M under the ceiling, or under the lowest fitting hanging
+    from it over the lamp's footprint (a triangle wholly within FITTING_M under the ceiling
+    whose xz bounds overlap the footprint): a panel laid through a recessed light or a
+    shallow fixture would light its inside from a fraction of a millimetre."""
+    half_x, half_z = LAMP_SIZE_M[0] * unit / 2, LAMP_SIZE_M[1] * unit / 2
+    y = ceiling - LAMP_DROP_M * unit
+    lowest = ceiling
+    for a, b, c, _ in tris:
+        ys = (a[1], b[1], c[1])
+        if max(ys) > ceiling or min(ys) < ceiling - FITTING_M * unit:
+            continue
+        if max(a[0], b[0], c[0]) < x - half_x or min(a[0], b[0], c[0]) > x + half_x:
+            continue
+        if max(a[2], b[2], c[2]) < z - half_z or min(a[2], b[2], c[2]) > z + half_z:
+            continue
+        if min(ys) < y + LAMP_DROP_M * unit / 2:
+            lowest = min(lowest, min(ys))
+    if lowest < ceiling:
+        y = lowest - LAMP_DROP_M * unit
+        notes.append("a fitting hangs to y = %g over the lamp's footprint: lamp lowered under it" % lowest)
+    return y
 
 
 def fmt(x):

@@ -72,3 +72,42 @@ fn a_furnished_rooms_power_adds_up() {
     let created = e["created_fraction"].as_f64().unwrap();
     assert!(created < 0.01, "{created} of the emitted power made ({e})");
 }
+
+/// `scripts/real_rooms.py` hangs its panel 1 cm under the ceiling, and under the bottom of a
+/// fitting there (a recessed light 2 cm deep over the room's centre) rather than through it:
+/// a panel laid through a fitting lit the fitting's inside from a fraction of a millimetre.
+/// Without the fitting, 1 cm under the ceiling as before.
+#[test]
+fn real_rooms_hangs_its_lamp_under_a_ceiling_fitting() {
+    let dir = tempfile::tempdir().unwrap();
+    let lamp_y = |fitting: bool| -> f64 {
+        // A 4 × 2.5 × 4 m room (floor up, ceiling down) and, over its centre, an open box
+        // 30 cm square hanging from 2.48 to the ceiling.
+        let mut obj = String::from(
+            "v -2 0 -2\nv 2 0 -2\nv 2 0 2\nv -2 0 2\nv -2 2.5 -2\nv 2 2.5 -2\nv 2 2.5 2\nv -2 2.5 2\n\
+             f 1 4 3 2\nf 5 6 7 8\n",
+        );
+        if fitting {
+            obj += "v -0.15 2.48 -0.15\nv 0.15 2.48 -0.15\nv 0.15 2.48 0.15\nv -0.15 2.48 0.15\n\
+                    v -0.15 2.5 -0.15\nv 0.15 2.5 -0.15\nv 0.15 2.5 0.15\nv -0.15 2.5 0.15\n\
+                    f 9 10 11 12\nf 9 13 14 10\nf 10 14 15 11\nf 11 15 16 12\nf 12 16 13 9\n";
+        }
+        let name = if fitting { "fitted" } else { "bare" };
+        let path = dir.path().join(format!("{name}.obj"));
+        std::fs::write(&path, obj).unwrap();
+        let out = Command::new("python3")
+            .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/real_rooms.py"))
+            .arg(&path)
+            .output()
+            .expect("python3 (setup.sh installs it)");
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let toml = std::fs::read_to_string(dir.path().join(format!("{name}.toml"))).unwrap();
+        // The lamp is the file's one polygon: its first corner's y.
+        let corners = toml.split("vertices = [[").nth(1).expect("the lamp's vertices");
+        corners.split(',').nth(1).unwrap().trim().parse().unwrap()
+    };
+    let bare = lamp_y(false);
+    assert!((bare - 2.49).abs() < 1e-9, "bare room: lamp at {bare}");
+    let fitted = lamp_y(true);
+    assert!((fitted - 2.47).abs() < 1e-9, "under the fitting: lamp at {fitted}");
+}
