@@ -13,7 +13,7 @@ use super::plans::PatchPlan;
 use super::ray_ends::{shooter_point, target_cell};
 use super::received::Seen;
 use super::shot::Shot;
-use crate::form_factor::distance_to_polygon;
+use crate::form_factor::{distance_to_polygon, point_to_polygon};
 use crate::sampling::{ONE_BELOW, Rng, Strata, four_units, point_on, point_on_f32};
 use crate::shaft::{FEW, Visibility, bounds};
 
@@ -153,17 +153,29 @@ pub(super) fn draw(
 
 /// Whether element `e` draws its rays by solid angle from its own points
 /// ([`draw_by_solid_angle`]): it is [`near`] an even shooter and large beside its distance
-/// to it, where neither the kernel's ends nor its weights can stand for the whole element.
+/// to it, where neither the kernel's ends nor its weights can stand for the whole element,
+/// and the shooter fills at least [`SOLID_ANGLE_LEAST_FACTOR`] of its centre's view, so
+/// that its directions meet the shooter often enough to be drawn by rejection.
 fn by_solid_angle(shot: &Shot, e: usize) -> bool {
     if shot.uneven.is_some() || !near(shot, e) {
         return false;
     }
-    let distance = distance_to_polygon(shot.vertex_means[e], shot.shooter.normal, shot.shooter.corners());
+    let (centre, corners) = (shot.vertex_means[e], shot.shooter.corners());
+    let distance = distance_to_polygon(centre, shot.shooter.normal, corners);
+    let in_front = shot.shooter.normal.dot(centre - corners[0]) > 0.0;
     shot.element_radii[e] > SMALL * distance
+        && in_front
+        && point_to_polygon(centre, shot.mesh.elements[e].normal, corners) >= SOLID_ANGLE_LEAST_FACTOR
 }
 
+/// The least form factor from an element's centre to the shooter for [`by_solid_angle`]: a
+/// direction meets the shooter with about that chance, so a ray finds it within
+/// [`SOLID_ANGLE_REDRAWS`] tries but 3 % of the time. Below it a receiver that saw none of
+/// the shooter in its tries would be taken as unblocked (as a pair that needs no ray is).
+const SOLID_ANGLE_LEAST_FACTOR: f64 = 0.1;
+
 /// Draws `count` rays of element `e` by the projected solid angle: a uniform point of the
-/// element, a cosine-distributed direction from it (stratified), kept where it meets the
+/// element, a cosine-distributed direction from it, kept where it meets the
 /// shooter's front (redrawn up to [`SOLID_ANGLE_REDRAWS`] times, else given up). The share
 /// of such rays that are unblocked is the visibility weighted by the form factor kernel over
 /// the whole element, Σ V cos θ cos θ' / r² dA dA' over Σ cos θ cos θ' / r² dA dA' (the
@@ -195,16 +207,17 @@ fn draw_by_solid_angle(shot: &Shot, e: usize, count: u32, rng: &mut Rng, mut ray
         })
     };
     let (t, b) = el.normal.any_orthonormal_pair();
-    let mut strata = Strata::new(count);
     for _ in 0..count {
-        let stratum = strata.next();
+        // Directions drawn afresh, not stratified: a stratum kept until one of its directions
+        // met the shooter would weigh alike strata that meet it always and ones that meet
+        // it rarely (a lamp shade's inside read 50 % bright so).
         for _ in 0..SOLID_ANGLE_REDRAWS {
             let x = point_on(receiver, rng.next_f64(), rng.next_f64());
             let height = sn.dot(x - c0);
             if height <= 0.0 {
                 continue;
             }
-            let (u, v) = strata.jitter(stratum, rng);
+            let (u, v) = rng.next_f32_pair();
             let (r, phi) = (f64::from(u).sqrt(), std::f64::consts::TAU * f64::from(v));
             let d =
                 t * (r * phi.cos()) + b * (r * phi.sin()) + el.normal * (1.0 - f64::from(u)).max(0.0).sqrt();
