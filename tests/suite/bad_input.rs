@@ -243,16 +243,29 @@ fn picture_headers_are_checked_before_allocating() {
     // An OpenEXR header declaring 4096 × 4096 pixels (within the pixel limit) and then no
     // data: refused by its size against the file's before a pixel is allocated.
     let path = dir.path().join("hollow.exr");
-    std::fs::write(&path, exr_header(4096, 4096)).unwrap();
+    std::fs::write(&path, exr_header(4096, 4096, None)).unwrap();
     let o = run(&["tonemap", path.to_str().unwrap(), "-o", out.to_str().unwrap()]);
     assert_input_error(&o, "hollow.exr", &["hollow.exr", "4096×4096", "bytes can hold"]);
     assert!(!out.exists());
+    // A 4 × 3 picture in tiles of 2²⁴ × 2²¹ pixels: the tile buffer is not allocated either
+    // (a fuzzer's 487-byte file of this kind took 1.9 GB).
+    let path = dir.path().join("tiles.exr");
+    std::fs::write(&path, exr_header(4, 3, Some((1 << 24, 1 << 21)))).unwrap();
+    let o = run(&["tonemap", path.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert_input_error(&o, "tiles.exr", &["tiles.exr", "tiles of 16777216×2097152", "bytes can"]);
+    assert!(!out.exists());
+    // The fuzzer's file itself, with its tile offsets and data.
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/bad/huge-tiles.exr");
+    let o = run(&["tonemap", path.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert_input_error(&o, "huge-tiles.exr", &["huge-tiles.exr", "tiles of 16777280×3604480"]);
+    assert!(!out.exists());
 }
 
-/// A scan-line OpenEXR header (RGB half floats, no compression) of a `width` × `height`
-/// picture, and no pixel data.
-fn exr_header(width: i32, height: i32) -> Vec<u8> {
-    let mut b = vec![0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0];
+/// An OpenEXR header (RGB half floats, no compression) of a `width` × `height` picture, in
+/// scan lines or in one level of `tiles` (width, height), and no pixel data.
+fn exr_header(width: i32, height: i32, tiles: Option<(u32, u32)>) -> Vec<u8> {
+    // Version 2; bit 9 of the version field marks a single-part tiled file.
+    let mut b = vec![0x76, 0x2f, 0x31, 0x01, 2, if tiles.is_some() { 2 } else { 0 }, 0, 0];
     let mut attribute = |name: &str, kind: &str, value: &[u8]| {
         for text in [name, kind] {
             b.extend_from_slice(text.as_bytes());
@@ -276,6 +289,11 @@ fn exr_header(width: i32, height: i32) -> Vec<u8> {
     attribute("pixelAspectRatio", "float", &1f32.to_le_bytes());
     attribute("screenWindowCenter", "v2f", &[0; 8]);
     attribute("screenWindowWidth", "float", &1f32.to_le_bytes());
+    if let Some((w, h)) = tiles {
+        let description: Vec<u8> =
+            [w.to_le_bytes(), h.to_le_bytes()].concat().into_iter().chain([0]).collect();
+        attribute("tiles", "tiledesc", &description);
+    }
     b.push(0);
     b
 }

@@ -95,6 +95,22 @@ pub enum ImageFileError {
         /// The file's size.
         bytes: u64,
     },
+    /// A tiled header declares tiles of more pixels than the file's bytes could hold.
+    #[error(
+        "{path}: the header declares tiles of {width}×{height} pixels, more than its {bytes} bytes can \
+         hold (at least one byte per {} pixels)",
+        EXR_MOST_PIXELS_PER_BYTE
+    )]
+    TilesTooLarge {
+        /// The file.
+        path: PathBuf,
+        /// Declared tile width.
+        width: u64,
+        /// Declared tile height.
+        height: u64,
+        /// The file's size.
+        bytes: u64,
+    },
     /// The path is a folder, a FIFO or a device, not a regular file.
     #[error("{path}: not a regular file")]
     NotAFile {
@@ -333,6 +349,19 @@ pub fn read_exr(path: &Path) -> Result<HdrImage, ImageFileError> {
         let bytes = bytes.len() as u64;
         if width.saturating_mul(height) > bytes.saturating_mul(EXR_MOST_PIXELS_PER_BYTE) {
             return Err(ImageFileError::Truncated { path: path.to_owned(), width, height, bytes });
+        }
+        // A tile is decoded into a buffer of its declared size, however small the picture:
+        // a 487-byte file of a 4 × 3 picture in tiles of 16 777 280 × 3 604 480 took 1.9 GB.
+        if let exr::meta::BlockDescription::Tiles(tiles) = header.blocks {
+            let (tw, th) = (tiles.tile_size.width() as u64, tiles.tile_size.height() as u64);
+            if tw.saturating_mul(th) > bytes.saturating_mul(EXR_MOST_PIXELS_PER_BYTE) {
+                return Err(ImageFileError::TilesTooLarge {
+                    path: path.to_owned(),
+                    width: tw,
+                    height: th,
+                    bytes,
+                });
+            }
         }
     }
     let img = exr::prelude::read()
