@@ -74,21 +74,23 @@ pub(super) fn near(shot: &Shot, e: usize) -> bool {
 /// this share of its centre's distance to the shooter.
 const SMALL: f64 = 0.5;
 
+/// Element `e`'s centre's distance to the shooter's polygon when it is [`near`], which both
+/// near-field choices ([`by_solid_angle`], [`near_ends`]) weigh its size against.
+fn near_distance(shot: &Shot, e: usize) -> Option<f64> {
+    near(shot, e)
+        .then(|| distance_to_polygon(shot.vertex_means[e], shot.shooter.normal, shot.shooter.corners()))
+}
+
 /// The kernel's table for element `e` (see [`NearEnds`]), or `None` when it is far from the
-/// shooter (or sees none of it).
-fn near_ends(shot: &Shot, e: usize) -> Option<NearEnds> {
-    if !near(shot, e) {
-        return None;
-    }
-    let centre = shot.vertex_means[e];
+/// shooter (`distance`, from [`near_distance`], is `None`) or sees none of it.
+fn near_ends(shot: &Shot, e: usize, distance: Option<f64>) -> Option<NearEnds> {
     // The kernel is taken at the centre, so it must stand for the whole element: not for
     // an element as large as its distance (a floor element along a wall's foot), whose
     // ends would crowd where its centre is nearest.
-    let distance = distance_to_polygon(centre, shot.shooter.normal, shot.shooter.corners());
-    if shot.element_radii[e] > SMALL * distance {
+    if shot.element_radii[e] > SMALL * distance? {
         return None;
     }
-    shot.near_runs.weigh(centre, shot.mesh.elements[e].normal, shot.shooter.normal)
+    shot.near_runs.weigh(shot.vertex_means[e], shot.mesh.elements[e].normal, shot.shooter.normal)
 }
 
 /// Draws element `e`'s `rays` to the shooter and hands each segment to `ray` with its
@@ -116,7 +118,8 @@ pub(super) fn draw(
     mut ray: impl FnMut(Vec3, Vec3, f32),
 ) {
     let (seed, key) = (shot.params.seed, e as u64);
-    if by_solid_angle(shot, e) {
+    let distance = near_distance(shot, e);
+    if by_solid_angle(shot, e, distance) {
         let (count, mut rng) = match rays {
             Rays::Pilot => (shot.pilot_for(e).count(), Rng::for_task(seed, shot.stream, key)),
             Rays::Penumbra => {
@@ -126,7 +129,7 @@ pub(super) fn draw(
         draw_by_solid_angle(shot, e, count, &mut rng, |from, to| ray(from, to, 1.0));
         return;
     }
-    let near = near_ends(shot, e);
+    let near = near_ends(shot, e, distance);
     let ends = Ends { shot, near: near.as_ref() };
     let (n, ns) = (shot.mesh.elements[e].normal.as_vec3(), shot.shooter.normal.as_vec3());
     let weighed = weighs_rays(shot, e);
@@ -153,15 +156,13 @@ pub(super) fn draw(
 
 /// Whether element `e` draws its rays by solid angle from its own points
 /// ([`draw_by_solid_angle`]): it is [`near`] an even shooter and large beside its distance
-/// to it, where neither the kernel's ends nor its weights can stand for the whole element,
-/// and the shooter fills at least [`SOLID_ANGLE_LEAST_FACTOR`] of its centre's view, so
-/// that its directions meet the shooter often enough to be drawn by rejection.
-fn by_solid_angle(shot: &Shot, e: usize) -> bool {
-    if shot.uneven.is_some() || !near(shot, e) {
-        return false;
-    }
+/// to it (`distance`, from [`near_distance`]), where neither the kernel's ends nor its
+/// weights can stand for the whole element, and the shooter fills at least
+/// [`SOLID_ANGLE_LEAST_FACTOR`] of its centre's view, so that its directions meet the
+/// shooter often enough to be drawn by rejection.
+fn by_solid_angle(shot: &Shot, e: usize, distance: Option<f64>) -> bool {
+    let Some(distance) = distance.filter(|_| shot.uneven.is_none()) else { return false };
     let (centre, corners) = (shot.vertex_means[e], shot.shooter.corners());
-    let distance = distance_to_polygon(centre, shot.shooter.normal, corners);
     let in_front = shot.shooter.normal.dot(centre - corners[0]) > 0.0;
     shot.element_radii[e] > SMALL * distance
         && in_front
