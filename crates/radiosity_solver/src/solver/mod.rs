@@ -106,9 +106,10 @@ pub struct Solver {
     tally: Tally,
     /// Shots, rays, time, stop.
     progress: Progress,
-    /// Per shooter (patches, then groups): whether it is enclosed (see [`enclosure`]),
-    /// once probed.
-    enclosed: Vec<Option<bool>>,
+    /// Per shooter (patches, then groups), once probed: the share of its power its shots
+    /// must deliver, 1 when it is enclosed; none for an emitter that sees out, whose rows are
+    /// taken as they are (see [`enclosure`]).
+    delivers: Vec<Option<Option<tally::Delivery>>>,
     /// The occluder triangles left out of `accel` (a room's walls, see
     /// `occluders::hull_triangles`), built with the sun's light or at the first probe.
     hull: Option<radiosity_accel::Bvh>,
@@ -184,7 +185,7 @@ impl Solver {
             scratch: ShotScratch::new(&mesh),
             tally,
             progress: Progress::new(mesh.patches.len()),
-            enclosed: vec![None; shooters],
+            delivers: vec![None; shooters],
             hull,
             probe_reach: {
                 let (lo, hi) = mesh.bounds();

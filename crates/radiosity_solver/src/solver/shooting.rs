@@ -12,7 +12,7 @@ use std::time::Instant;
 
 use super::Overshoot;
 use super::clusters::Shooter;
-use super::tally::Shooters;
+use super::tally::{Delivery, Shooters};
 use super::{Solver, StepBudget, StepReport};
 
 impl Solver {
@@ -72,18 +72,18 @@ impl Solver {
         // 3. Shoot ω ΔB_i through it (ω = 1 unless over-relaxing).
         let omega = self.params.overshoot.omega();
         let patch = key as u32;
-        let enclosed = self.encloses(shooter, key);
+        let delivers = self.delivers(shooter, key);
         let by = match shooter {
             Shooter::Patch(p) => Shooters {
                 patches: std::slice::from_ref(&patch),
                 area: self.mesh.patches[p].area,
                 near_reach: None,
-                enclosed,
+                delivers,
             },
             Shooter::Group(g) => {
                 let group = self.clusters.group(g);
                 let near_reach = Some((group.centre, self.clusters.near_reach(g)));
-                Shooters { patches: &group.patches, area: group.area, near_reach, enclosed }
+                Shooters { patches: &group.patches, area: group.area, near_reach, delivers }
             }
         };
         self.tally.shoot(&self.mesh, &self.tables, by, &row, omega, self.clusters.members());
@@ -123,33 +123,40 @@ impl Solver {
 }
 
 impl Solver {
-    /// Whether every probe ray from `shooter` (shooter index `key`) meets a surface (see
-    /// [`super::enclosure`]); probed once per shooter, the first time it shoots.
-    fn encloses(&mut self, shooter: Shooter, key: usize) -> bool {
-        if let Some(known) = self.enclosed[key] {
+    /// The share of `shooter`'s power (shooter index `key`) its shots must deliver (see
+    /// [`super::enclosure`]): all of it when every probe ray meets a surface; where some
+    /// leave, for a shooter that does not emit, what the probes do not see leave
+    /// ([`super::enclosure::escaping_share`]); none for an emitter that sees out, whose row
+    /// (drawn with many rays, and the largest shot of a solve) is taken as it is. Probed once
+    /// per shooter, the first time it shoots.
+    fn delivers(&mut self, shooter: Shooter, key: usize) -> Option<Delivery> {
+        if let Some(known) = self.delivers[key] {
             return known;
         }
         let mesh = &*self.mesh;
         let hull = self
             .hull
             .get_or_insert_with(|| radiosity_accel::Bvh::new(&crate::occluders::hull_triangles(mesh)));
-        let points: Vec<(glam::DVec3, glam::DVec3)> = match shooter {
+        let (points, emits): (Vec<(glam::DVec3, glam::DVec3)>, bool) = match shooter {
             Shooter::Patch(p) => {
                 let patch = &mesh.patches[p];
                 let inner = patch.corners().iter().map(|c| (patch.centre + *c) * 0.5);
-                std::iter::once(patch.centre).chain(inner).map(|x| (x, patch.normal)).collect()
+                let points = std::iter::once(patch.centre).chain(inner).map(|x| (x, patch.normal)).collect();
+                (points, super::clusters::patch_emits(mesh, p))
             }
-            Shooter::Group(g) => self.clusters.probe_points(g),
+            Shooter::Group(g) => (self.clusters.probe_points(g), self.clusters.group(g).emits),
         };
-        let known = super::enclosure::encloses(
-            &*self.accel,
-            hull,
-            &points,
-            self.probe_reach,
-            self.params.seed,
-            key as u64,
-        );
-        self.enclosed[key] = Some(known);
+        let (accel, reach, seed) = (&*self.accel, self.probe_reach, self.params.seed);
+        let known = if super::enclosure::encloses(accel, hull, &points, reach, seed, key as u64) {
+            Some(Delivery { share: 1.0, error: 0.0 })
+        } else if emits || points.is_empty() {
+            None
+        } else {
+            let (escaping, error) =
+                super::enclosure::escaping_share(accel, hull, &points, reach, seed, key as u64);
+            Some(Delivery { share: 1.0 - escaping, error })
+        };
+        self.delivers[key] = Some(known);
         known
     }
 }
