@@ -53,7 +53,8 @@ pub(super) fn encloses(
 /// Wallace §4.4), so the share of cosine-distributed rays that meet nothing is the share of
 /// its light that leaves. At least [`SHARE_PROBES`] rays, more where a share p needs them
 /// for a standard error √(p(1 − p)/n) of [`SHARE_ERROR`], up to [`MAX_SHARE_PROBES`]; a
-/// share of 0.25 so takes 1 875 rays. Returns the share and its standard error.
+/// share of 0.25 so takes 1 920 rays (whole chunks of [`SHARE_CHUNK`]). Returns the share
+/// and its standard error.
 pub(super) fn escaping_share(
     accel: &dyn RayQuery,
     hull: &dyn RayQuery,
@@ -62,15 +63,30 @@ pub(super) fn escaping_share(
     seed: u64,
     key: u64,
 ) -> (f64, f64) {
-    let mut rng = Rng::for_task(seed, SHARE_STREAM, key);
-    let first = escaping(accel, hull, points, reach, &mut rng, SHARE_PROBES);
+    // Chunks of rays with streams of their own, traced in parallel: a count is the same
+    // whatever thread traced which chunk.
+    let count = |chunks: std::ops::Range<usize>| -> usize {
+        use rayon::prelude::*;
+        chunks
+            .into_par_iter()
+            .map(|c| {
+                let rng = Rng::for_task(seed, SHARE_STREAM ^ key, c as u64);
+                escaping(accel, hull, points, reach, rng, SHARE_CHUNK)
+            })
+            .sum()
+    };
+    let first_chunks = SHARE_PROBES / SHARE_CHUNK;
+    let first = count(0..first_chunks);
     let p = first as f64 / SHARE_PROBES as f64;
     let wanted = (p * (1.0 - p) / (SHARE_ERROR * SHARE_ERROR)).ceil() as usize;
-    let n = wanted.clamp(SHARE_PROBES, MAX_SHARE_PROBES);
-    let more = escaping(accel, hull, points, reach, &mut rng, n - SHARE_PROBES);
-    let p = (first + more) as f64 / n as f64;
+    let chunks = wanted.clamp(SHARE_PROBES, MAX_SHARE_PROBES).div_ceil(SHARE_CHUNK);
+    let n = chunks * SHARE_CHUNK;
+    let p = (first + count(first_chunks..chunks)) as f64 / n as f64;
     (p, (p * (1.0 - p) / n as f64).sqrt())
 }
+
+/// Probe rays of one random stream of [`escaping_share`], traced as one task.
+const SHARE_CHUNK: usize = 128;
 
 /// Probe rays of [`escaping_share`] before it judges how many it needs.
 const SHARE_PROBES: usize = 512;
