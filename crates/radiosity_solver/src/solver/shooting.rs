@@ -12,6 +12,7 @@ use std::time::Instant;
 
 use super::Overshoot;
 use super::clusters::Shooter;
+use super::enclosure::Probes;
 use super::tally::{Delivery, Shooters};
 use super::{Solver, StepBudget, StepReport};
 
@@ -146,14 +147,13 @@ impl Solver {
             }
             Shooter::Group(g) => (self.clusters.probe_points(g), self.clusters.group(g).emits),
         };
-        let (accel, reach, seed) = (&*self.accel, self.probe_reach, self.params.seed);
-        let known = if super::enclosure::encloses(accel, hull, &points, reach, seed, key as u64) {
+        let probes = Probes { accel: &*self.accel, hull, reach: self.probe_reach, seed: self.params.seed };
+        let known = if probes.encloses(&points, key as u64) {
             Some(Delivery { share: 1.0, error: 0.0 })
         } else if emits || points.is_empty() {
             None
         } else {
-            let (escaping, error) =
-                super::enclosure::escaping_share(accel, hull, &points, reach, seed, key as u64);
+            let (escaping, error) = probes.escaping_share(&points, key as u64);
             Some(Delivery { share: 1.0 - escaping, error })
         };
         self.delivers[key] = Some(known);
