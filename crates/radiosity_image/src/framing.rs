@@ -14,6 +14,7 @@
 
 use glam::DVec3;
 
+use radiosity_accel::{Bvh, RayQuery};
 use radiosity_core::{Camera, CameraRays, Facing, Polygon, Scene, Shape, Sides};
 
 /// Probe rays per candidate view, across and down (a 4:3 picture).
@@ -48,13 +49,16 @@ fn choose(scene: &Scene) -> Camera {
         candidates.push(Camera::fitting(lo, hi, d, up));
     }
     // From outside first: an open scene (a box without a front wall, a model on a plane) is
-    // shown as a whole from its open side whenever some side shows enough front faces (the
-    // backs of two-sided walls, seen from outside, are not enough: nothing lights them).
-    let best_outside = best_of(scene, candidates, false);
-    if best_outside.2 >= PROBE.0 * PROBE.1 / 4 {
+    // shown as a whole from its open side whenever half the probe rays of some side meet
+    // sides that see a light (the outsides of a room's walls are not such sides: nothing
+    // lights them, whichever way they are wound). A quarter let the Modern Hall be shown
+    // from outside, a little of its lit inside through its glass front in a black picture.
+    let lights = Lights::of(scene);
+    let best_outside = best_of(scene, &lights, candidates, false);
+    if best_outside.2 >= PROBE.0 * PROBE.1 / 2 {
         return best_outside.0;
     }
-    // A closed room shows only the backs of its walls from outside: look from inside, at
+    // A closed room shows only the unlit outsides of its walls: look from inside, at
     // mid-height, standing back from the middle towards one wall (as a photographer stands
     // to show a room), along each horizontal axis; the view that shows the most objects
     // wins (from the middle along +z, the generated furnished room showed a bare wall and
@@ -68,7 +72,7 @@ fn choose(scene: &Scene) -> Camera {
         let view = contents.and_then(|c| aim(c - from, d)).unwrap_or(d);
         Camera::try_new(from, from + view, DVec3::Y, INSIDE_FOV_DEG).ok()
     });
-    let best_inside = best_of(scene, inside.collect(), true);
+    let best_inside = best_of(scene, &lights, inside.collect(), true);
     if best_inside.1 > best_outside.1 { best_inside.0 } else { best_outside.0 }
 }
 
@@ -114,89 +118,258 @@ fn contents_centre(scene: &Scene, lo: DVec3, hi: DVec3) -> Option<DVec3> {
 /// What a probe ray meets first.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 enum Seen {
-    /// The front face of anything.
-    Front,
-    /// The back face of a two-sided object: lit if something lights it.
-    TwoSidedBack,
+    /// A side that takes part in the solve (the front of anything, either face of a
+    /// two-sided object) and sees a light directly; any such side when the scene's lights
+    /// give no point to look for (see [`Lights`]).
+    Lit,
+    /// A side that takes part in the solve but sees no light directly: lit, if at all, by
+    /// what the lights light. The outside of a room modelled with its normals out (as many
+    /// exported rooms are) is such a side, and nothing lights it.
+    Shaded,
     /// The back of a one-sided face: black.
     Back,
 }
 
-/// The candidate with the best score (a front face 2, a two-sided back face 1), its score
-/// and its front faces; ties keep the earlier one (the classic framing first). With
-/// `by_objects`, the number of objects whose lit sides the probe rays meet comes first.
-/// `candidates` must not be empty.
-fn best_of(scene: &Scene, candidates: Vec<Camera>, by_objects: bool) -> (Camera, usize, usize) {
+/// The candidate with the best score (a lit side 2, a shaded one 1), its score and its lit
+/// sides; ties keep the earlier one (the classic framing first). With `by_objects`, the
+/// number of objects whose solved sides the probe rays meet comes first. `candidates` must
+/// not be empty.
+fn best_of(
+    scene: &Scene,
+    lights: &Lights,
+    candidates: Vec<Camera>,
+    by_objects: bool,
+) -> (Camera, usize, usize) {
     let mut best = (candidates[0], 0usize, 0usize);
     let mut best_key = (0, 0);
     for camera in candidates {
-        let seen = probe_objects(scene, &camera);
-        let fronts = seen.iter().filter(|(s, _)| *s == Seen::Front).count();
-        let score = 2 * fronts + seen.iter().filter(|(s, _)| *s == Seen::TwoSidedBack).count();
+        let seen = probe_objects(scene, lights, &camera);
+        let lit = seen.iter().filter(|(s, _)| *s == Seen::Lit).count();
+        let score = 2 * lit + seen.iter().filter(|(s, _)| *s == Seen::Shaded).count();
         let mut objects: Vec<usize> =
             seen.iter().filter(|(s, _)| *s != Seen::Back).map(|&(_, o)| o).collect();
         objects.sort_unstable();
         objects.dedup();
         let key = (if by_objects { objects.len() } else { 0 }, score);
         if key > best_key {
-            (best, best_key) = ((camera, score, fronts), key);
+            (best, best_key) = ((camera, score, lit), key);
         }
     }
     best
 }
 
-/// The share of the probe rays through `camera` that first meet a lit side: a front face, or
-/// either face of a two-sided object.
+/// The share of the probe rays through `camera` that first meet a side that takes part in
+/// the solve: a front face, or either face of a two-sided object.
 fn lit_share(scene: &Scene, camera: &Camera) -> f64 {
-    probe(scene, camera).into_iter().filter(|&s| s != Seen::Back).count() as f64 / (PROBE.0 * PROBE.1) as f64
+    let solved = probe(scene, &Lights::none(), camera).into_iter().filter(|&s| s != Seen::Back).count();
+    solved as f64 / (PROBE.0 * PROBE.1) as f64
 }
 
 /// What each probe ray through `camera` meets first (rays that meet nothing are left out).
-fn probe(scene: &Scene, camera: &Camera) -> Vec<Seen> {
-    probe_objects(scene, camera).into_iter().map(|(seen, _)| seen).collect()
+fn probe(scene: &Scene, lights: &Lights, camera: &Camera) -> Vec<Seen> {
+    probe_objects(scene, lights, camera).into_iter().map(|(seen, _)| seen).collect()
 }
 
 /// [`probe`], with the object each ray meets.
-fn probe_objects(scene: &Scene, camera: &Camera) -> Vec<(Seen, usize)> {
+fn probe_objects(scene: &Scene, lights: &Lights, camera: &Camera) -> Vec<(Seen, usize)> {
     let rays = CameraRays::new(camera, PROBE.0 as u32, PROBE.1 as u32);
     (0..PROBE.1)
         .flat_map(|j| (0..PROBE.0).map(move |i| (i, j)))
         .filter_map(|(i, j)| {
             let dir = rays.direction(i as f64 + 0.5, j as f64 + 0.5);
-            first_hit(scene, camera.position, dir).map(|(_, seen, object)| (seen, object))
+            let (t, side, object) = first_hit(scene, camera.position, dir)?;
+            let seen = match side {
+                Side::Dark => Seen::Back,
+                Side::Solved(facing) if lights.light(camera.position + dir * t, facing) => Seen::Lit,
+                Side::Solved(_) => Seen::Shaded,
+            };
+            Some((seen, object))
         })
         .collect()
 }
 
-/// How many of the probe rays through `camera` first meet a lit side: a front face, or either
-/// face of a two-sided object.
+/// How many of the probe rays through `camera` first meet a side that takes part in the
+/// solve: a front face, or either face of a two-sided object.
 #[cfg(test)]
 pub(crate) fn front_faces_seen(scene: &Scene, camera: &Camera) -> usize {
-    probe(scene, camera).into_iter().filter(|&s| s != Seen::Back).count()
+    probe(scene, &Lights::none(), camera).into_iter().filter(|&s| s != Seen::Back).count()
+}
+
+/// Which face of a surface a ray meets.
+#[derive(Clone, Copy, PartialEq, Debug)]
+enum Side {
+    /// A face that takes part in the solve, with its unit normal (towards the ray's origin).
+    Solved(DVec3),
+    /// The back of a one-sided face.
+    Dark,
+}
+
+/// Emitter points (on the lit side of the emitting polygons and spheres, luminaires' light
+/// points) kept for the view probes, at most this many, spread over the emitters.
+const MAX_LIGHT_POINTS: usize = 16;
+
+/// Where the light comes from, to tell a side that sees a light from one that sees none.
+///
+/// Probing views by which face the rays meet alone was fooled by rooms modelled with their
+/// normals out and read two-sided (an OBJ's default): from outside, every side showed the
+/// room's front faces, lit by nothing, and Bitterli's *Veach Bidir* room was rendered
+/// black from behind a wall. A side counts as lit when a light point is in view of it
+/// (unblocked, in front of both), or the sun, or the sky straight above it.
+struct Lights {
+    /// Points just off the emitters' lit sides, each with that side's normal (`None`: a
+    /// luminaire, which may light every way).
+    points: Vec<(DVec3, Option<DVec3>)>,
+    /// Unit directions towards light at infinity: the sun, the zenith of a sky.
+    towards: Vec<DVec3>,
+    /// The scene's polygons, for the shadow rays; `None` when there is no light to find.
+    blockers: Option<Bvh>,
+    /// The scene's spheres, which the BVH of polygons leaves out.
+    spheres: Vec<radiosity_core::Sphere>,
+    /// How far off a surface a probe point stands, and light points off their emitter.
+    step: f64,
+    /// Past the scene: the length of a shadow ray towards light at infinity.
+    reach: f64,
+}
+
+impl Lights {
+    /// No light to look for: every side that takes part in the solve counts as lit.
+    fn none() -> Self {
+        Self {
+            points: Vec::new(),
+            towards: Vec::new(),
+            blockers: None,
+            spheres: Vec::new(),
+            step: 0.0,
+            reach: 0.0,
+        }
+    }
+
+    /// The lights of `scene`.
+    fn of(scene: &Scene) -> Self {
+        let (lo, hi) = scene.bounds();
+        let diagonal = (hi - lo).length().max(f64::MIN_POSITIVE);
+        let step = 1e-3 * diagonal;
+        let mut points = Vec::new();
+        for object in &scene.objects {
+            if !scene.materials[object.material].is_emitter() {
+                continue;
+            }
+            let back = matches!(object.sides, Sides::Two { emits_back: true });
+            let mut polygon = |p: &Polygon| {
+                let v = p.vertices();
+                let centre = v.iter().copied().sum::<DVec3>() / v.len() as f64;
+                let n = p.normal();
+                points.push((centre + n * step, Some(n)));
+                if back {
+                    points.push((centre - n * step, Some(-n)));
+                }
+            };
+            match &object.shape {
+                Shape::Polygons(ps) => ps.iter().for_each(&mut polygon),
+                Shape::Mesh(m) => m.polygons().iter().for_each(&mut polygon),
+                Shape::Sphere(s) => {
+                    let out = if s.facing == Facing::Outward { 1.0 } else { -1.0 };
+                    for axis in [DVec3::X, -DVec3::X, DVec3::Y, -DVec3::Y, DVec3::Z, -DVec3::Z] {
+                        points.push((s.center + axis * (s.radius + out * step), Some(axis * out)));
+                    }
+                }
+            }
+        }
+        points.extend(scene.lighting.luminaires.iter().map(|l| (l.light_point(step), None)));
+        if points.len() > MAX_LIGHT_POINTS {
+            let stride = points.len() as f64 / MAX_LIGHT_POINTS as f64;
+            points = (0..MAX_LIGHT_POINTS).map(|k| points[(k as f64 * stride) as usize]).collect();
+        }
+        let mut towards: Vec<DVec3> = scene.lighting.sun.iter().map(|s| s.towards.normalize()).collect();
+        if scene.lighting.sky.is_some() {
+            towards.push(DVec3::Y);
+        }
+        if points.is_empty() && towards.is_empty() {
+            return Self::none();
+        }
+        let mut triangles = Vec::new();
+        let mut spheres = Vec::new();
+        for object in &scene.objects {
+            let mut fan = |p: &Polygon| {
+                let v = p.vertices();
+                for k in 1..v.len() - 1 {
+                    triangles.push([v[0].as_vec3(), v[k].as_vec3(), v[k + 1].as_vec3()]);
+                }
+            };
+            match &object.shape {
+                Shape::Polygons(ps) => ps.iter().for_each(&mut fan),
+                Shape::Mesh(m) => m.polygons().iter().for_each(&mut fan),
+                Shape::Sphere(s) => spheres.push(*s),
+            }
+        }
+        Self { points, towards, blockers: Some(Bvh::new(&triangles)), spheres, step, reach: 4.0 * diagonal }
+    }
+
+    /// Whether the point `q` of a surface whose face towards the viewer has unit normal
+    /// `facing` sees a light directly (always, when there is no light to look for).
+    fn light(&self, q: DVec3, facing: DVec3) -> bool {
+        let Some(bvh) = &self.blockers else { return true };
+        let from = q + facing * self.step;
+        let sphere_between = |a: DVec3, b: DVec3| self.spheres.iter().any(|s| segment_meets_sphere(a, b, s));
+        let point_seen = self.points.iter().any(|&(l, n)| {
+            let to = l - from;
+            facing.dot(to) > 0.0
+                && n.is_none_or(|n| n.dot(to) < 0.0)
+                && !bvh.occluded(from.as_vec3(), l.as_vec3())
+                && !sphere_between(from, l)
+        });
+        point_seen
+            || self.towards.iter().any(|&d| {
+                facing.dot(d) > 0.0
+                    && !bvh.occluded_towards(from.as_vec3(), d.as_vec3(), self.reach as f32)
+                    && !sphere_between(from, from + d * self.reach)
+            })
+    }
+}
+
+/// Whether the segment from `a` to `b` crosses the surface of sphere `s`.
+fn segment_meets_sphere(a: DVec3, b: DVec3, s: &radiosity_core::Sphere) -> bool {
+    let d = b - a;
+    let len = d.length();
+    if len <= 0.0 {
+        return false;
+    }
+    let d = d / len;
+    // |a + t d − c|² = r²: t² + 2 b t + c = 0.
+    let oc = a - s.center;
+    let (bh, c) = (oc.dot(d), oc.length_squared() - s.radius * s.radius);
+    let disc = bh * bh - c;
+    if disc < 0.0 {
+        return false;
+    }
+    let root = disc.sqrt();
+    [-bh - root, -bh + root].iter().any(|&t| t > 0.0 && t < len)
 }
 
 /// The nearest surface along `origin + t·dir` (t > 0): its distance, which of its faces the
 /// ray meets, and its object.
-fn first_hit(scene: &Scene, origin: DVec3, dir: DVec3) -> Option<(f64, Seen, usize)> {
-    let mut best: Option<(f64, Seen, usize)> = None;
+fn first_hit(scene: &Scene, origin: DVec3, dir: DVec3) -> Option<(f64, Side, usize)> {
+    let mut best: Option<(f64, Side, usize)> = None;
     for (index, object) in scene.objects.iter().enumerate() {
         let two_sided = object.sides != Sides::One;
-        let mut take = |t: f64, front: bool| {
-            let seen = match (front, two_sided) {
-                (true, _) => Seen::Front,
-                (false, true) => Seen::TwoSidedBack,
-                (false, false) => Seen::Back,
+        // `normal` is the face's outward (front) normal.
+        let mut take = |t: f64, normal: DVec3| {
+            let front = normal.dot(dir) < 0.0;
+            let side = match (front, two_sided) {
+                (true, _) => Side::Solved(normal),
+                (false, true) => Side::Solved(-normal),
+                (false, false) => Side::Dark,
             };
             if best.is_none_or(|(b, _, _)| t < b) {
-                best = Some((t, seen, index));
+                best = Some((t, side, index));
             }
         };
         match &object.shape {
             Shape::Polygons(ps) => {
-                ps.iter().filter_map(|p| hit_polygon(p, origin, dir)).for_each(|h| take(h.0, h.1))
+                ps.iter().filter_map(|p| hit_polygon(p, origin, dir)).for_each(|(t, n)| take(t, n))
             }
             Shape::Mesh(m) => {
-                m.polygons().iter().filter_map(|p| hit_polygon(p, origin, dir)).for_each(|h| take(h.0, h.1))
+                m.polygons().iter().filter_map(|p| hit_polygon(p, origin, dir)).for_each(|(t, n)| take(t, n))
             }
             Shape::Sphere(s) => {
                 // |o + t d − c|² = r², d unit: t² + 2 b t + c = 0.
@@ -210,8 +383,8 @@ fn first_hit(scene: &Scene, origin: DVec3, dir: DVec3) -> Option<(f64, Seen, usi
                 let root = disc.sqrt();
                 let t = if -b - root > 0.0 { -b - root } else { -b + root };
                 if t > 0.0 {
-                    let outward = (origin + dir * t - s.center).dot(dir) < 0.0;
-                    take(t, outward == (s.facing == Facing::Outward));
+                    let outward = (origin + dir * t - s.center) / s.radius;
+                    take(t, if s.facing == Facing::Outward { outward } else { -outward });
                 }
             }
         }
@@ -219,8 +392,8 @@ fn first_hit(scene: &Scene, origin: DVec3, dir: DVec3) -> Option<(f64, Seen, usi
     best
 }
 
-/// Where the ray meets the convex polygon `p` (t > 0), and whether on its lit side.
-fn hit_polygon(p: &Polygon, origin: DVec3, dir: DVec3) -> Option<(f64, bool)> {
+/// Where the ray meets the convex polygon `p` (t > 0), and the polygon's normal.
+fn hit_polygon(p: &Polygon, origin: DVec3, dir: DVec3) -> Option<(f64, DVec3)> {
     let n = p.normal();
     let v = p.vertices();
     let denom = n.dot(dir);
@@ -234,7 +407,7 @@ fn hit_polygon(p: &Polygon, origin: DVec3, dir: DVec3) -> Option<(f64, bool)> {
     let q = origin + dir * t;
     let k = v.len();
     let inside = (0..k).all(|i| (v[(i + 1) % k] - v[i]).cross(q - v[i]).dot(n) >= 0.0);
-    inside.then_some((t, denom < 0.0))
+    inside.then_some((t, n))
 }
 
 #[cfg(test)]
@@ -279,8 +452,8 @@ mod tests {
         }
         let camera = camera_or_framing(&scene);
         assert!(camera.position.z < 0.0 && camera.look_at.z > camera.position.z, "{camera:?}");
-        let seen = probe(&scene, &camera);
-        assert!(seen.iter().filter(|&&s| s == Seen::Front).count() >= PROBE.0 * PROBE.1 / 4, "{seen:?}");
+        let seen = probe(&scene, &Lights::of(&scene), &camera);
+        assert!(seen.iter().filter(|&&s| s == Seen::Lit).count() >= PROBE.0 * PROBE.1 / 4, "{seen:?}");
         // Turned round, so that it opens towards +z as McGuire's OBJ does: still seen from the
         // open side.
         for o in &mut scene.objects {
@@ -305,6 +478,55 @@ mod tests {
         let camera = camera_or_framing(&scene);
         let (lo, hi) = scene.bounds();
         assert!(camera.position.cmpgt(lo).all() && camera.position.cmplt(hi).all(), "{camera:?}");
+    }
+
+    /// A room modelled with its normals out and read two-sided (as an OBJ is), lit by a
+    /// ceiling lamp inside: from outside, every side shows the walls' front faces, which
+    /// nothing lights. Closed, it is seen from inside; without its −x wall, through that
+    /// opening.
+    #[test]
+    fn a_room_wound_outwards_is_seen_where_its_lamp_lights_it() {
+        use radiosity_core::{Material, Object, Rgb, box_faces};
+        let room = |open: bool| {
+            let (lo, hi) = (DVec3::ZERO, DVec3::new(4.0, 3.0, 5.0));
+            let mut walls = box_faces(lo, hi, Facing::Outward, 0.0).unwrap();
+            if open {
+                walls.retain(|p| p.normal().dot(-DVec3::X) < 0.5);
+            }
+            let lamp = Polygon::try_new(vec![
+                DVec3::new(1.5, 2.99, 2.0),
+                DVec3::new(2.5, 2.99, 2.0),
+                DVec3::new(2.5, 2.99, 3.0),
+                DVec3::new(1.5, 2.99, 3.0),
+            ])
+            .unwrap();
+            assert!(lamp.normal().y < -0.99, "the lamp faces down");
+            let materials = vec![
+                Material::try_new("wall", Rgb::splat(0.7), Rgb::ZERO).unwrap(),
+                Material::try_new("lamp", Rgb::ZERO, Rgb::splat(10.0)).unwrap(),
+            ];
+            let objects = vec![
+                Object {
+                    name: "room".into(),
+                    material: 0,
+                    shape: Shape::Polygons(walls),
+                    sides: Sides::Two { emits_back: false },
+                },
+                Object::new("lamp", 1, Shape::Polygons(vec![lamp])),
+            ];
+            (Scene::try_new("room", None, materials, objects).unwrap(), lo, hi)
+        };
+        let (closed, lo, hi) = room(false);
+        let camera = camera_or_framing(&closed);
+        assert!(camera.position.cmpgt(lo).all() && camera.position.cmplt(hi).all(), "inside: {camera:?}");
+        let (open, _, _) = room(true);
+        let camera = camera_or_framing(&open);
+        assert!(
+            camera.position.x < 0.0 && camera.look_at.x > camera.position.x,
+            "through the opening: {camera:?}"
+        );
+        let seen = probe(&open, &Lights::of(&open), &camera);
+        assert!(seen.iter().filter(|&&s| s == Seen::Lit).count() >= PROBE.0 * PROBE.1 / 4, "{seen:?}");
     }
 
     /// In a closed room holding a block by one wall, the inside view looks towards the
