@@ -7,10 +7,8 @@
 use rustc_hash::FxHashMap as HashMap;
 
 use glam::DVec3;
-use radiosity_core::{MeshParams, Polygon, PolygonMesh};
+use radiosity_core::{Polygon, PolygonMesh};
 
-use crate::bisection::mesh_triangles;
-use crate::builder::SurfaceBuilder;
 use crate::union_find::UnionFind;
 
 /// How the faces of a [`PolygonMesh`] are cut into surfaces: groups of triangles (face
@@ -92,20 +90,14 @@ pub(crate) fn pair_as_quad(m: &PolygonMesh, a: usize, b: usize) -> Option<Polygo
     None
 }
 
-/// Meshes a group of coplanar triangles into `b`, each cut by bisection (see `bisection`).
-pub(crate) fn mesh_triangle_group(
-    b: &mut SurfaceBuilder,
-    m: &PolygonMesh,
-    group: &[u32],
-    params: &MeshParams,
-) {
+/// The triangles of `group`, faces of `m` with three corners each.
+pub(crate) fn group_triangles(m: &PolygonMesh, group: &[u32]) -> Vec<[DVec3; 3]> {
     let pos = m.positions();
-    let triangles: Vec<[DVec3; 3]> = group
+    group
         .iter()
         .map(|&f| {
             let idx = &m.faces()[f as usize];
             [idx[0], idx[1], idx[2]].map(|i| pos[i as usize])
         })
-        .collect();
-    mesh_triangles(b, &triangles, m.polygons()[group[0] as usize].normal(), params);
+        .collect()
 }
