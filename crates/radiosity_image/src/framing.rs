@@ -329,21 +329,17 @@ impl Lights {
 
 /// Whether the segment from `a` to `b` crosses the surface of sphere `s`.
 fn segment_meets_sphere(a: DVec3, b: DVec3, s: &radiosity_core::Sphere) -> bool {
-    let d = b - a;
-    let len = d.length();
-    if len <= 0.0 {
-        return false;
-    }
-    let d = d / len;
-    // |a + t d − c|² = r²: t² + 2 b t + c = 0.
-    let oc = a - s.center;
-    let (bh, c) = (oc.dot(d), oc.length_squared() - s.radius * s.radius);
-    let disc = bh * bh - c;
-    if disc < 0.0 {
-        return false;
-    }
-    let root = disc.sqrt();
-    [-bh - root, -bh + root].iter().any(|&t| t > 0.0 && t < len)
+    let len = (b - a).length();
+    len > 0.0 && sphere_roots(a, (b - a) / len, s).is_some_and(|ts| ts.iter().any(|&t| t > 0.0 && t < len))
+}
+
+/// Where the line `origin + t·dir` (`dir` unit) meets the surface of sphere `s`: both roots
+/// of |o + t d − c|² = r², i.e. t² + 2 b t + c = 0, nearer first; `None` when it misses.
+fn sphere_roots(origin: DVec3, dir: DVec3, s: &radiosity_core::Sphere) -> Option<[f64; 2]> {
+    let oc = origin - s.center;
+    let (b, c) = (oc.dot(dir), oc.length_squared() - s.radius * s.radius);
+    let disc = b * b - c;
+    (disc >= 0.0).then(|| [-b - disc.sqrt(), -b + disc.sqrt()])
 }
 
 /// The nearest surface along `origin + t·dir` (t > 0): its distance, which of its faces the
@@ -372,16 +368,8 @@ fn first_hit(scene: &Scene, origin: DVec3, dir: DVec3) -> Option<(f64, Side, usi
                 m.polygons().iter().filter_map(|p| hit_polygon(p, origin, dir)).for_each(|(t, n)| take(t, n))
             }
             Shape::Sphere(s) => {
-                // |o + t d − c|² = r², d unit: t² + 2 b t + c = 0.
-                let oc = origin - s.center;
-                let b = oc.dot(dir);
-                let c = oc.length_squared() - s.radius * s.radius;
-                let disc = b * b - c;
-                if disc < 0.0 {
-                    continue;
-                }
-                let root = disc.sqrt();
-                let t = if -b - root > 0.0 { -b - root } else { -b + root };
+                let Some([near, far]) = sphere_roots(origin, dir, s) else { continue };
+                let t = if near > 0.0 { near } else { far };
                 if t > 0.0 {
                     let outward = (origin + dir * t - s.center) / s.radius;
                     take(t, if s.facing == Facing::Outward { outward } else { -outward });

@@ -11,7 +11,7 @@ use glam::DVec3;
 use radiosity_core::{Material, MeshParams, Polygon, Rgb, Scene, Shape, Sides};
 
 use crate::bisection::mesh_triangles;
-use crate::builder::{SurfaceBuilder, is_large, polygon_area_normal};
+use crate::builder::{SurfaceBuilder, is_large, is_large_area, polygon_area_normal};
 use crate::contacts::seams::cut_triangles;
 use crate::contacts::{Contacts, PolygonId};
 use crate::grading;
@@ -173,7 +173,7 @@ impl Mesh {
                             // elements).
                             let area: f64 =
                                 ts.iter().map(|t| 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length()).sum();
-                            let large = area >= 4.0 * params.element_size * params.element_size;
+                            let large = is_large_area(area, params);
                             let seams = contacts
                                 .as_ref()
                                 .filter(|_| params.contacts && large)

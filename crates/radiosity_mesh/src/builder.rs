@@ -35,7 +35,12 @@ impl SurfaceBuilder {
 /// nothing from a cut or a grading (the facets of a tessellated model): only larger ones are
 /// looked at for contacts and inside corners.
 pub(crate) fn is_large(p: &Polygon, params: &MeshParams) -> bool {
-    p.area() >= 4.0 * params.element_size * params.element_size
+    is_large_area(p.area(), params)
+}
+
+/// [`is_large`] for a region of area `area` (a model's triangles merged into one outline).
+pub(crate) fn is_large_area(area: f64, params: &MeshParams) -> bool {
+    area >= 4.0 * params.element_size * params.element_size
 }
 
 pub(crate) fn divisions(length: f64, size: f64) -> usize {
