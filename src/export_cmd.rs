@@ -5,7 +5,10 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::Args;
-use radiosity_export::{ExportFormat, Texels, VertexColours};
+use radiosity_export::{
+    ATLAS_FILES, AtlasOptions, AtlasTexels, ExportFormat, LightmapQuantity, Texels, VertexColours,
+    atlas_radiance, bake_atlas, write_atlas,
+};
 use radiosity_image::{Gather, HdrImage, RenderParams, Renderer, ToneOperator, ToneParams};
 
 use crate::errors::InputError;
@@ -33,9 +36,26 @@ pub struct ExportArgs {
     /// (made if missing, with the folders above it).
     #[arg(long)]
     pub lightmap: Option<PathBuf>,
+    /// Also write, into this folder, the scene's own faces for a game engine:
+    /// `lightmapped.gltf` (the model's meshes, materials and colour textures, with lightmap
+    /// coordinates in TEXCOORD_1 from a chart-and-pack unwrap), `lightmap.exr` (linear) and
+    /// `lightmap.png` (tone-mapped, also in the glTF). See docs/FORMAT.md.
+    #[arg(long, value_name = "DIR")]
+    pub lightmap_atlas: Option<PathBuf>,
+    /// Lightmap texels per scene unit (default: the most that fits one --atlas-size page).
+    /// Needs --lightmap-atlas.
+    #[arg(long, value_name = "TEXELS", value_parser = positive_density)]
+    pub texels_per_unit: Option<f64>,
+    /// Lightmap atlas width in texels (its height is what the charts take), 64 to 16384.
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(64..=16384))]
+    pub atlas_size: u32,
+    /// What lightmap atlas texels hold: `irradiance` E (W per unit², what an engine multiplies
+    /// by the albedo and its texture) or `radiosity` B (the albedo applied).
+    #[arg(long, value_enum, default_value_t = QuantityArg::Irradiance)]
+    pub lightmap_quantity: QuantityArg,
     /// Lightmap texels: `none` interpolated from the solution, `direct` with direct light by
     /// shadow rays per texel (sharp shadows from a coarse solve), `full` also one bounce of
-    /// gathering rays. Needs --lightmap.
+    /// gathering rays. Needs --lightmap or --lightmap-atlas.
     #[arg(long, value_enum, default_value_t = GatherArg::None)]
     pub gather: GatherArg,
     #[command(flatten)]
@@ -45,6 +65,34 @@ pub struct ExportArgs {
     pub force: bool,
     #[command(flatten)]
     pub solve: SolveOpts,
+}
+
+/// What lightmap atlas texels hold.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum QuantityArg {
+    /// Irradiance E arriving at the surface.
+    Irradiance,
+    /// Radiosity B leaving it.
+    Radiosity,
+}
+
+impl From<QuantityArg> for LightmapQuantity {
+    fn from(q: QuantityArg) -> Self {
+        match q {
+            QuantityArg::Irradiance => LightmapQuantity::Irradiance,
+            QuantityArg::Radiosity => LightmapQuantity::Radiosity,
+        }
+    }
+}
+
+/// `--texels-per-unit`: finite and positive.
+fn positive_density(text: &str) -> Result<f64, String> {
+    let value: f64 = text.parse().map_err(|_| format!("'{text}' is not a number"))?;
+    if value.is_finite() && value > 0.0 && value <= 1e6 {
+        Ok(value)
+    } else {
+        Err(format!("{value}: must be in (0, 1e6]"))
+    }
 }
 
 /// Runs `export`.
@@ -62,8 +110,19 @@ pub fn run(a: ExportArgs) -> Result<()> {
     if let Some(dir) = &a.lightmap {
         targets.folder(dir, "lightmapped.obj", "--lightmap")?;
     }
-    if a.lightmap.is_none() && !matches!(a.gather, GatherArg::None) {
-        return Err(InputError("--gather bakes lightmaps: give --lightmap DIR too".into()).into());
+    if let Some(dir) = &a.lightmap_atlas {
+        targets.folder(dir, ATLAS_FILES[0], "--lightmap-atlas")?;
+    }
+    if a.lightmap.is_none() && a.lightmap_atlas.is_none() && !matches!(a.gather, GatherArg::None) {
+        return Err(InputError(
+            "--gather bakes lightmaps: give --lightmap DIR or --lightmap-atlas DIR too".into(),
+        )
+        .into());
+    }
+    if a.lightmap_atlas.is_none() && a.texels_per_unit.is_some() {
+        return Err(
+            InputError("--texels-per-unit sizes the atlas: give --lightmap-atlas DIR too".into()).into()
+        );
     }
     let prepared = prepare(&a.scene, &a.solve)?;
     let (solver, report) = run_solver(&prepared)?;
@@ -138,6 +197,43 @@ pub fn run(a: ExportArgs) -> Result<()> {
             })
         })?;
         note(format_args!("wrote {count} lightmap files into {}", dir.display()))?;
+    }
+    if let Some(dir) = &a.lightmap_atlas {
+        let gather = Gather::from(a.gather);
+        let renderer = (gather != Gather::None).then(|| Renderer::new(mesh.clone()));
+        let params = RenderParams { gather, seed: a.solve.seed, ..RenderParams::default() };
+        let texels = match &renderer {
+            Some(renderer) => AtlasTexels::Gathered { renderer, params: &params },
+            None => AtlasTexels::Interpolated,
+        };
+        let options = AtlasOptions {
+            texels_per_unit: a.texels_per_unit,
+            size: a.atlas_size,
+            quantity: a.lightmap_quantity.into(),
+            ..AtlasOptions::default()
+        };
+        let what = format!("unwrapping and baking the lightmap atlas (gather {})", gather.as_str());
+        let atlas = spinning(&what, || bake_atlas(&prepared.scene, mesh, &solution, &options, texels))
+            .map_err(|e| InputError(format!("--lightmap-atlas: {e}")))?;
+        let ev = a.tone.exposure.ev_for(&atlas_radiance(&atlas));
+        let tone = ToneParams::new(ev, a.tone.tonemap.into());
+        spinning(&format!("writing {}", dir.display()), || {
+            output::write_folder(dir, a.force, |staging| {
+                write_atlas(staging, &prepared.scene, &atlas, &options, tone)
+            })
+        })?;
+        note(format_args!(
+            "wrote {} into {}: {}x{} texels, {:.2} texels per unit, {} charts, {} of {} face texels \
+             without an element under them (filled from their neighbours)",
+            ATLAS_FILES.join(", "),
+            dir.display(),
+            atlas.image.width(),
+            atlas.image.height(),
+            atlas.texels_per_unit,
+            atlas.charts,
+            atlas.missed,
+            atlas.covered
+        ))?;
     }
     Ok(())
 }

@@ -174,14 +174,64 @@ fn existing_output_and_bad_input_are_one_line_errors_with_exit_code_2() {
     assert!(stderr(&o).contains("missing.gltf: cannot read the model file"), "{}", stderr(&o));
 }
 
-/// A textured OBJ floor under a lamp, exported to GLB and glTF: the floor's primitive has
-/// `TEXCOORD_0` and a material whose base colour texture is the PNG embedded in the buffer,
-/// sampled as loaded (`-clamp on`); the lamp keeps the untextured material; the count of
-/// vertices said is the count written; the validator finds no error.
+/// The textured room's faces for an engine: `--lightmap-atlas` writes the glTF, the EXR and
+/// the PNG; every primitive has the lightmap's `TEXCOORD_1` in [0, 1] and its material points
+/// at the lightmap texture on set 1; the floor keeps its own `vt` as `TEXCOORD_0` under its
+/// texture (clamped as loaded); the validator finds no error; a second run without --force
+/// refuses to overwrite.
 #[test]
-fn a_textured_model_exports_its_texture_and_passes_the_validator() {
+fn the_lightmap_atlas_keeps_the_models_faces_and_texture() {
     let dir = tempfile::tempdir().unwrap();
-    let d = dir.path();
+    let model = textured_room(dir.path());
+    let (out, atlas) = (dir.path().join("lit.glb"), dir.path().join("atlas"));
+    let args = [
+        "export",
+        model.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--lightmap-atlas",
+        atlas.to_str().unwrap(),
+        "--atlas-size",
+        "128",
+        "--max-shots",
+        "50",
+    ];
+    let o = radiosity(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("128x"), "{}", stderr(&o));
+    for f in ["lightmapped.gltf", "lightmap.exr", "lightmap.png"] {
+        assert!(atlas.join(f).is_file(), "{f} written");
+    }
+    let gltf = atlas.join("lightmapped.gltf");
+    let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&gltf).unwrap()).unwrap();
+    assert_eq!(doc["asset"]["extras"]["radiosity_lightmap"]["quantity"], "irradiance");
+    let lightmap = doc["asset"]["extras"]["radiosity_lightmap"]["texture"].as_u64().unwrap();
+    for mesh in doc["meshes"].as_array().unwrap() {
+        let prim = &mesh["primitives"][0];
+        let uv1 = &doc["accessors"][prim["attributes"]["TEXCOORD_1"].as_u64().unwrap() as usize];
+        assert_eq!(uv1["type"], "VEC2");
+        let material = &doc["materials"][prim["material"].as_u64().unwrap() as usize];
+        assert_eq!(material["extras"]["lightmap"]["index"].as_u64(), Some(lightmap), "{material}");
+        assert_eq!(material["extras"]["lightmap"]["texCoord"], 1);
+    }
+    let floor = doc["meshes"].as_array().unwrap().iter().find(|m| m["name"] == "floor").unwrap();
+    let prim = &floor["primitives"][0];
+    assert_ne!(prim["attributes"]["TEXCOORD_0"], prim["attributes"]["TEXCOORD_1"], "the model's own set");
+    let material = &doc["materials"][prim["material"].as_u64().unwrap() as usize];
+    let base = &material["pbrMetallicRoughness"]["baseColorTexture"];
+    assert_eq!(base["texCoord"], 0);
+    let sampler = &doc["samplers"]
+        [doc["textures"][base["index"].as_u64().unwrap() as usize]["sampler"].as_u64().unwrap() as usize];
+    assert_eq!(sampler["wrapS"].as_u64(), Some(33071), "clamped as loaded");
+    validate(&[&gltf]);
+    std::fs::remove_file(&out).unwrap();
+    let o = radiosity(&args);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("pass --force"), "{}", stderr(&o));
+}
+
+/// A textured OBJ floor (a 4 × 4 PNG, clamped) under an untextured lamp, in `dir`; the OBJ's path.
+fn textured_room(d: &Path) -> PathBuf {
     let pixels = (0..16u8).map(|i| [i * 16, 255 - i * 16, 128]).collect();
     radiosity_image::write_png(
         &d.join("tiles.png"),
@@ -198,6 +248,18 @@ fn a_textured_model_exports_its_texture_and_passes_the_validator() {
         o lamp\nv 0.75 1.5 0.75\nv 1.25 1.5 0.75\nv 1.25 1.5 1.25\nv 0.75 1.5 1.25\nusemtl lamp\nf 5 6 7 8\n";
     let model = d.join("room.obj");
     std::fs::write(&model, obj).unwrap();
+    model
+}
+
+/// A textured OBJ floor under a lamp, exported to GLB and glTF: the floor's primitive has
+/// `TEXCOORD_0` and a material whose base colour texture is the PNG embedded in the buffer,
+/// sampled as loaded (`-clamp on`); the lamp keeps the untextured material; the count of
+/// vertices said is the count written; the validator finds no error.
+#[test]
+fn a_textured_model_exports_its_texture_and_passes_the_validator() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let model = textured_room(d);
     let (glb, gltf) = (d.join("lit.glb"), d.join("lit.gltf"));
     for out in [&glb, &gltf] {
         let o =

@@ -18,7 +18,9 @@
 //!   (linear B); faces are the elements' triangles (a quad element gives two, as in glTF) as
 //!   `list uchar uint`: triangles only, because common readers (trimesh among them) refuse a
 //!   face list that mixes triangles and quads.
-//! * Lightmaps: see [`write_lightmaps`].
+//! * Lightmaps: see [`write_lightmaps`] (one cell per element, an OBJ over the elements)
+//!   and [`bake_atlas`] with [`write_atlas`] (the model's own faces unwrapped into one atlas,
+//!   a glTF with `TEXCOORD_1` for engines).
 //!
 //! Frames: the mesh is in the renderer's +y-up frame. glTF is +y up by its specification and
 //! is written as the mesh is; PLY and the lightmaps' OBJ have no convention, and are written
@@ -45,7 +47,12 @@ use rayon::prelude::*;
 use serde_json::{Value, json};
 use textured::{TexturedMaterials, push_view};
 
+mod atlas;
+mod atlas_gltf;
 mod textured;
+
+pub use atlas::{Atlas, AtlasError, AtlasMesh, AtlasOptions, AtlasTexels, LightmapQuantity, bake_atlas};
+pub use atlas_gltf::{ATLAS_FILES, atlas_gltf, atlas_radiance, write_atlas};
 
 /// What the exported vertex colours (`COLOR_0`) hold. glTF requires colours in [0, 1], so
 /// radiosity itself (lights reach 65 W per unit² in the Cornell box) goes unclamped into the

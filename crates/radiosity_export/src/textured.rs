@@ -64,7 +64,7 @@ pub(crate) fn push_view(blob: &mut Vec<u8>, bytes: &[u8], target: Option<u32>) -
 }
 
 /// glTF's sampler wrap code.
-fn wrap_code(wrap: Wrap) -> u32 {
+pub(crate) fn wrap_code(wrap: Wrap) -> u32 {
     match wrap {
         Wrap::Repeat => 10497,
         Wrap::ClampToEdge => 33071,
