@@ -224,7 +224,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
         })?;
         note(format_args!(
             "wrote {} into {}: {}x{} texels, {:.2} texels per unit, {} charts, {} of {} face texels \
-             without an element under them (filled from their neighbours)",
+             without an element under them (filled from their neighbours){}",
             ATLAS_FILES.join(", "),
             dir.display(),
             atlas.image.width(),
@@ -232,7 +232,11 @@ pub fn run(a: ExportArgs) -> Result<()> {
             atlas.texels_per_unit,
             atlas.charts,
             atlas.missed,
-            atlas.covered
+            atlas.covered,
+            match atlas.dim_sides {
+                0 => String::new(),
+                n => format!("; {n} dim sides (the outside of a room) at an eighth of the density"),
+            }
         ))?;
     }
     Ok(())

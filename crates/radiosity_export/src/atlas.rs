@@ -63,6 +63,14 @@ impl Default for AtlasOptions {
     }
 }
 
+/// A side of a two-sided object is dim when its mean radiosity is at most this share of the
+/// scene's (both area-weighted, brightest channel): the outside of a room, the back of a wall.
+pub const DIM: f64 = 1e-2;
+
+/// A dim side's texel density against the rest: an eighth along each axis, a sixty-fourth of
+/// the texels, so that the outside of a room takes no more of the atlas than a chair.
+pub const DIM_DENSITY: f32 = 1.0 / 8.0;
+
 /// One object's faces on one side, unwrapped: the glTF primitive it becomes.
 #[derive(Clone, Debug)]
 pub struct AtlasMesh {
@@ -70,6 +78,8 @@ pub struct AtlasMesh {
     pub object: usize,
     /// The back side of a two-sided object: its faces turned over.
     pub back: bool,
+    /// The object is two-sided: a texel takes the element facing its side only.
+    pub two_sided: bool,
     /// This side gives off its material's emission (a back side only when the object
     /// `emits_back`).
     pub emits: bool,
@@ -94,6 +104,8 @@ pub struct Atlas {
     pub texels_per_unit: f64,
     /// Charts packed.
     pub charts: u32,
+    /// Sides unwrapped at [`DIM_DENSITY`] because they are [`DIM`].
+    pub dim_sides: usize,
     /// Texels whose centre lies on a face.
     pub covered: usize,
     /// Of those, texels whose point found no element of its object and side (a part left out
@@ -178,20 +190,22 @@ pub fn bake_atlas(
     options: &AtlasOptions,
     texels: AtlasTexels<'_>,
 ) -> Result<Atlas, AtlasError> {
-    // Per object: its triangles, and per element whether it faces the way the object's
-    // faces do (front) or the other way (back).
     let mut meshes = Vec::new();
     let mut inputs: Vec<(Vec<[f32; 3]>, Vec<u32>)> = Vec::new();
     let locator = Locator::new(scene, mesh);
+    let scene_mean = mean_radiosity(mesh, solution, 0..mesh.elements.len());
+    let mut scales = Vec::new();
     for o in 0..scene.objects.len() {
         let triangles = object_triangles(scene, o);
         if triangles.is_empty() {
             continue;
         }
-        // The sides the mesher kept: a closed two-sided object lit from one side is meshed
-        // on that side only (the inside of a room modelled with its normals out).
-        for back in [false, true].into_iter().filter(|&back| locator.maps.contains_key(&(o, back))) {
-            let faces: Vec<_> = triangles
+        // A one-sided object: its faces as wound. A two-sided one: each side on which the
+        // mesher kept elements (a closed object lit from one side is meshed on that side only:
+        // the inside of a room modelled with its normals out).
+        let two_sided = matches!(scene.objects[o].sides, Sides::Two { .. });
+        for back in [false, true] {
+            let faces: Vec<Face> = triangles
                 .iter()
                 .map(
                     |&(t, uv)| {
@@ -199,12 +213,19 @@ pub fn bake_atlas(
                     },
                 )
                 .collect();
+            let (hits, mean) = probe_side(mesh, solution, &locator, o, &faces);
+            if (two_sided && hits == 0) || (!two_sided && back) {
+                continue;
+            }
+            let dim = two_sided && mean <= DIM * scene_mean;
+            scales.push(if dim { DIM_DENSITY } else { 1.0 });
             let (positions, indices, uv0, corners) = weld(&faces);
             inputs.push((positions.iter().map(|p| p.as_vec3().to_array()).collect(), indices.clone()));
             let emits = !back || matches!(scene.objects[o].sides, Sides::Two { emits_back: true });
             meshes.push(AtlasMesh {
                 object: o,
                 back,
+                two_sided,
                 emits,
                 positions: corners,
                 uv0,
@@ -222,8 +243,11 @@ pub fn bake_atlas(
     };
     let unwrap_options =
         uvunwrap::Options { density, padding: options.padding, ..uvunwrap::Options::default() };
-    let inputs: Vec<uvunwrap::MeshInput> =
-        inputs.iter().map(|(p, i)| uvunwrap::MeshInput::new(p, i)).collect();
+    let inputs: Vec<uvunwrap::MeshInput> = inputs
+        .iter()
+        .zip(&scales)
+        .map(|((p, i), &scale)| uvunwrap::MeshInput { scale, ..uvunwrap::MeshInput::new(p, i) })
+        .collect();
     let atlas = uvunwrap::generate(&inputs, &unwrap_options)?;
     if atlas.page_count > 1 {
         return Err(AtlasError::Pages(atlas.page_count, options.size));
@@ -263,6 +287,7 @@ pub fn bake_atlas(
         meshes,
         texels_per_unit: f64::from(atlas.texels_per_unit),
         charts: atlas.chart_count,
+        dim_sides: scales.iter().filter(|&&s| s < 1.0).count(),
         covered,
         missed,
     })
@@ -365,12 +390,19 @@ fn dilate(grid: &mut [Option<Rgb>], w: u32, h: u32, passes: u32) {
 /// A locator triangle's element and the three of its vertex indices it spans.
 type Owner = (u32, [u32; 3]);
 
-/// Finds the element under a point of an object's face: one ray structure per object and
-/// side over its element triangles (a quad split in two).
+/// An element found under a face's point: the element and its radiosity interpolated there.
+struct Found {
+    element: usize,
+    radiosity: Rgb,
+}
+
+/// Finds the element under a point of an object's face. Per object, two ray structures over
+/// its element triangles (a quad split in two): its front surfaces' and its back surfaces'
+/// (a two-sided object's twins), so that the coplanar twin of an element is never in the
+/// same structure and the nearest hit along the face's normal is one element.
 struct Locator {
-    /// Per (object, back): the structure and, per triangle, its element and corners (three
-    /// of the element's vertex indices).
-    maps: HashMap<(usize, bool), (Bvh, Vec<Owner>)>,
+    /// Per (object, back surfaces): the structure and, per triangle, its element and corners.
+    parts: HashMap<(usize, bool), (Bvh, Vec<Owner>)>,
     /// Distance off the face the rays start from, and twice it their reach: far above the
     /// structure's single precision, far below a model's detail.
     lift: f64,
@@ -380,32 +412,11 @@ impl Locator {
     fn new(scene: &Scene, mesh: &Mesh) -> Self {
         let (lo, hi) = scene.bounds();
         let lift = 1e-4 * (hi - lo).length().max(1e-9);
-        // An element is on its object's back side when its normal points against the face of
-        // the object nearest its centre: found with the object's own faces.
-        let mut faces: HashMap<usize, (Bvh, Vec<DVec3>)> = HashMap::new();
-        let mut back = vec![false; mesh.elements.len()];
-        for (e, flag) in back.iter_mut().enumerate() {
-            let o = mesh.element_object(e);
-            if !matches!(scene.objects[o].sides, Sides::Two { .. }) {
-                continue;
-            }
-            let (bvh, normals) = faces.entry(o).or_insert_with(|| {
-                let tris = object_triangles(scene, o);
-                let bvh = Bvh::new(&tris.iter().map(|(t, _)| t.map(DVec3::as_vec3)).collect::<Vec<_>>());
-                let normals =
-                    tris.iter().map(|(t, _)| (t[1] - t[0]).cross(t[2] - t[0]).normalize()).collect();
-                (bvh, normals)
-            });
-            let el = &mesh.elements[e];
-            let start = (el.centre + el.normal * lift).as_vec3();
-            if let Some(hit) = bvh.closest_hit(start, -el.normal.as_vec3(), (2.0 * lift) as f32) {
-                *flag = normals[hit.triangle as usize].dot(el.normal) < 0.0;
-            }
-        }
-        type Side = (Vec<[Vec3; 3]>, Vec<Owner>);
-        let mut triangles: HashMap<(usize, bool), Side> = HashMap::new();
+        type Part = (Vec<[Vec3; 3]>, Vec<Owner>);
+        let mut triangles: HashMap<(usize, bool), Part> = HashMap::new();
         for (e, el) in mesh.elements.iter().enumerate() {
-            let entry = triangles.entry((mesh.element_object(e), back[e])).or_default();
+            let surface = &mesh.surfaces[mesh.patches[el.patch as usize].surface as usize];
+            let entry = triangles.entry((surface.object as usize, surface.back)).or_default();
             let v = el.vertex_indices();
             for k in 1..v.len() - 1 {
                 let corners = [v[0], v[k], v[k + 1]];
@@ -413,14 +424,49 @@ impl Locator {
                 entry.1.push((e as u32, corners));
             }
         }
-        let maps =
+        let parts =
             triangles.into_iter().map(|(key, (tris, owners))| (key, (Bvh::new(&tris), owners))).collect();
-        Self { maps, lift }
+        Self { parts, lift }
+    }
+
+    /// The element of object `o` under point `p` of a face with unit normal `normal`, and its
+    /// radiosity there: one facing the same way as the face, or, unless `facing` is asked
+    /// for, one facing the other way (a one-sided object the mesher turned over).
+    fn find(
+        &self,
+        mesh: &Mesh,
+        solution: &Solution,
+        o: usize,
+        p: DVec3,
+        normal: DVec3,
+        facing: bool,
+    ) -> Option<Found> {
+        let start = (p + normal * self.lift).as_vec3();
+        let mut turned = None;
+        for back in [false, true] {
+            let Some((bvh, owners)) = self.parts.get(&(o, back)) else { continue };
+            let Some(hit) = bvh.closest_hit(start, -normal.as_vec3(), (2.0 * self.lift) as f32) else {
+                continue;
+            };
+            let (e, corners) = owners[hit.triangle as usize];
+            let weights = [1.0 - f64::from(hit.u) - f64::from(hit.v), f64::from(hit.u), f64::from(hit.v)];
+            let radiosity = corners
+                .iter()
+                .zip(weights)
+                .map(|(&v, w)| solution.vertex_radiosity[v as usize] * w)
+                .sum::<Rgb>();
+            let found = Found { element: e as usize, radiosity };
+            if mesh.elements[e as usize].normal.dot(normal) > 0.0 {
+                return Some(found);
+            }
+            turned = turned.or(Some(found));
+        }
+        if facing { None } else { turned }
     }
 
     /// The texel value at point `p` of one of `m`'s faces, whose unit normal is `normal`
-    /// (the gather's random stream keyed by `key`): `None` when no element of its object and
-    /// side lies under it.
+    /// (the gather's random stream keyed by `key`): `None` when no element of its object lies
+    /// under it, facing the way the side does when the object is two-sided.
     #[allow(clippy::too_many_arguments)]
     fn value(
         &self,
@@ -432,18 +478,9 @@ impl Locator {
         texels: AtlasTexels<'_>,
         key: u64,
     ) -> Option<Result<Rgb, RenderError>> {
-        let (bvh, owners) = self.maps.get(&(m.object, m.back))?;
-        let start = (p + normal * self.lift).as_vec3();
-        let hit = bvh.closest_hit(start, -normal.as_vec3(), (2.0 * self.lift) as f32)?;
-        let (e, corners) = owners[hit.triangle as usize];
-        let e = e as usize;
-        let weights = [1.0 - f64::from(hit.u) - f64::from(hit.v), f64::from(hit.u), f64::from(hit.v)];
+        let Found { element: e, radiosity } = self.find(mesh, solution, m.object, p, normal, m.two_sided)?;
         let b = match texels {
-            AtlasTexels::Interpolated => corners
-                .iter()
-                .zip(weights)
-                .map(|(&v, w)| solution.vertex_radiosity[v as usize] * w)
-                .sum::<Rgb>(),
+            AtlasTexels::Interpolated => radiosity,
             AtlasTexels::Gathered { renderer, params } => {
                 // A thousandth of the way to the element's centre: a face's edge may be a
                 // room's edge, where rays graze the next wall.
@@ -459,6 +496,40 @@ impl Locator {
             LightmapQuantity::Irradiance => irradiance(mesh, e, b, m.emits),
         }))
     }
+}
+
+/// Faces probed to tell which sides of a two-sided object were meshed and how bright they
+/// are, at most.
+const PROBES: usize = 256;
+
+/// Of the faces `faces` of object `o` seen from the side whose normals they have: how many
+/// of (up to [`PROBES`] of them, spread over the list) have an element facing that way under
+/// their centroid, and the area-weighted mean of the brightest channel of its radiosity.
+fn probe_side(mesh: &Mesh, solution: &Solution, locator: &Locator, o: usize, faces: &[Face]) -> (usize, f64) {
+    let step = faces.len().div_ceil(PROBES).max(1);
+    let (mut hits, mut sum, mut area) = (0, 0.0, 0.0);
+    for (t, _) in faces.iter().step_by(step) {
+        let n = (t[1] - t[0]).cross(t[2] - t[0]);
+        let centroid = (t[0] + t[1] + t[2]) / 3.0;
+        if let Some(found) = locator.find(mesh, solution, o, centroid, n.normalize(), true) {
+            let b = found.radiosity;
+            hits += 1;
+            sum += b.r.max(b.g).max(b.b) * n.length();
+            area += n.length();
+        }
+    }
+    (hits, if area > 0.0 { sum / area } else { 0.0 })
+}
+
+/// The area-weighted mean of the brightest channel of `elements`' radiosity.
+fn mean_radiosity(mesh: &Mesh, solution: &Solution, elements: impl Iterator<Item = usize>) -> f64 {
+    let (mut sum, mut area) = (0.0, 0.0);
+    for e in elements {
+        let (b, a) = (solution.element_radiosity[e], mesh.elements[e].area);
+        sum += b.r.max(b.g).max(b.b) * a;
+        area += a;
+    }
+    if area > 0.0 { sum / area } else { 0.0 }
 }
 
 /// Irradiance from radiosity `b` on element `e`: (B − emission)/ρ̄ per channel (the emission

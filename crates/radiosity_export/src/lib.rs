@@ -51,7 +51,9 @@ mod atlas;
 mod atlas_gltf;
 mod textured;
 
-pub use atlas::{Atlas, AtlasError, AtlasMesh, AtlasOptions, AtlasTexels, LightmapQuantity, bake_atlas};
+pub use atlas::{
+    Atlas, AtlasError, AtlasMesh, AtlasOptions, AtlasTexels, DIM, DIM_DENSITY, LightmapQuantity, bake_atlas,
+};
 pub use atlas_gltf::{ATLAS_FILES, atlas_gltf, atlas_radiance, write_atlas};
 
 /// What the exported vertex colours (`COLOR_0`) hold. glTF requires colours in [0, 1], so

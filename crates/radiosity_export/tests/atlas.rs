@@ -176,7 +176,8 @@ fn irradiance_texels_are_radiosity_over_reflectance() {
 }
 
 /// A two-sided plate lit from below only: both sides get charts of their own, the lit one
-/// bright and the other dark, as the solution has them.
+/// bright and the other dark, as the solution has them, the dark one at the dim sides'
+/// density.
 #[test]
 fn both_sides_of_a_two_sided_object_get_charts() {
     let scene = two_sided_plate(0.5, 1.0, 0.0);
@@ -195,4 +196,10 @@ fn both_sides_of_a_two_sided_object_get_charts() {
     let (front, back) = if sides[0].back { (sides[1], sides[0]) } else { (sides[0], sides[1]) };
     assert!(mean(front) > 0.05 && mean(back) < 1e-3 * mean(front), "{} {}", mean(front), mean(back));
     assert!(back.back && !front.back);
+    // The dark side is unwrapped at an eighth of the density: a sixty-fourth of the texels.
+    let (nf, nb) = (texel_points(front, w, h).len() as f64, texel_points(back, w, h).len() as f64);
+    let share = nb / nf;
+    let expected = f64::from(radiosity_export::DIM_DENSITY).powi(2);
+    assert!((share / expected - 1.0).abs() < 0.5, "{nb} texels against {nf}: {share}");
+    assert_eq!(atlas.dim_sides, 1);
 }
