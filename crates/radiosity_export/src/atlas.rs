@@ -518,20 +518,29 @@ impl Locator {
 /// are, at most.
 const PROBES: usize = 256;
 
-/// Of the faces `faces` of object `o` seen from the side whose normals they have: how many
-/// of (up to [`PROBES`] of them, spread over the list) have an element facing that way under
-/// their centroid, and the area-weighted mean of the brightest channel of its radiosity.
+/// Points probed per face: the inner points of a lattice of this many steps per edge (a face
+/// may lie partly under a solid standing on it, left out of the solve, its centroid too).
+const PROBE_STEPS: u32 = 6;
+
+/// Of the faces `faces` of object `o` seen from the side whose normals they have: at how
+/// many points (spread over up to [`PROBES`] of them) an element facing that way lies, and
+/// the area-weighted mean of the brightest channel of its radiosity there.
 fn probe_side(mesh: &Mesh, solution: &Solution, locator: &Locator, o: usize, faces: &[Face]) -> (usize, f64) {
     let step = faces.len().div_ceil(PROBES).max(1);
     let (mut hits, mut sum, mut area) = (0, 0.0, 0.0);
     for (t, _) in faces.iter().step_by(step) {
         let n = (t[1] - t[0]).cross(t[2] - t[0]);
-        let centroid = (t[0] + t[1] + t[2]) / 3.0;
-        if let Some(found) = locator.find(mesh, solution, o, centroid, n.normalize(), true) {
-            let b = found.radiosity;
-            hits += 1;
-            sum += b.r.max(b.g).max(b.b) * n.length();
-            area += n.length();
+        for i in 1..PROBE_STEPS {
+            for j in 1..PROBE_STEPS - i {
+                let (a, b) = (f64::from(i) / f64::from(PROBE_STEPS), f64::from(j) / f64::from(PROBE_STEPS));
+                let point = t[0] * (1.0 - a - b) + t[1] * a + t[2] * b;
+                if let Some(found) = locator.find(mesh, solution, o, point, n.normalize(), true) {
+                    let b = found.radiosity;
+                    hits += 1;
+                    sum += b.r.max(b.g).max(b.b) * n.length();
+                    area += n.length();
+                }
+            }
         }
     }
     (hits, if area > 0.0 { sum / area } else { 0.0 })

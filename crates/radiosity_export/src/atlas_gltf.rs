@@ -161,7 +161,7 @@ pub fn atlas_gltf(
         "asset": { "version": "2.0", "generator": concat!("radiosity ", env!("CARGO_PKG_VERSION")),
             "extras": { "radiosity_lightmap": {
                 "texture": 0, "texCoord": 1, "quantity": options.quantity.as_str(), "unit": unit,
-                "hdr": ATLAS_FILES[1],
+                "hdr": ATLAS_FILES[1], "png_exposure_ev": tone.exposure_ev,
                 "png": format!("{}/pi tone-mapped ({}, {:+.3} EV), sRGB", options.quantity.as_str(),
                     tone.operator, tone.exposure_ev),
                 "texels_per_unit": atlas.texels_per_unit } } },
