@@ -1,7 +1,7 @@
 #!/usr/bin/env node
 // Shows a lightmapped glTF written by `radiosity export --lightmap-atlas DIR` as a game
-// engine would: three.js in headless Chromium (software WebGL), every material unlit and lit
-// by the lightmap alone (MeshBasicMaterial: albedo x lightMap, the lightmap being the linear
+// engine would: three.js in headless Chromium (software WebGL), emitters at their emissive
+// radiance, every other material unlit and lit by the lightmap alone (MeshBasicMaterial: albedo x lightMap, the lightmap being the linear
 // irradiance of DIR/lightmap.exr on TEXCOORD_1, times 1/pi), ACES tone mapping at the
 // exposure the PNG was made with. Saves the picture.
 //
@@ -74,6 +74,13 @@ try {
     // Irradiance E on a surface of albedo rho shows rho E / pi; radiosity B (the albedo
     // already in it) shows B / pi on white.
     const irradiance = info.quantity === 'irradiance';
+    if (m.emissive && m.emissiveIntensity * Math.max(m.emissive.r, m.emissive.g, m.emissive.b) > 0) {
+      // An emitter shows its own radiance: its emission M (factor x strength) over pi.
+      o.material = new THREE.MeshBasicMaterial({
+        color: m.emissive.clone().multiplyScalar(m.emissiveIntensity / Math.PI),
+      });
+      return;
+    }
     o.material = new THREE.MeshBasicMaterial({
       color: irradiance ? m.color : new THREE.Color(1, 1, 1), map: irradiance ? m.map : null,
       lightMap: lightmap, lightMapIntensity: s.png ? 1 : 1 / Math.PI,

@@ -228,6 +228,16 @@ fn the_lightmap_atlas_keeps_the_models_faces_and_texture() {
     let o = radiosity(&args);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("pass --force"), "{}", stderr(&o));
+    // A density needs an atlas, and a positive one.
+    let model = model.to_str().unwrap();
+    let lone = ["export", model, "-o", out.to_str().unwrap(), "--texels-per-unit", "10"];
+    let zero =
+        ["export", model, "-o", out.to_str().unwrap(), "--lightmap-atlas", "a", "--texels-per-unit", "0"];
+    for (args, needle) in [(&lone[..], "give --lightmap-atlas DIR too"), (&zero[..], "must be in (0, 1e6]")] {
+        let o = radiosity(args);
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        assert!(stderr(&o).contains(needle), "{}", stderr(&o));
+    }
 }
 
 /// A textured OBJ floor (a 4 × 4 PNG, clamped) under an untextured lamp, in `dir`; the OBJ's path.

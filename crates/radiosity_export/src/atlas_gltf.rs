@@ -88,10 +88,13 @@ pub fn atlas_gltf(
     // One glTF material per scene material used.
     let mut materials: Vec<Value> = Vec::new();
     let mut material_of = std::collections::HashMap::new();
+    let mut emissive = false;
     for m in &atlas.meshes {
         let object = &scene.objects[m.object];
         let material = &scene.materials[object.material];
-        let index = *material_of.entry(object.material).or_insert_with(|| {
+        // A side that does not emit (the back of a lamp) takes the material without its
+        // emission.
+        let index = *material_of.entry((object.material, m.emits)).or_insert_with(|| {
             let rho = material.reflectance.to_array().map(|c| c.clamp(0.0, 1.0));
             let mut pbr = json!({ "baseColorFactor": [rho[0], rho[1], rho[2], 1.0],
                 "metallicFactor": 0.0, "roughnessFactor": 1.0 });
@@ -114,8 +117,22 @@ pub fn atlas_gltf(
                 pbr["baseColorFactor"] = json!([f[0], f[1], f[2], 1.0]);
                 pbr["baseColorTexture"] = json!({ "index": textures.len() - 1, "texCoord": 0 });
             }
-            materials.push(json!({ "name": material.name, "pbrMetallicRoughness": pbr,
-                "extras": { "lightmap": { "index": 0, "texCoord": 1 } } }));
+            let name =
+                if m.emits { material.name.clone() } else { format!("{} (not emitting)", material.name) };
+            let mut entry = json!({ "name": name, "pbrMetallicRoughness": pbr,
+                "extras": { "lightmap": { "index": 0, "texCoord": 1 } } });
+            // An emitter's emission M (W per unit², as this program reads glTF back), the
+            // colour at most 1 and the rest in the strength: it shows M/π beside the
+            // lightmap's E/π.
+            let emission = if m.emits { material.emission.to_array() } else { [0.0; 3] };
+            let peak = emission.iter().copied().fold(0.0, f64::max);
+            if peak > 0.0 {
+                entry["emissiveFactor"] = json!(emission.map(|c| c / peak));
+                entry["extensions"] = json!({ "KHR_materials_emissive_strength": {
+                    "emissiveStrength": peak } });
+                emissive = true;
+            }
+            materials.push(entry);
             materials.len() - 1
         });
         let count = m.positions.len();
@@ -157,7 +174,7 @@ pub fn atlas_gltf(
         nodes.push(json!({ "name": name, "mesh": meshes.len() - 1 }));
     }
     let unit = "W per scene unit squared";
-    let doc = json!({
+    let mut doc = json!({
         "asset": { "version": "2.0", "generator": concat!("radiosity ", env!("CARGO_PKG_VERSION")),
             "extras": { "radiosity_lightmap": {
                 "texture": 0, "texCoord": 1, "quantity": options.quantity.as_str(), "unit": unit,
@@ -178,5 +195,8 @@ pub fn atlas_gltf(
         "buffers": [{ "byteLength": blob.len(),
             "uri": format!("data:application/octet-stream;base64,{}", base64(&blob)) }],
     });
+    if emissive {
+        doc["extensionsUsed"] = json!(["KHR_materials_emissive_strength"]);
+    }
     serde_json::to_string(&doc).expect("a JSON value serialises")
 }

@@ -203,3 +203,44 @@ fn both_sides_of_a_two_sided_object_get_charts() {
     assert!((share / expected - 1.0).abs() < 0.5, "{nb} texels against {nf}: {share}");
     assert_eq!(atlas.dim_sides, 1);
 }
+
+/// The written glTF reads back (with this program's own loader) as the same faces and the
+/// same lamps: its triangles' total area is the scene's, front sides plus each two-sided
+/// object's back, and its emitted power the scene's (the back of the lamp does not emit).
+#[test]
+fn the_written_gltf_reads_back_with_the_same_area_and_emission() {
+    let scene = cornell_box();
+    let (problem, solution) = solved(&scene, 50);
+    let options = AtlasOptions { size: 256, ..AtlasOptions::default() };
+    let atlas = bake_atlas(&scene, problem.mesh(), &solution, &options, AtlasTexels::Interpolated).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let tone = radiosity_image::ToneParams::new(0.0, radiosity_image::ToneOperator::Aces);
+    let written = radiosity_export::write_atlas(dir.path(), &scene, &atlas, &options, tone).unwrap();
+    assert_eq!(written.len(), 3);
+    let back = radiosity_io::load_scene(&dir.path().join("lightmapped.gltf")).unwrap().scene;
+    let totals = |s: &Scene| {
+        let (mut total, mut emitted) = (0.0, 0.0);
+        for o in &s.objects {
+            let a = match &o.shape {
+                radiosity_core::Shape::Polygons(p) => p.iter().map(|p| p.area()).sum::<f64>(),
+                radiosity_core::Shape::Mesh(m) => m.polygons().iter().map(|p| p.area()).sum::<f64>(),
+                radiosity_core::Shape::Sphere(_) => 0.0,
+            };
+            total += a;
+            emitted += a * s.materials[o.material].emission.g;
+        }
+        (total, emitted)
+    };
+    let ((a0, e0), (a1, e1)) = (totals(&scene), totals(&back));
+    let backs: f64 = atlas
+        .meshes
+        .iter()
+        .filter(|m| m.back)
+        .map(|m| match &scene.objects[m.object].shape {
+            radiosity_core::Shape::Polygons(p) => p.iter().map(|p| p.area()).sum::<f64>(),
+            _ => 0.0,
+        })
+        .sum();
+    assert!(((a0 + backs) / a1 - 1.0).abs() < 1e-6, "{a0} + {backs} vs {a1}");
+    assert!((e1 / e0 - 1.0).abs() < 1e-6, "emitted {e0} vs {e1}");
+}
