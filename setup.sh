@@ -11,6 +11,7 @@
 #   imagemagick            to inspect screenshots by hand (identify, compare)
 #   python3                scripts/real_rooms.py, run by tests/suite/rooms.rs
 #   nodejs, npm            (only when npm is missing) to install and run the glTF validator
+#                          and the lightmap readers (scripts/lightmap-view)
 set -euo pipefail
 
 packages=(
@@ -54,4 +55,15 @@ if [ -d "$validator_dir/node_modules/gltf-validator" ]; then
 else
   echo "setup.sh: installing gltf-validator (npm)"
   npm ci --prefix "$validator_dir" --no-audit --no-fund
+fi
+
+# glTF-Transform and three.js (npm, pinned by the lock file): tests/suite/export.rs reads the
+# lightmap atlas with them, as an engine would, and fails in CI when they are missing.
+# (playwright-core comes along for scripts/lightmap-view/view.mjs; it downloads no browser.)
+lightmap_dir="$(dirname "$0")/scripts/lightmap-view"
+if [ -d "$lightmap_dir/node_modules/@gltf-transform/core" ] && [ -d "$lightmap_dir/node_modules/three" ]; then
+  echo "setup.sh: lightmap readers present"
+else
+  echo "setup.sh: installing the lightmap readers (npm)"
+  npm ci --prefix "$lightmap_dir" --no-audit --no-fund
 fi

@@ -23,24 +23,8 @@ fn root() -> PathBuf {
 /// to install it.
 fn validate(files: &[&Path]) {
     let script = root().join("scripts/gltf-validator/validate.mjs");
-    let package = root().join("scripts/gltf-validator/node_modules/gltf-validator");
-    let node = Command::new("node").arg("--version").output();
-    let missing = match (&node, package.is_dir()) {
-        (Err(e), _) => Some(format!("node cannot be run ({e})")),
-        (Ok(_), false) => {
-            Some(format!("the npm package gltf-validator is not installed in {}", package.display()))
-        }
-        (Ok(_), true) => None,
-    };
-    if let Some(why) = missing {
-        let msg = format!(
-            "glTF VALIDATION NOT RUN: {why}; install it with ./setup.sh (or: npm ci --prefix scripts/gltf-validator)"
-        );
-        assert!(std::env::var_os("CI").is_none(), "{msg} — required in CI");
-        eprintln!("{msg}");
-        return;
-    }
-    let mut cmd = Command::new("node");
+    let Some(node) = node_package("gltf-validator", "gltf-validator") else { return };
+    let mut cmd = Command::new(node);
     cmd.arg(&script).args(files);
     let o = cmd.output().expect("run node");
     let out = String::from_utf8_lossy(&o.stdout);
@@ -238,6 +222,69 @@ fn the_lightmap_atlas_keeps_the_models_faces_and_texture() {
         assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
         assert!(stderr(&o).contains(needle), "{}", stderr(&o));
     }
+}
+
+/// The lightmap read as an engine reads it gives the solve's per-object means: the Cornell
+/// box's atlas (radiosity texels, no contact cuts so every face is solved whole) read by
+/// `scripts/lightmap-view/means.mjs` (glTF-Transform for the glTF, three.js's EXRLoader for
+/// the texels, sampled bilinearly at `TEXCOORD_1` over every triangle), against `solve
+/// --json` with the same settings: every object within 2 % (vertex interpolation and the
+/// texel grid aside; measured within 0.9 %).
+#[test]
+fn the_lightmap_read_through_texcoord_1_by_another_reader_gives_the_solves_means() {
+    let Some(node) = node_package("lightmap-view", "@gltf-transform/core") else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let (glb, atlas, report) =
+        (dir.path().join("lit.glb"), dir.path().join("atlas"), dir.path().join("s.json"));
+    let common = ["--contacts", "false", "--max-shots", "400", "-q"];
+    let o = radiosity(
+        &[
+            &["export", "cornell", "-o", glb.to_str().unwrap(), "--lightmap-atlas", atlas.to_str().unwrap()]
+                [..],
+            &["--lightmap-quantity", "radiosity", "--atlas-size", "512"],
+            &common,
+        ]
+        .concat(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = radiosity(&[&["solve", "cornell", "--json", report.to_str().unwrap()][..], &common].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let means = Command::new(node)
+        .arg(root().join("scripts/lightmap-view/means.mjs"))
+        .arg(atlas.join("lightmapped.gltf"))
+        .output()
+        .expect("run node");
+    assert!(means.status.success(), "{}", stderr(&means));
+    let means: serde_json::Value = serde_json::from_slice(&means.stdout).unwrap();
+    let solved: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    let objects = solved["objects"].as_array().unwrap();
+    assert_eq!(objects.len(), 16);
+    for object in objects {
+        let name = object["name"].as_str().unwrap();
+        let lightmap = &means[name];
+        for c in 0..3 {
+            let (got, want) = (lightmap[c].as_f64().unwrap(), object["radiosity"][c].as_f64().unwrap());
+            assert!(
+                (got - want).abs() <= 0.02 * want + 1e-9,
+                "{name} channel {c}: lightmap {got}, solve {want}"
+            );
+        }
+    }
+}
+
+/// `node` when the npm package `package` is installed in `scripts/<folder>`; `None` with a
+/// loud message otherwise, and a failure under CI (where `setup.sh` installs both).
+fn node_package(folder: &str, package: &str) -> Option<&'static str> {
+    let installed = root().join("scripts").join(folder).join("node_modules").join(package).is_dir();
+    let why = match (Command::new("node").arg("--version").output(), installed) {
+        (Err(e), _) => format!("node cannot be run ({e})"),
+        (Ok(_), false) => format!("the npm package {package} is not installed in scripts/{folder}"),
+        (Ok(_), true) => return Some("node"),
+    };
+    let msg = format!("NOT RUN: {why}; install it with ./setup.sh (or: npm ci --prefix scripts/{folder})");
+    assert!(std::env::var_os("CI").is_none(), "{msg} — required in CI");
+    eprintln!("{msg}");
+    None
 }
 
 /// A textured OBJ floor (a 4 × 4 PNG, clamped) under an untextured lamp, in `dir`; the OBJ's path.
