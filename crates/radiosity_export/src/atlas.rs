@@ -101,6 +101,9 @@ pub struct AtlasMesh {
     pub uv0: Option<Vec<[f64; 2]>>,
     /// Lightmap coordinates per vertex in [0, 1]² of the atlas, v down (row 0 at the top).
     pub uv1: Vec<[f32; 2]>,
+    /// Per vertex, the chart it lies in (numbered across the atlas); `u32::MAX` for a vertex
+    /// of degenerate triangles only.
+    pub chart: Vec<u32>,
     /// Triangles, three vertex indices each, wound so their normal is the side's.
     pub indices: Vec<u32>,
 }
@@ -242,6 +245,7 @@ pub fn bake_atlas(
                 positions: corners,
                 uv0,
                 uv1: Vec::new(),
+                chart: Vec::new(),
                 indices,
             });
         }
@@ -275,6 +279,7 @@ pub fn bake_atlas(
         m.uv0 = m.uv0.take().map(|uv| out.vertices.iter().map(|v| uv[v.xref as usize]).collect());
         m.positions = positions;
         m.uv1 = out.vertices.iter().map(|v| v.uv).collect();
+        m.chart = out.vertices.iter().map(|v| v.chart.unwrap_or(u32::MAX)).collect();
         m.indices = out.indices.clone();
     }
     let (w, h) = (atlas.width, atlas.height);

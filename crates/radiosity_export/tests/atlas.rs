@@ -147,6 +147,51 @@ fn the_padding_around_every_chart_is_filled() {
     assert!(atlas.meshes.iter().all(|m| m.uv1.iter().flatten().all(|c| (0.0..=1.0).contains(c))));
 }
 
+/// No texel of one chart samples another: every texel whose centre lies in a chart belongs
+/// to that chart alone, and the texels a bilinear lookup there reads (its 3 × 3
+/// neighbourhood), and the padding beyond, hold no other chart's texels.
+#[test]
+fn no_chart_samples_another() {
+    let scene = cornell_box();
+    let (problem, solution) = solved(&scene, 50);
+    let atlas = bake(&scene, problem.mesh(), &solution, LightmapQuantity::Radiosity);
+    let (w, h) = (atlas.image.width(), atlas.image.height());
+    let mut owner = vec![u32::MAX; (w * h) as usize];
+    for m in &atlas.meshes {
+        for tri in m.indices.chunks_exact(3) {
+            let chart = m.chart[tri[0] as usize];
+            assert!(tri.iter().all(|&v| m.chart[v as usize] == chart), "a triangle spans charts");
+            let one = AtlasMesh { indices: tri.to_vec(), ..m.clone() };
+            for (x, y, _, _) in texel_points(&one, w, h) {
+                let slot = &mut owner[(y * w + x) as usize];
+                assert!(*slot == u32::MAX || *slot == chart, "texel ({x}, {y}) in two charts");
+                *slot = chart;
+            }
+        }
+    }
+    let reach = AtlasOptions::default().padding as i64;
+    for y in 0..h as i64 {
+        for x in 0..w as i64 {
+            let chart = owner[(y * w as i64 + x) as usize];
+            if chart == u32::MAX {
+                continue;
+            }
+            for dy in -reach..=reach {
+                for dx in -reach..=reach {
+                    let (nx, ny) = (x + dx, y + dy);
+                    if (0..w as i64).contains(&nx) && (0..h as i64).contains(&ny) {
+                        let other = owner[(ny * w as i64 + nx) as usize];
+                        assert!(
+                            other == u32::MAX || other == chart,
+                            "({x}, {y}) of chart {chart} beside chart {other}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
+
 /// Irradiance texels times the reflectance are the radiosity texels, off the light; the
 /// bake is the same twice over.
 #[test]
