@@ -289,3 +289,29 @@ fn the_written_gltf_reads_back_with_the_same_area_and_emission() {
     assert!(((a0 + backs) / a1 - 1.0).abs() < 1e-6, "{a0} + {backs} vs {a1}");
     assert!((e1 / e0 - 1.0).abs() < 1e-6, "emitted {e0} vs {e1}");
 }
+
+/// A fixed density is kept: the Cornell box (a 556 mm room) at 0.2 texels per millimetre
+/// gets charts whose texel area is the faces' area times 0.2², within the rasterisation's
+/// edge texels.
+#[test]
+fn a_fixed_density_sizes_the_charts() {
+    let scene = cornell_box();
+    let (problem, solution) = solved(&scene, 20);
+    let options = AtlasOptions { texels_per_unit: Some(0.2), ..AtlasOptions::default() };
+    let atlas = bake_atlas(&scene, problem.mesh(), &solution, &options, AtlasTexels::Interpolated).unwrap();
+    assert!((atlas.texels_per_unit - 0.2).abs() < 1e-6, "{}", atlas.texels_per_unit);
+    let (w, h) = (atlas.image.width(), atlas.image.height());
+    for m in atlas.meshes.iter().filter(|m| !m.back) {
+        let area: f64 = m
+            .indices
+            .chunks_exact(3)
+            .map(|t| {
+                let p = |k: usize| m.positions[t[k] as usize];
+                0.5 * (p(1) - p(0)).cross(p(2) - p(0)).length()
+            })
+            .sum();
+        let texels = texel_points(m, w, h).len() as f64;
+        let expected = area * 0.2 * 0.2;
+        assert!((texels / expected - 1.0).abs() < 0.1, "object {}: {texels} texels for {expected}", m.object);
+    }
+}
