@@ -1,7 +1,7 @@
 //! `radiosity export`: solve a scene (or a model file) and write the lit mesh as glTF, GLB or
 //! PLY with baked vertex colours, and optionally per-object lightmaps.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 use clap::Args;
@@ -10,11 +10,12 @@ use radiosity_export::{
     atlas_radiance, bake_atlas, write_atlas,
 };
 use radiosity_image::{Gather, HdrImage, RenderParams, Renderer, ToneOperator, ToneParams};
+use radiosity_solver::Solution;
 
 use crate::errors::InputError;
 use crate::output::{self, Targets, note};
 use crate::picture_opts::{GatherArg, ToneOpts};
-use crate::prepare::{prepare, run_solver};
+use crate::prepare::{Prepared, prepare, run_solver};
 use crate::progress::spinning;
 use crate::solve_opts::SolveOpts;
 
@@ -25,8 +26,9 @@ pub struct ExportArgs {
     #[arg(help = crate::solve_opts::SCENE_HELP)]
     pub scene: String,
     /// Lit mesh to write: .glb, .gltf (buffer embedded) or .ply (binary little endian).
+    /// Needed unless --lightmap or --lightmap-atlas is given.
     #[arg(short = 'o', long = "output")]
-    pub output: PathBuf,
+    pub output: Option<PathBuf>,
     /// glTF COLOR_0: the tone-mapped display colour (see --exposure, --tonemap) instead of
     /// exposed linear radiance clamped to 1. Exact radiosity is always in _RADIOSITY (glTF) or
     /// radiosity_r/g/b (PLY).
@@ -101,12 +103,23 @@ fn positive_density(text: &str) -> Result<f64, String> {
 /// Bad scene or options, an unknown output extension, an existing output without --force
 /// (exit code 2), or a file that cannot be written.
 pub fn run(a: ExportArgs) -> Result<()> {
-    let format = ExportFormat::from_path(&a.output).ok_or_else(|| {
-        InputError(format!("{}: unknown output format; expected .glb, .gltf or .ply", a.output.display()))
-    })?;
+    let format = match &a.output {
+        Some(path) => Some(ExportFormat::from_path(path).ok_or_else(|| {
+            InputError(format!("{}: unknown output format; expected .glb, .gltf or .ply", path.display()))
+        })?),
+        None if a.lightmap.is_none() && a.lightmap_atlas.is_none() => {
+            return Err(InputError(
+                "nothing to write: give -o FILE (a lit mesh), --lightmap DIR or --lightmap-atlas DIR".into(),
+            )
+            .into());
+        }
+        None => None,
+    };
     // Refuse before solving, so a long solve is not lost to an existing file.
     let mut targets = Targets::new(a.force);
-    targets.file(&a.output, "-o")?;
+    if let Some(path) = &a.output {
+        targets.file(path, "-o")?;
+    }
     if let Some(dir) = &a.lightmap {
         targets.folder(dir, "lightmapped.obj", "--lightmap")?;
     }
@@ -131,7 +144,45 @@ pub fn run(a: ExportArgs) -> Result<()> {
     // as large as the picture's inputs.
     drop(solver);
     let mesh = prepared.problem.mesh();
+    note(format_args!(
+        "{}: {} patches, {} elements, {} shots, unshot {:.4} %",
+        prepared.scene.name,
+        mesh.patches.len(),
+        mesh.elements.len(),
+        report.total_shots,
+        report.unshot_fraction * 100.0
+    ))?;
+    if let (Some(path), Some(format)) = (&a.output, format) {
+        write_lit_mesh(&a, path, format, &prepared, &solution)?;
+    }
+    if let Some(dir) = &a.lightmap {
+        write_cells(&a, dir, &prepared, &solution)?;
+    }
+    if let Some(dir) = &a.lightmap_atlas {
+        write_atlas_folder(&a, dir, &prepared, &solution)?;
+    }
+    Ok(())
+}
 
+/// The renderer and its settings when `--gather` asks for texels gathered per point.
+fn gatherer(
+    a: &ExportArgs,
+    mesh: &std::sync::Arc<radiosity_mesh::Mesh>,
+) -> (Gather, Option<Renderer>, RenderParams) {
+    let gather = Gather::from(a.gather);
+    let renderer = (gather != Gather::None).then(|| Renderer::new(mesh.clone()));
+    (gather, renderer, RenderParams { gather, seed: a.solve.seed, ..RenderParams::default() })
+}
+
+/// Writes the lit element mesh to `path` in `format`.
+fn write_lit_mesh(
+    a: &ExportArgs,
+    path: &Path,
+    format: ExportFormat,
+    prepared: &Prepared,
+    solution: &Solution,
+) -> Result<()> {
+    let mesh = prepared.problem.mesh();
     // The exposure for display colours: fixed, or the elements metered as a picture's pixels
     // are (lit part to middle grey, capped under white; there is no picture to measure, so
     // the scene itself is used).
@@ -149,22 +200,14 @@ pub fn run(a: ExportArgs) -> Result<()> {
         ExportFormat::Ply => Vec::new(),
         ExportFormat::Glb | ExportFormat::Gltf => radiosity_image::element_uvs(&prepared.scene, mesh),
     };
-    spinning(&format!("writing {}", a.output.display()), || {
+    spinning(&format!("writing {}", path.display()), || {
         let bytes = match format {
-            ExportFormat::Glb => radiosity_export::glb_bytes(mesh, &solution, mode, &uvs),
-            ExportFormat::Gltf => radiosity_export::gltf_text(mesh, &solution, mode, &uvs).into_bytes(),
-            ExportFormat::Ply => radiosity_export::ply_bytes(mesh, &solution, tone, prepared.up),
+            ExportFormat::Glb => radiosity_export::glb_bytes(mesh, solution, mode, &uvs),
+            ExportFormat::Gltf => radiosity_export::gltf_text(mesh, solution, mode, &uvs).into_bytes(),
+            ExportFormat::Ply => radiosity_export::ply_bytes(mesh, solution, tone, prepared.up),
         };
-        output::write_file(&a.output, a.force, &bytes)
+        output::write_file(path, a.force, &bytes)
     })?;
-    note(format_args!(
-        "{}: {} patches, {} elements, {} shots, unshot {:.4} %",
-        prepared.scene.name,
-        mesh.patches.len(),
-        mesh.elements.len(),
-        report.total_shots,
-        report.unshot_fraction * 100.0
-    ))?;
     let colours = match (format, a.tonemapped) {
         (ExportFormat::Ply, _) => format!(
             "display colours ({}, {ev:+.2} EV) and linear radiosity",
@@ -177,67 +220,69 @@ pub fn run(a: ExportArgs) -> Result<()> {
         ExportFormat::Ply => mesh.positions.len(),
         ExportFormat::Glb | ExportFormat::Gltf => radiosity_export::gltf_vertex_count(mesh, &uvs),
     };
-    note(format_args!("wrote {} ({vertices} vertices, {colours})", a.output.display()))?;
-    if let Some(dir) = &a.lightmap {
-        let gather = Gather::from(a.gather);
-        let renderer = (gather != Gather::None).then(|| Renderer::new(mesh.clone()));
-        let params = RenderParams { gather, seed: a.solve.seed, ..RenderParams::default() };
-        let texels = match &renderer {
-            Some(renderer) => Texels::Gathered { renderer, params: &params },
-            None => Texels::Interpolated,
-        };
-        let what = format!(
-            "baking lightmaps ({} texels a cell, gather {})",
-            radiosity_export::LIGHTMAP_CELL_TEXELS.pow(2),
-            gather.as_str()
-        );
-        let count = spinning(&what, || {
-            output::write_folder(dir, a.force, |staging| {
-                radiosity_export::write_lightmaps(staging, mesh, &solution, texels, prepared.up)
-            })
-        })?;
-        note(format_args!("wrote {count} lightmap files into {}", dir.display()))?;
-    }
-    if let Some(dir) = &a.lightmap_atlas {
-        let gather = Gather::from(a.gather);
-        let renderer = (gather != Gather::None).then(|| Renderer::new(mesh.clone()));
-        let params = RenderParams { gather, seed: a.solve.seed, ..RenderParams::default() };
-        let texels = match &renderer {
-            Some(renderer) => AtlasTexels::Gathered { renderer, params: &params },
-            None => AtlasTexels::Interpolated,
-        };
-        let options = AtlasOptions {
-            texels_per_unit: a.texels_per_unit,
-            size: a.atlas_size,
-            quantity: a.lightmap_quantity.into(),
-            ..AtlasOptions::default()
-        };
-        let what = format!("unwrapping and baking the lightmap atlas (gather {})", gather.as_str());
-        let atlas = spinning(&what, || bake_atlas(&prepared.scene, mesh, &solution, &options, texels))
-            .map_err(|e| InputError(format!("--lightmap-atlas: {e}")))?;
-        let ev = a.tone.exposure.ev_for(&atlas_radiance(&atlas));
-        let tone = ToneParams::new(ev, a.tone.tonemap.into());
-        spinning(&format!("writing {}", dir.display()), || {
-            output::write_folder(dir, a.force, |staging| {
-                write_atlas(staging, &prepared.scene, &atlas, &options, tone)
-            })
-        })?;
-        note(format_args!(
-            "wrote {} into {}: {}x{} texels, {:.2} texels per unit, {} charts, {} of {} face texels \
-             without an element under them (filled from their neighbours){}",
-            ATLAS_FILES.join(", "),
-            dir.display(),
-            atlas.image.width(),
-            atlas.image.height(),
-            atlas.texels_per_unit,
-            atlas.charts,
-            atlas.missed,
-            atlas.covered,
-            match atlas.dim_sides {
-                0 => String::new(),
-                n => format!("; {n} dim sides (the outside of a room) at an eighth of the density"),
-            }
-        ))?;
-    }
-    Ok(())
+    note(format_args!("wrote {} ({vertices} vertices, {colours})", path.display()))
+}
+
+/// Writes the per-element lightmap cells and their OBJ into `dir` (`--lightmap`).
+fn write_cells(a: &ExportArgs, dir: &Path, prepared: &Prepared, solution: &Solution) -> Result<()> {
+    let mesh = prepared.problem.mesh();
+    let (gather, renderer, params) = gatherer(a, mesh);
+    let texels = match &renderer {
+        Some(renderer) => Texels::Gathered { renderer, params: &params },
+        None => Texels::Interpolated,
+    };
+    let what = format!(
+        "baking lightmaps ({} texels a cell, gather {})",
+        radiosity_export::LIGHTMAP_CELL_TEXELS.pow(2),
+        gather.as_str()
+    );
+    let count = spinning(&what, || {
+        output::write_folder(dir, a.force, |staging| {
+            radiosity_export::write_lightmaps(staging, mesh, solution, texels, prepared.up)
+        })
+    })?;
+    note(format_args!("wrote {count} lightmap files into {}", dir.display()))
+}
+
+/// Unwraps the scene's faces into one atlas, bakes it and writes its files into `dir`
+/// (`--lightmap-atlas`).
+fn write_atlas_folder(a: &ExportArgs, dir: &Path, prepared: &Prepared, solution: &Solution) -> Result<()> {
+    let mesh = prepared.problem.mesh();
+    let (gather, renderer, params) = gatherer(a, mesh);
+    let texels = match &renderer {
+        Some(renderer) => AtlasTexels::Gathered { renderer, params: &params },
+        None => AtlasTexels::Interpolated,
+    };
+    let options = AtlasOptions {
+        texels_per_unit: a.texels_per_unit,
+        size: a.atlas_size,
+        quantity: a.lightmap_quantity.into(),
+        ..AtlasOptions::default()
+    };
+    let what = format!("unwrapping and baking the lightmap atlas (gather {})", gather.as_str());
+    let atlas = spinning(&what, || bake_atlas(&prepared.scene, mesh, solution, &options, texels))
+        .map_err(|e| InputError(format!("--lightmap-atlas: {e}")))?;
+    let ev = a.tone.exposure.ev_for(&atlas_radiance(&atlas));
+    let tone = ToneParams::new(ev, a.tone.tonemap.into());
+    spinning(&format!("writing {}", dir.display()), || {
+        output::write_folder(dir, a.force, |staging| {
+            write_atlas(staging, &prepared.scene, &atlas, &options, tone)
+        })
+    })?;
+    note(format_args!(
+        "wrote {} into {}: {}x{} texels, {:.2} texels per unit, {} charts, {} of {} face texels \
+         without an element under them (filled from their neighbours){}",
+        ATLAS_FILES.join(", "),
+        dir.display(),
+        atlas.image.width(),
+        atlas.image.height(),
+        atlas.texels_per_unit,
+        atlas.charts,
+        atlas.missed,
+        atlas.covered,
+        match atlas.dim_sides {
+            0 => String::new(),
+            n => format!("; {n} dim sides (the outside of a room) at an eighth of the density"),
+        }
+    ))
 }

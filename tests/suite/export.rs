@@ -162,7 +162,7 @@ fn existing_output_and_bad_input_are_one_line_errors_with_exit_code_2() {
 /// the PNG; every primitive has the lightmap's `TEXCOORD_1` in [0, 1] and its material points
 /// at the lightmap texture on set 1; the floor keeps its own `vt` as `TEXCOORD_0` under its
 /// texture (clamped as loaded); the validator finds no error; a second run without --force
-/// refuses to overwrite.
+/// refuses to overwrite; the atlas alone needs no `-o`.
 #[test]
 fn the_lightmap_atlas_keeps_the_models_faces_and_texture() {
     let dir = tempfile::tempdir().unwrap();
@@ -212,12 +212,28 @@ fn the_lightmap_atlas_keeps_the_models_faces_and_texture() {
     let o = radiosity(&args);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("pass --force"), "{}", stderr(&o));
+    let alone = dir.path().join("alone");
+    let o = radiosity(&[
+        "export",
+        model.to_str().unwrap(),
+        "--lightmap-atlas",
+        alone.to_str().unwrap(),
+        "--max-shots",
+        "5",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(alone.join("lightmapped.gltf").is_file());
     // A density needs an atlas, and a positive one.
     let model = model.to_str().unwrap();
     let lone = ["export", model, "-o", out.to_str().unwrap(), "--texels-per-unit", "10"];
     let zero =
         ["export", model, "-o", out.to_str().unwrap(), "--lightmap-atlas", "a", "--texels-per-unit", "0"];
-    for (args, needle) in [(&lone[..], "give --lightmap-atlas DIR too"), (&zero[..], "must be in (0, 1e6]")] {
+    let nothing = ["export", model, "--max-shots", "5"];
+    for (args, needle) in [
+        (&lone[..], "give --lightmap-atlas DIR too"),
+        (&zero[..], "must be in (0, 1e6]"),
+        (&nothing[..], "nothing to write: give -o FILE"),
+    ] {
         let o = radiosity(args);
         assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
         assert!(stderr(&o).contains(needle), "{}", stderr(&o));
