@@ -66,6 +66,21 @@ pub fn run(a: SolveArgs) -> Result<()> {
         report.unshot_fraction * 100.0,
         stop
     ))?;
+    // The parts of surfaces that solids stand on are left out of the mesh: an object's mean is
+    // over what was meshed, where `verify` spreads it over the whole input area.
+    let covered: Vec<(usize, f64)> =
+        mesh.hidden_area.iter().copied().enumerate().filter(|&(_, h)| h > 0.0).collect();
+    if !covered.is_empty() {
+        let total: f64 = covered.iter().map(|&(_, h)| h).sum();
+        let who = match covered.len() {
+            1 => "1 object has parts covered by solids standing on it".to_owned(),
+            n => format!("{n} objects have parts covered by solids standing on them"),
+        };
+        output::note(format_args!(
+            "note: {who} ({total:.4e} unit² in all), left out of the solve: means are over the \
+             meshed area (`verify` spreads them over the whole input area; the JSON's covered_area)"
+        ))?;
+    }
     if a.json.as_deref() != Some("-") {
         let mut table = format!(
             "{:<24} {:>12} {:>36} {:>36}\n",
@@ -112,6 +127,9 @@ pub fn run(a: SolveArgs) -> Result<()> {
                 });
                 if let Some(back) = o.radiosity_back {
                     entry["radiosity_back"] = json!(back.to_array());
+                }
+                if let Some(&hidden) = mesh.hidden_area.get(i).filter(|&&h| h > 0.0) {
+                    entry["covered_area"] = json!(hidden);
                 }
                 if scene.lighting.is_photometric() {
                     let (luminance, illuminance) = crate::lighting_cmd::object_photometry(scene, i, o);

@@ -625,3 +625,27 @@ fn full_gather_pictures_default_to_64_samples_per_pixel() {
         assert!(out.contains(said), "{args:?}: wanted {said:?} in {out}");
     }
 }
+
+/// Where solids stand on a surface, `solve` says what it left out: the Cornell floor's
+/// `covered_area` (under the two blocks) and its meshed `area` add up to the floor's input
+/// polygon, the area `verify` spreads the floor's mean over; a note says so once.
+#[test]
+fn solve_reports_the_area_covered_by_solids() {
+    let o = radiosity(&["solve", "cornell", "--max-shots", "5", "--json", "-", "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let doc: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let floor = doc["objects"].as_array().unwrap().iter().find(|o| o["name"] == "floor").unwrap();
+    let (meshed, covered) = (floor["area"].as_f64().unwrap(), floor["covered_area"].as_f64().unwrap());
+    let scene = radiosity_io::load_scene(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.toml"))
+        .unwrap()
+        .scene;
+    let input: f64 = match &scene.objects.iter().find(|o| o.name == "floor").unwrap().shape {
+        radiosity_core::Shape::Polygons(p) => p.iter().map(|p| p.area()).sum(),
+        _ => unreachable!("the Cornell floor is a polygon"),
+    };
+    assert!(covered > 0.1 * input && covered < 0.3 * input, "{covered} of {input}");
+    assert!(((meshed + covered) / input - 1.0).abs() < 1e-9, "{meshed} + {covered} vs {input}");
+    let ceiling = doc["objects"].as_array().unwrap().iter().find(|o| o["name"] == "ceiling").unwrap();
+    assert!(ceiling.get("covered_area").is_none(), "nothing stands on the ceiling");
+    assert_eq!(stderr(&o).matches("covered by solids standing on it").count(), 1, "{}", stderr(&o));
+}
