@@ -15,8 +15,8 @@ use radiosity_core::{Camera, Material, Rgb, Sides, Wrap, unique_names};
 
 use crate::LoadError;
 use crate::model::{
-    DEFAULT_GREY, DecodedImage, Model, ModelPart, PartBuilder, Transform, clamp_reflectance, model_error,
-    model_material, specular_warning,
+    DEFAULT_GREY, DecodedImage, Model, ModelPart, PartBuilder, Transform, alpha_warning, clamp_reflectance,
+    model_error, model_material, specular_warning,
 };
 use crate::texture_map::UvTransform;
 
@@ -323,6 +323,17 @@ pub(crate) fn parse_gltf(
                         &name,
                         &format!("KHR_materials_transmission {transmission}"),
                     ));
+                }
+                match m.alpha_mode() {
+                    gltf::material::AlphaMode::Opaque => {}
+                    gltf::material::AlphaMode::Mask => warnings.push(alpha_warning(
+                        origin,
+                        &name,
+                        &format!("alphaMode MASK, alphaCutoff {}", m.alpha_cutoff().unwrap_or(0.5)),
+                    )),
+                    gltf::material::AlphaMode::Blend => {
+                        warnings.push(alpha_warning(origin, &name, "alphaMode BLEND"))
+                    }
                 }
                 let strength = m.emissive_strength().unwrap_or(1.0) as f64;
                 let emission = m.emissive_factor().map(|v| v as f64 * strength);

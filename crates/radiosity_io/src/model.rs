@@ -206,6 +206,15 @@ pub(crate) fn specular_warning(origin: &str, name: &str, why: &str) -> String {
     format!("material '{name}' ({origin}) is specular/transmissive ({why}); treated as diffuse")
 }
 
+/// The warning for a material whose alpha mask (`why`: glTF's `alphaMode`, MTL's `map_d`) is
+/// not applied: its faces are whole, opaque sheets, in the solve, the pictures and the
+/// reference alike (foliage casts rectangles).
+pub(crate) fn alpha_warning(origin: &str, name: &str, why: &str) -> String {
+    format!(
+        "material '{name}' ({origin}) has an alpha mask ({why}) that is not applied: its faces are solid and block light whole"
+    )
+}
+
 /// A colour texture read from a file: its 8-bit sRGB texels and their mean linear colour.
 pub(crate) struct DecodedImage {
     width: u32,

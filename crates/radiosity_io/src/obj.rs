@@ -16,8 +16,8 @@ use radiosity_core::{Sides, unique_names};
 
 use crate::LoadError;
 use crate::model::{
-    DEFAULT_GREY, MAX_TEXT_BYTES, Model, ModelPart, PartBuilder, Transform, clamp_reflectance, model_error,
-    model_material, read_input_file, read_texture, specular_warning,
+    DEFAULT_GREY, MAX_TEXT_BYTES, Model, ModelPart, PartBuilder, Transform, alpha_warning, clamp_reflectance,
+    model_error, model_material, read_input_file, read_texture, specular_warning,
 };
 use crate::texture_map::{UvTransform, parse_map_kd};
 
@@ -363,6 +363,9 @@ pub(crate) fn parse_obj(
                     let reflectance = clamp_reflectance(mtl_origin, &m.name, reflectance, warnings);
                     if let Some(why) = specular_reason(m) {
                         warnings.push(specular_warning(mtl_origin, &m.name, &why));
+                    }
+                    if let Some(mask) = &m.dissolve_texture {
+                        warnings.push(alpha_warning(mtl_origin, &m.name, &format!("map_d {mask}")));
                     }
                     let emission = m.emissive.unwrap_or([0.0; 3]);
                     // Name the line of the value at fault: Kd unless only the emission is wrong.

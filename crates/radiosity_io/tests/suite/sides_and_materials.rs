@@ -246,6 +246,40 @@ fn specular_and_transmissive_materials_are_diffuse_with_a_warning() {
     assert!(m.warnings[0].contains("KHR_materials_transmission 0.9"), "{:?}", m.warnings);
 }
 
+/// An alpha mask (MTL `map_d`, glTF `alphaMode` MASK or BLEND) is not applied yet: the
+/// material loads whole, with a warning that says so; an opaque glTF material says nothing.
+#[test]
+fn alpha_masked_materials_load_whole_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "m.mtl", "newmtl leaves\nKd 0.3 0.5 0.2\nmap_d leaves_mask.png\n");
+    write(dir.path(), "m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl leaves\nf 1 2 3\n");
+    let m = load_model(&dir.path().join("m.obj"), &Transform::default()).unwrap();
+    let path = dir.path().join("m.mtl").display().to_string();
+    assert_eq!(
+        m.warnings,
+        [format!(
+            "material 'leaves' ({path}) has an alpha mask (map_d leaves_mask.png) that is not applied: its faces are solid and block light whole"
+        )]
+    );
+    let m = gltf_model(
+        r#"{"name":"chain","alphaMode":"MASK","alphaCutoff":0.3,"pbrMetallicRoughness":{"metallicFactor":0,"baseColorFactor":[0.5,0.5,0.5,1]}}"#,
+    );
+    assert_eq!(
+        m.warnings,
+        [
+            "material 'chain' (m.gltf) has an alpha mask (alphaMode MASK, alphaCutoff 0.3) that is not applied: its faces are solid and block light whole"
+        ]
+    );
+    let m = gltf_model(
+        r#"{"name":"veil","alphaMode":"BLEND","pbrMetallicRoughness":{"metallicFactor":0,"baseColorFactor":[0.5,0.5,0.5,1]}}"#,
+    );
+    assert!(m.warnings.len() == 1 && m.warnings[0].contains("(alphaMode BLEND)"), "{:?}", m.warnings);
+    let m = gltf_model(
+        r#"{"name":"wall","alphaMode":"OPAQUE","pbrMetallicRoughness":{"metallicFactor":0,"baseColorFactor":[0.5,0.5,0.5,1]}}"#,
+    );
+    assert!(m.warnings.is_empty(), "{:?}", m.warnings);
+}
+
 #[test]
 fn an_obj_texture_scales_kd_by_its_mean_and_a_missing_one_is_a_warning() {
     let dir = tempfile::tempdir().unwrap();
