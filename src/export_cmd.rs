@@ -7,7 +7,7 @@ use anyhow::Result;
 use clap::Args;
 use radiosity_export::{
     ATLAS_FILES, AtlasOptions, AtlasTexels, ExportFormat, LightmapQuantity, Texels, VertexColours,
-    atlas_radiance, bake_atlas, write_atlas,
+    atlas_radiance, bake_atlas, bake_source_atlas, write_atlas, write_source_atlas,
 };
 use radiosity_image::{Gather, HdrImage, RenderParams, Renderer, ToneOperator, ToneParams};
 use radiosity_solver::Solution;
@@ -260,13 +260,30 @@ fn write_atlas_folder(a: &ExportArgs, dir: &Path, prepared: &Prepared, solution:
         ..AtlasOptions::default()
     };
     let what = format!("unwrapping and baking the lightmap atlas (gather {})", gather.as_str());
-    let atlas = spinning(&what, || bake_atlas(&prepared.scene, mesh, solution, &options, texels))
+    // A glTF model is kept as it is (its nodes, materials, normals), its primitives given
+    // the lightmap's coordinates; any other input is written as the scene's faces.
+    let path = Path::new(&a.scene);
+    let is_gltf = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"));
+    let (atlas, source) = if is_gltf && path.is_file() {
+        let (atlas, source) = spinning(&what, || {
+            bake_source_atlas(path, prepared.up, &prepared.scene, mesh, solution, &options, texels)
+        })
         .map_err(|e| InputError(format!("--lightmap-atlas: {e}")))?;
+        (atlas, Some(source))
+    } else {
+        let atlas = spinning(&what, || bake_atlas(&prepared.scene, mesh, solution, &options, texels))
+            .map_err(|e| InputError(format!("--lightmap-atlas: {e}")))?;
+        (atlas, None)
+    };
     let ev = a.tone.exposure.ev_for(&atlas_radiance(&atlas));
     let tone = ToneParams::new(ev, a.tone.tonemap.into());
     spinning(&format!("writing {}", dir.display()), || {
-        output::write_folder(dir, a.force, |staging| {
-            write_atlas(staging, &prepared.scene, &atlas, &options, tone)
+        output::write_folder(dir, a.force, |staging| match &source {
+            Some(source) => write_source_atlas(staging, source, &atlas, &options, tone),
+            None => write_atlas(staging, &prepared.scene, &atlas, &options, tone),
         })
     })?;
     note(format_args!(

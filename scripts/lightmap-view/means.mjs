@@ -2,7 +2,7 @@
 // Per-object means of a lightmap atlas, read as an engine reads it: the glTF written by
 // `radiosity export --lightmap-atlas DIR` through glTF-Transform (a glTF reader this project
 // did not write), its lightmap EXR through three.js's EXRLoader, the texels sampled
-// bilinearly at TEXCOORD_1 over a lattice of points on every triangle, weighted by area.
+// bilinearly at its texture coordinate set (TEXCOORD_1, or the one the file names) over a lattice of points on every triangle, weighted by area.
 // Prints one JSON object: mesh name -> [r, g, b].
 //
 // Usage: node scripts/lightmap-view/means.mjs DIR/lightmapped.gltf
@@ -53,7 +53,7 @@ for (const node of doc.getRoot().listNodes()) {
   let area = 0;
   for (const prim of mesh.listPrimitives()) {
     const pos = prim.getAttribute('POSITION');
-    const uv = prim.getAttribute('TEXCOORD_1');
+    const uv = prim.getAttribute(`TEXCOORD_${info.texCoord}`);
     const idx = prim.getIndices();
     for (let t = 0; t < idx.getCount(); t += 3) {
       const k = [idx.getScalar(t), idx.getScalar(t + 1), idx.getScalar(t + 2)];

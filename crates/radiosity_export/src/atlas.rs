@@ -104,6 +104,9 @@ pub struct AtlasMesh {
     /// Per vertex, the chart it lies in (numbered across the atlas); `u32::MAX` for a vertex
     /// of degenerate triangles only.
     pub chart: Vec<u32>,
+    /// Per vertex, the unwrap's input vertex it was made from (vertices are split along the
+    /// charts' seams).
+    pub xref: Vec<u32>,
     /// Triangles, three vertex indices each, wound so their normal is the side's.
     pub indices: Vec<u32>,
 }
@@ -140,6 +143,9 @@ pub enum AtlasError {
     /// The charts did not fit one page.
     #[error("the charts take {0} pages of {1}²: give a larger --atlas-size or fewer --texels-per-unit")]
     Pages(u32, u32),
+    /// The model file could not be read again, or holds what the atlas cannot rewrite.
+    #[error("{0}")]
+    Source(String),
     /// A gather failed.
     #[error(transparent)]
     Gather(#[from] RenderError),
@@ -207,7 +213,7 @@ pub fn bake_atlas(
 ) -> Result<Atlas, AtlasError> {
     let mut meshes = Vec::new();
     let mut inputs: Vec<(Vec<[f32; 3]>, Vec<u32>)> = Vec::new();
-    let locator = Locator::new(scene, mesh);
+    let locator = Locator::new(scene, mesh, false);
     let scene_mean = mean_radiosity(mesh, solution, 0..mesh.elements.len());
     let mut scales = Vec::new();
     for o in 0..scene.objects.len() {
@@ -246,10 +252,33 @@ pub fn bake_atlas(
                 uv0,
                 uv1: Vec::new(),
                 chart: Vec::new(),
+                xref: Vec::new(),
                 indices,
             });
         }
     }
+    unwrap_and_bake(mesh, solution, options, texels, &locator, Unwrapping { meshes, inputs, scales })
+}
+
+/// What goes into one unwrap: the meshes, their positions and triangles as the unwrap takes
+/// them, and each one's density against the rest.
+pub(crate) struct Unwrapping {
+    pub(crate) meshes: Vec<AtlasMesh>,
+    pub(crate) inputs: Vec<(Vec<[f32; 3]>, Vec<u32>)>,
+    pub(crate) scales: Vec<f32>,
+}
+
+/// Unwraps `work` into one atlas and bakes `solution` on `mesh` into it, texels found by
+/// `locator`.
+pub(crate) fn unwrap_and_bake(
+    mesh: &Mesh,
+    solution: &Solution,
+    options: &AtlasOptions,
+    texels: AtlasTexels<'_>,
+    locator: &Locator,
+    work: Unwrapping,
+) -> Result<Atlas, AtlasError> {
+    let Unwrapping { mut meshes, inputs, scales } = work;
     if meshes.is_empty() {
         return Err(AtlasError::Empty);
     }
@@ -280,6 +309,7 @@ pub fn bake_atlas(
         m.positions = positions;
         m.uv1 = out.vertices.iter().map(|v| v.uv).collect();
         m.chart = out.vertices.iter().map(|v| v.chart.unwrap_or(u32::MAX)).collect();
+        m.xref = out.vertices.iter().map(|v| v.xref).collect();
         m.indices = out.indices.clone();
     }
     let (w, h) = (atlas.width, atlas.height);
@@ -421,7 +451,7 @@ struct Found {
 /// its element triangles (a quad split in two): its front surfaces' and its back surfaces'
 /// (a two-sided object's twins), so that the coplanar twin of an element is never in the
 /// same structure and the nearest hit along the face's normal is one element.
-struct Locator {
+pub(crate) struct Locator {
     /// Per (object, back surfaces): the structure and, per triangle, its element and corners.
     parts: HashMap<(usize, bool), (Bvh, Vec<Owner>)>,
     /// Distance off the face the rays start from, and twice it their reach: far above the
@@ -429,15 +459,22 @@ struct Locator {
     lift: f64,
 }
 
+/// The object key of a [`Locator`] over every object at once.
+pub(crate) const ANY_OBJECT: usize = usize::MAX;
+
 impl Locator {
-    fn new(scene: &Scene, mesh: &Mesh) -> Self {
+    /// The locator over `mesh`'s elements, per object, or over all of them as one
+    /// ([`ANY_OBJECT`]) when `any` (faces that are not the scene's objects: a glTF's
+    /// primitives kept as they are).
+    pub(crate) fn new(scene: &Scene, mesh: &Mesh, any: bool) -> Self {
         let (lo, hi) = scene.bounds();
         let lift = 1e-4 * (hi - lo).length().max(1e-9);
         type Part = (Vec<[Vec3; 3]>, Vec<Owner>);
         let mut triangles: HashMap<(usize, bool), Part> = HashMap::new();
         for (e, el) in mesh.elements.iter().enumerate() {
             let surface = &mesh.surfaces[mesh.patches[el.patch as usize].surface as usize];
-            let entry = triangles.entry((surface.object as usize, surface.back)).or_default();
+            let object = if any { ANY_OBJECT } else { surface.object as usize };
+            let entry = triangles.entry((object, surface.back)).or_default();
             let v = el.vertex_indices();
             for k in 1..v.len() - 1 {
                 let corners = [v[0], v[k], v[k + 1]];

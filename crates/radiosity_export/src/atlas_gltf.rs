@@ -47,18 +47,46 @@ pub fn write_atlas(
     options: &AtlasOptions,
     tone: ToneParams,
 ) -> Result<Vec<PathBuf>, String> {
+    let (mut written, png) = write_pictures(dir, atlas, tone)?;
+    let text = atlas_gltf(scene, atlas, options, &png, tone);
+    let gltf = dir.join(ATLAS_FILES[0]);
+    std::fs::write(&gltf, text).map_err(|e| format!("{}: {e}", gltf.display()))?;
+    written.insert(0, gltf);
+    Ok(written)
+}
+
+/// Writes `lightmap.exr` and `lightmap.png` (tone-mapped by `tone`) into `dir`, made if
+/// missing: their paths and the PNG's bytes.
+pub(crate) fn write_pictures(
+    dir: &Path,
+    atlas: &Atlas,
+    tone: ToneParams,
+) -> Result<(Vec<PathBuf>, Vec<u8>), String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: cannot create the folder: {e}", dir.display()))?;
-    let [gltf_name, exr_name, png_name] = ATLAS_FILES;
-    let exr = dir.join(exr_name);
+    let exr = dir.join(ATLAS_FILES[1]);
     radiosity_image::write_exr(&exr, &atlas.image).map_err(|e| e.to_string())?;
     let picture = tone_map_image(&atlas_radiance(atlas), &tone);
-    let png_path = dir.join(png_name);
+    let png_path = dir.join(ATLAS_FILES[2]);
     let png = encode_png(&picture, &png_path).map_err(|e| e.to_string())?;
     std::fs::write(&png_path, &png).map_err(|e| format!("{}: {e}", png_path.display()))?;
-    let text = atlas_gltf(scene, atlas, options, &png, tone);
-    let gltf = dir.join(gltf_name);
-    std::fs::write(&gltf, text).map_err(|e| format!("{}: {e}", gltf.display()))?;
-    Ok(vec![gltf, exr, png_path])
+    Ok((vec![exr, png_path], png))
+}
+
+/// The asset's `extras.radiosity_lightmap`: what the texels hold, where the lightmap is
+/// (`texture`, on `TEXCOORD_<set>`), the HDR file and the PNG's tone curve.
+pub(crate) fn lightmap_extras(
+    atlas: &Atlas,
+    options: &AtlasOptions,
+    tone: ToneParams,
+    texture: usize,
+    set: usize,
+) -> Value {
+    json!({
+        "texture": texture, "texCoord": set, "quantity": options.quantity.as_str(),
+        "unit": "W per scene unit squared", "hdr": ATLAS_FILES[1], "png_exposure_ev": tone.exposure_ev,
+        "png": format!("{}/pi tone-mapped ({}, {:+.3} EV), sRGB", options.quantity.as_str(), tone.operator,
+            tone.exposure_ev),
+        "texels_per_unit": atlas.texels_per_unit })
 }
 
 /// The `.gltf` text of the lightmapped model (buffer embedded as a data URI), `png` the
@@ -173,15 +201,9 @@ pub fn atlas_gltf(
             "attributes": attributes, "indices": base + 2, "material": index }] }));
         nodes.push(json!({ "name": name, "mesh": meshes.len() - 1 }));
     }
-    let unit = "W per scene unit squared";
     let mut doc = json!({
         "asset": { "version": "2.0", "generator": concat!("radiosity ", env!("CARGO_PKG_VERSION")),
-            "extras": { "radiosity_lightmap": {
-                "texture": 0, "texCoord": 1, "quantity": options.quantity.as_str(), "unit": unit,
-                "hdr": ATLAS_FILES[1], "png_exposure_ev": tone.exposure_ev,
-                "png": format!("{}/pi tone-mapped ({}, {:+.3} EV), sRGB", options.quantity.as_str(),
-                    tone.operator, tone.exposure_ev),
-                "texels_per_unit": atlas.texels_per_unit } } },
+            "extras": { "radiosity_lightmap": lightmap_extras(atlas, options, tone, 0, 1) } },
         "scene": 0,
         "scenes": [{ "nodes": (0..nodes.len()).collect::<Vec<_>>() }],
         "nodes": nodes,

@@ -49,12 +49,14 @@ use textured::{TexturedMaterials, push_view};
 
 mod atlas;
 mod atlas_gltf;
+mod atlas_source;
 mod textured;
 
 pub use atlas::{
     Atlas, AtlasError, AtlasMesh, AtlasOptions, AtlasTexels, DIM, DIM_DENSITY, LightmapQuantity, bake_atlas,
 };
 pub use atlas_gltf::{ATLAS_FILES, atlas_gltf, atlas_radiance, write_atlas};
+pub use atlas_source::{SourceGltf, bake_source_atlas, write_source_atlas};
 
 /// What the exported vertex colours (`COLOR_0`) hold. glTF requires colours in [0, 1], so
 /// radiosity itself (lights reach 65 W per unit² in the Cornell box) goes unclamped into the
