@@ -19,6 +19,7 @@ mod scene;
 mod scene_error;
 mod srgb;
 mod texture;
+mod triangles;
 mod up;
 
 pub use color::Rgb;
@@ -41,6 +42,7 @@ pub use scene::{
 pub use scene_error::SceneError;
 pub use srgb::{encode_srgb, srgb_decode, srgb_encode};
 pub use texture::{Texture, Wrap};
+pub use triangles::{fan_triangles, strip_triangles};
 pub use up::UpAxis;
 
 /// Re-export of the vector maths used in the public API.

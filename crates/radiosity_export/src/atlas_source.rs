@@ -10,7 +10,7 @@
 use std::path::{Path, PathBuf};
 
 use glam::{DMat4, DVec3};
-use radiosity_core::{Scene, UpAxis};
+use radiosity_core::{Scene, UpAxis, fan_triangles, strip_triangles};
 use radiosity_image::ToneParams;
 use radiosity_mesh::Mesh;
 use radiosity_solver::Solution;
@@ -108,24 +108,13 @@ pub fn bake_source_atlas(
     Ok((atlas, SourceGltf { json, buffers, base, primitives }))
 }
 
-/// A primitive's triangles as a list, strips and fans unrolled (every other triangle of a
-/// strip wound back); `None` for points and lines.
+/// A primitive's triangles as a list, strips and fans unrolled; `None` for points and lines.
 fn triangle_list(mode: gltf::mesh::Mode, indices: &[u32]) -> Option<Vec<u32>> {
     use gltf::mesh::Mode;
     Some(match mode {
         Mode::Triangles => indices[..indices.len() / 3 * 3].to_vec(),
-        Mode::TriangleStrip => (2..indices.len())
-            .flat_map(|k| {
-                if k % 2 == 0 {
-                    [indices[k - 2], indices[k - 1], indices[k]]
-                } else {
-                    [indices[k - 1], indices[k - 2], indices[k]]
-                }
-            })
-            .collect(),
-        Mode::TriangleFan => {
-            (2..indices.len()).flat_map(|k| [indices[0], indices[k - 1], indices[k]]).collect()
-        }
+        Mode::TriangleStrip => strip_triangles(indices).concat(),
+        Mode::TriangleFan => fan_triangles(indices).concat(),
         _ => return None,
     })
 }

@@ -11,7 +11,7 @@ use std::path::Path;
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 use radiosity_core::glam::{DMat4, DVec3};
-use radiosity_core::{Camera, Material, Rgb, Sides, Wrap, unique_names};
+use radiosity_core::{Camera, Material, Rgb, Sides, Wrap, fan_triangles, strip_triangles, unique_names};
 
 use crate::LoadError;
 use crate::model::{
@@ -451,19 +451,8 @@ pub(crate) fn parse_gltf(
                 None => (0..welded.len() as u32).collect(),
             };
             let triangles: Vec<[u32; 3]> = match prim.mode() {
-                Mode::TriangleStrip => (2..indices.len())
-                    .map(|k| {
-                        // Every other triangle of a strip is wound the other way.
-                        if k % 2 == 0 {
-                            [indices[k - 2], indices[k - 1], indices[k]]
-                        } else {
-                            [indices[k - 1], indices[k - 2], indices[k]]
-                        }
-                    })
-                    .collect(),
-                Mode::TriangleFan => {
-                    (2..indices.len()).map(|k| [indices[0], indices[k - 1], indices[k]]).collect()
-                }
+                Mode::TriangleStrip => strip_triangles(&indices),
+                Mode::TriangleFan => fan_triangles(&indices),
                 _ => {
                     if !indices.len().is_multiple_of(3) {
                         return Err(err(format!(
