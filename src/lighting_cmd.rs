@@ -41,7 +41,7 @@ pub fn compute_grids(prepared: &Prepared, solution: &Solution) -> Result<Vec<Gri
 /// what daylight factors are taken against (CIE overcast sky; EN 17037).
 pub fn sky_lux(scene: &radiosity_core::Scene) -> Option<f64> {
     let to_lux = scene.lighting.unit().lux_per_irradiance();
-    scene.lighting.sky.map(|s| s.horizontal_irradiance().luminance() * to_lux).filter(|&e| e > 0.0)
+    scene.lighting.sky.as_ref().map(|s| s.horizontal_irradiance().luminance() * to_lux).filter(|&e| e > 0.0)
 }
 
 /// One line per grid: Em, Emin, Emax, U0, and with a sky (`sky_lux`, see [`sky_lux`]) the

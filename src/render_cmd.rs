@@ -198,7 +198,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let renderer = spinning("preparing the renderer", || {
         Renderer::new(prepared.problem.mesh().clone())
             .with_textures(&prepared.scene)
-            .with_sky(prepared.scene.lighting.sky)
+            .with_sky(prepared.scene.lighting.sky.clone())
     });
     // The irradiance cache is gathered before the first row: say so, and keep the line
     // ticking meanwhile, so a long gather does not look like a hang.

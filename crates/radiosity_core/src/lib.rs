@@ -17,9 +17,9 @@ mod photometry;
 pub mod random;
 mod scene;
 mod scene_error;
+mod sky_map;
 mod srgb;
 mod texture;
-mod triangles;
 mod up;
 
 pub use color::Rgb;
@@ -40,9 +40,9 @@ pub use scene::{
     box_faces, check_coordinate, coordinate_in_range, unique_names,
 };
 pub use scene_error::SceneError;
+pub use sky_map::SkyMap;
 pub use srgb::{encode_srgb, srgb_decode, srgb_encode};
 pub use texture::{Texture, Wrap};
-pub use triangles::{fan_triangles, strip_triangles};
 pub use up::UpAxis;
 
 /// Re-export of the vector maths used in the public API.

@@ -38,7 +38,7 @@ use std::sync::Arc;
 
 use glam::DVec3;
 
-use crate::Rgb;
+use crate::{Rgb, SkyMap};
 
 /// Maximum luminous efficacy: lumens per watt of the RGB power (see the module doc).
 pub const LUMENS_PER_WATT: f64 = 683.0;
@@ -541,7 +541,7 @@ impl Sun {
 }
 
 /// The light from infinity, which shoots first: the sun and the sky, either or both.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Daylight {
     /// Sunlight.
     pub sun: Option<Sun>,
@@ -557,7 +557,7 @@ impl Daylight {
 }
 
 /// How a sky's radiance varies over the dome.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum SkyModel {
     /// The same radiance everywhere above the horizon.
     Uniform,
@@ -575,14 +575,22 @@ pub enum SkyModel {
         /// Unit direction towards the sun.
         sun: DVec3,
     },
+    /// An environment map (an HDRI), over the whole sphere: its lower half is the ground's
+    /// light from infinity. [`SkyModel::relative_radiance`] is its luminance.
+    Map {
+        /// The radiance texels.
+        map: Arc<SkyMap>,
+        /// Unit direction of the map's middle column, at right angles to the zenith.
+        forward: DVec3,
+    },
 }
 
 impl SkyModel {
     /// The radiance along unit `towards` over the zenith's (`towards` above the horizon of
     /// the unit `zenith`).
-    pub fn relative_radiance(self, towards: DVec3, zenith: DVec3) -> f64 {
+    pub fn relative_radiance(&self, towards: DVec3, zenith: DVec3) -> f64 {
         let cos_z = towards.dot(zenith);
-        match self {
+        match *self {
             Self::Uniform => 1.0,
             Self::CieOvercast => (1.0 + 2.0 * cos_z) / 3.0,
             Self::CieClear { sun } => {
@@ -594,16 +602,19 @@ impl SkyModel {
                 let sun_zenith = sun.dot(zenith).clamp(-1.0, 1.0).acos();
                 indicatrix(chi) * gradation(cos_z) / (indicatrix(sun_zenith) * gradation(1.0))
             }
+            Self::Map { ref map, forward } => map.radiance(towards, zenith, forward).luminance(),
         }
     }
 
     /// The irradiance on an unobstructed horizontal plane over π L_z: ∫ g(ω) cos θ dω / π,
     /// 1 for the uniform sky, 2 ∫₀¹ (1 + 2μ)/3 μ dμ = 7/9 for the overcast one; for the
     /// clear sky by the midpoint rule over 256 rings of μ = cos θ and 512 azimuths (dω = dμ dφ).
-    pub fn horizontal_factor(self, zenith: DVec3) -> f64 {
+    pub fn horizontal_factor(&self, zenith: DVec3) -> f64 {
         match self {
             Self::Uniform => 1.0,
             Self::CieOvercast => 7.0 / 9.0,
+            // A map's own light: its horizontal irradiance's luminance over π.
+            Self::Map { map, .. } => map.horizontal_irradiance().luminance() / PI,
             Self::CieClear { .. } => {
                 let (t, b) = zenith.any_orthonormal_pair();
                 let (rings, around) = (256, 512);
@@ -625,8 +636,9 @@ impl SkyModel {
 
 /// Skylight: diffuse light from a dome at infinity above the horizon, shooting first, by
 /// shadow rays towards it, as the sun does. Below the horizon there is no sky (the ground
-/// outside the model is black: model the ground to have it reflect).
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// outside the model is black: model the ground to have it reflect), but for a map's lower
+/// half.
+#[derive(Clone, Debug, PartialEq)]
 pub struct Sky {
     /// Unit direction of the zenith (the scene's up).
     pub zenith: DVec3,
@@ -646,12 +658,21 @@ impl Sky {
 
     /// A sky of `model` whose unobstructed horizontal irradiance is `horizontal`.
     pub fn from_horizontal(model: SkyModel, zenith: DVec3, horizontal: Rgb, rays: u32) -> Self {
-        Self { zenith, model, zenith_radiosity: horizontal * (1.0 / model.horizontal_factor(zenith)), rays }
+        let zenith_radiosity = horizontal * (1.0 / model.horizontal_factor(zenith));
+        Self { zenith, model, zenith_radiosity, rays }
     }
 
     /// π times the radiance seen along unit direction `towards` (0 at and below the horizon):
     /// what a ray escaping the scene that way brings, in radiosity units.
     pub fn radiosity_towards(&self, towards: DVec3) -> Rgb {
+        if let SkyModel::Map { map, forward } = &self.model {
+            let l = map.radiance(towards, self.zenith, *forward);
+            return Rgb::new(
+                l.r * self.zenith_radiosity.r,
+                l.g * self.zenith_radiosity.g,
+                l.b * self.zenith_radiosity.b,
+            );
+        }
         if towards.dot(self.zenith) > 0.0 {
             self.zenith_radiosity * self.model.relative_radiance(towards, self.zenith)
         } else {
@@ -661,7 +682,18 @@ impl Sky {
 
     /// Irradiance on an unobstructed horizontal plane facing the zenith.
     pub fn horizontal_irradiance(&self) -> Rgb {
+        if let SkyModel::Map { map, .. } = &self.model {
+            let e = map.horizontal_irradiance();
+            let s = self.zenith_radiosity * (1.0 / PI);
+            return Rgb::new(e.r * s.r, e.g * s.g, e.b * s.b);
+        }
         self.zenith_radiosity * self.model.horizontal_factor(self.zenith)
+    }
+
+    /// A sky of environment map `map` (middle column towards `forward`), its radiance times
+    /// `scale` per channel: `zenith_radiosity` holds π × `scale`.
+    pub fn from_map(map: Arc<SkyMap>, zenith: DVec3, forward: DVec3, scale: Rgb, rays: u32) -> Self {
+        Self { zenith, model: SkyModel::Map { map, forward }, zenith_radiosity: scale * PI, rays }
     }
 }
 
@@ -694,7 +726,7 @@ impl Lighting {
 
     /// The light from infinity: the sun and the sky.
     pub fn daylight(&self) -> Daylight {
-        Daylight { sun: self.sun, sky: self.sky }
+        Daylight { sun: self.sun, sky: self.sky.clone() }
     }
 
     /// Total luminaire flux, lm.
@@ -715,6 +747,11 @@ impl Lighting {
         }
         if let Some(sky) = &mut self.sky {
             sky.zenith = f(sky.zenith);
+            match &mut sky.model {
+                SkyModel::CieClear { sun } => *sun = f(*sun),
+                SkyModel::Map { forward, .. } => *forward = f(*forward),
+                SkyModel::Uniform | SkyModel::CieOvercast => {}
+            }
         }
         for g in &mut self.grids {
             g.origin = f(g.origin);

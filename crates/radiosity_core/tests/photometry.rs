@@ -5,7 +5,7 @@ use std::f64::consts::PI;
 use std::sync::Arc;
 
 use radiosity_core::glam::DVec3;
-use radiosity_core::{Grid, IntensityTable, Luminaire, Rgb, Sky, SkyModel, colour_of_cct};
+use radiosity_core::{Grid, IntensityTable, Luminaire, Rgb, Sky, SkyMap, SkyModel, colour_of_cct};
 
 /// Each sky model's horizontal factor is ∫ g(θ) cos θ dω / π over the upper hemisphere,
 /// here by the midpoint rule over 20 000 rings of μ = cos θ (dω = 2π dμ).
@@ -151,4 +151,28 @@ fn the_clear_sky_peaks_at_the_sun_and_integrates_the_same_two_ways() {
     let se = ((sum2 / f64::from(n) - mean * mean) / f64::from(n)).sqrt();
     assert!((mean - factor).abs() < 4.0 * se, "rings {factor}, random {mean} ± {se}");
     assert!(se < 2e-3 * mean);
+}
+
+/// A map of radiance 1 everywhere gives an open plane π (∫ cos θ dω over a hemisphere), at
+/// any resolution; the middle column looks along `forward`, the top row at the zenith,
+/// and a texel's value comes back at its centre; bad sizes and texels are refused.
+#[test]
+fn a_map_is_looked_up_and_integrated_where_its_texels_are() {
+    for (w, h) in [(4, 2), (64, 32), (100, 51)] {
+        let map = SkyMap::try_new(w, h, vec![Rgb::splat(1.0); (w * h) as usize]).unwrap();
+        assert!((map.horizontal_irradiance().g / PI - 1.0).abs() < 1e-12, "{w} × {h}");
+    }
+    let (w, h) = (8u32, 4u32);
+    let texels = (0..w * h).map(|k| Rgb::new(f64::from(k % w), f64::from(k / w), 0.0)).collect::<Vec<_>>();
+    let map = SkyMap::try_new(w, h, texels).unwrap();
+    let (zenith, forward) = (DVec3::Y, DVec3::NEG_Z);
+    // Forward, just above the horizon: between columns 3 and 4 (u = ½), row 1.5 → 1.5.
+    let l = map.radiance(DVec3::new(0.0, 1e-9, -1.0), zenith, forward);
+    assert!((l.r - 3.5).abs() < 1e-6 && (l.g - 1.5).abs() < 1e-6, "{l:?}");
+    // To the right of forward (+x here): a quarter turn on, u = ¾, column 5.5.
+    let l = map.radiance(DVec3::new(1.0, 0.0, 0.0), zenith, forward);
+    assert!((l.r - 5.5).abs() < 1e-6, "{l:?}");
+    assert!(map.radiance(DVec3::Y, zenith, forward).g.abs() < 1e-9, "the zenith is the top row");
+    assert!(SkyMap::try_new(2, 2, vec![Rgb::ZERO; 3]).is_err());
+    assert!(SkyMap::try_new(2, 2, vec![Rgb::splat(-1.0); 4]).is_err());
 }

@@ -10,9 +10,9 @@
 use std::path::{Path, PathBuf};
 
 use glam::{DMat4, DVec3};
-use radiosity_core::{Scene, UpAxis, fan_triangles, strip_triangles};
+use radiosity_core::{Scene, UpAxis};
 use radiosity_image::ToneParams;
-use radiosity_mesh::Mesh;
+use radiosity_mesh::{Mesh, fan_triangles, strip_triangles};
 use radiosity_solver::Solution;
 use serde_json::{Value, json};
 

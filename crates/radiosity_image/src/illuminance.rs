@@ -153,7 +153,9 @@ pub fn grid_illuminance(
                     Ok(Some(hit)) => gathered += hit.radiance * PI,
                     // A ray that leaves the scene meets the sky: direct light, by the
                     // density that drew it π L (see `Sky::radiosity_towards`).
-                    Ok(None) => skylight += lighting.sky.map_or(Rgb::ZERO, |s| s.radiosity_towards(dir)),
+                    Ok(None) => {
+                        skylight += lighting.sky.as_ref().map_or(Rgb::ZERO, |s| s.radiosity_towards(dir))
+                    }
                     Err(_) => {}
                 }
             }

@@ -113,6 +113,13 @@ pub(crate) struct SkyDesc {
     pub(crate) cct: Option<Spanned<f64>>,
     /// Shadow rays per element towards the sky.
     pub(crate) rays: Option<Spanned<i64>>,
+    /// An equirectangular environment map (`.hdr` or `.exr`, linear radiance) as the sky,
+    /// relative to the scene file.
+    pub(crate) map: Option<Spanned<String>>,
+    /// What the map's texels are multiplied by (default 1).
+    pub(crate) scale: Option<Spanned<f64>>,
+    /// Degrees the map is turned about the zenith, its middle column from north towards east.
+    pub(crate) rotation: Option<Spanned<f64>>,
 }
 
 /// `[sun]`.

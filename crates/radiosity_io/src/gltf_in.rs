@@ -11,7 +11,8 @@ use std::path::Path;
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 use radiosity_core::glam::{DMat4, DVec3};
-use radiosity_core::{Camera, Material, Rgb, Sides, Wrap, fan_triangles, strip_triangles, unique_names};
+use radiosity_core::{Camera, Material, Rgb, Sides, Wrap, unique_names};
+use radiosity_mesh::{fan_triangles, strip_triangles};
 
 use crate::LoadError;
 use crate::model::{

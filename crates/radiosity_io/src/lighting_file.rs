@@ -10,7 +10,7 @@ use std::sync::Arc;
 use radiosity_core::glam::DVec3;
 use radiosity_core::{
     Grid, IntensityTable, LUMENS_PER_WATT, LengthUnit, Lighting, Luminaire, Material, Object, Opening, Rgb,
-    Shape, Sides, Sky, SkyModel, Sun, UpAxis, colour_of_cct, unit_luminance,
+    Shape, Sides, Sky, SkyMap, SkyModel, Sun, UpAxis, colour_of_cct, unit_luminance,
 };
 use toml::Spanned;
 
@@ -279,10 +279,21 @@ fn sky(
     loc: &Locator,
     d: &Spanned<SkyDesc>,
     unit: LengthUnit,
-    zenith: DVec3,
+    (up, folder): (UpAxis, &Path),
     sun: Option<&Sun>,
 ) -> Result<Sky, LoadError> {
+    let zenith = up.from_y_up(DVec3::Y);
     let (span, d) = (d.span(), d.get_ref());
+    if let Some(file) = &d.map {
+        return sky_of_map(loc, (span, d), unit, (up, folder), file);
+    }
+    for (key, given) in
+        [("scale", d.scale.as_ref().map(|s| s.span())), ("rotation", d.rotation.as_ref().map(|r| r.span()))]
+    {
+        if let Some(at) = given {
+            return Err(loc.at(at, format!("sky.{key}"), "turns or scales a map: give sky.map too"));
+        }
+    }
     let model = match d.model.as_ref().map(|m| (m.span(), m.get_ref().as_str())) {
         None | Some((_, "cie-overcast")) => SkyModel::CieOvercast,
         Some((_, "uniform")) => SkyModel::Uniform,
@@ -308,17 +319,7 @@ fn sky(
             ));
         }
     };
-    let rays = match &d.rays {
-        None => Sky::DEFAULT_RAYS,
-        Some(r) if (1..=MAX_SKY_RAYS).contains(r.get_ref()) => *r.get_ref() as u32,
-        Some(r) => {
-            return Err(loc.at(
-                r.span(),
-                "sky.rays",
-                format!("expected a whole number from 1 to {MAX_SKY_RAYS}"),
-            ));
-        }
-    };
+    let rays = sky_rays(loc, d)?;
     let amount =
         Amount { illuminance: &d.illuminance, irradiance: &d.irradiance, colour: &d.colour, cct: &d.cct };
     let horizontal = amount.irradiance(loc, span, "sky", "on an open horizontal plane", unit)?;
@@ -327,6 +328,89 @@ fn sky(
 
 /// The most shadow rays per element a `[sky]` may ask for.
 const MAX_SKY_RAYS: i64 = 4096;
+
+/// Shadow rays per element from `[sky]`'s `rays`, or the default.
+fn sky_rays(loc: &Locator, d: &SkyDesc) -> Result<u32, LoadError> {
+    match &d.rays {
+        None => Ok(Sky::DEFAULT_RAYS),
+        Some(r) if (1..=MAX_SKY_RAYS).contains(r.get_ref()) => Ok(*r.get_ref() as u32),
+        Some(r) => {
+            Err(loc.at(r.span(), "sky.rays", format!("expected a whole number from 1 to {MAX_SKY_RAYS}")))
+        }
+    }
+}
+
+/// The most texels along a sky map's width.
+const MAX_SKY_MAP_WIDTH: u32 = 16_384;
+
+/// A `[sky]` given by an environment map `file` (relative to `folder`): its middle column
+/// faces north (the `[sun]`'s default north, the file's −z, or +y for a z-up file) turned by
+/// `rotation` degrees towards east; its texels times `scale`, or scaled so that the open
+/// horizontal plane receives the illuminance or irradiance given.
+fn sky_of_map(
+    loc: &Locator,
+    (span, d): (Range<usize>, &SkyDesc),
+    unit: LengthUnit,
+    (up, folder): (UpAxis, &Path),
+    file: &Spanned<String>,
+) -> Result<Sky, LoadError> {
+    if let Some(m) = d.model.as_ref().filter(|m| m.get_ref() != "map") {
+        return Err(loc.at(
+            m.span(),
+            "sky.model",
+            "a sky is a model or a map: give one of sky.model and sky.map",
+        ));
+    }
+    let path = folder.join(file.get_ref());
+    let map = read_sky_map(&path)
+        .map_err(|m| loc.at(file.span(), "sky.map", format!("{}: {m}", path.display())))?;
+    let number = |v: &Option<Spanned<f64>>, key: &str, default: f64, ok: fn(f64) -> bool| match v {
+        None => Ok(default),
+        Some(x) if x.get_ref().is_finite() && ok(*x.get_ref()) => Ok(*x.get_ref()),
+        Some(x) => Err(loc.at(x.span(), format!("sky.{key}"), "expected a finite number (a scale above 0)")),
+    };
+    let scale = number(&d.scale, "scale", 1.0, |s| s > 0.0)?;
+    let rotation = number(&d.rotation, "rotation", 0.0, |_| true)?;
+    let zenith = up.from_y_up(DVec3::Y);
+    let north = up.from_y_up(DVec3::NEG_Z);
+    let east = north.cross(zenith);
+    let turn = rotation.to_radians();
+    let forward = north * turn.cos() + east * turn.sin();
+    let rays = sky_rays(loc, d)?;
+    let map = Arc::new(map);
+    if d.illuminance.is_some() || d.irradiance.is_some() {
+        if let Some(s) = &d.scale {
+            return Err(loc.at(s.span(), "sky.scale", "give a scale or an amount of light, not both"));
+        }
+        let amount =
+            Amount { illuminance: &d.illuminance, irradiance: &d.irradiance, colour: &d.colour, cct: &d.cct };
+        let horizontal = amount.irradiance(loc, span, "sky", "on an open horizontal plane", unit)?;
+        if map.horizontal_irradiance().luminance() <= 0.0 {
+            return Err(loc.at(
+                file.span(),
+                "sky.map",
+                "the map's upper half is black: it cannot be scaled to an amount of light",
+            ));
+        }
+        return Ok(Sky::from_horizontal(SkyModel::Map { map, forward }, zenith, horizontal, rays));
+    }
+    Ok(Sky::from_map(map, zenith, forward, Rgb::splat(scale), rays))
+}
+
+/// An equirectangular map of linear radiance from a Radiance `.hdr` or OpenEXR `.exr` file.
+fn read_sky_map(path: &Path) -> Result<SkyMap, String> {
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    if !matches!(ext.as_deref(), Some("hdr" | "exr")) {
+        return Err("expected a linear HDR image, .hdr (Radiance) or .exr".into());
+    }
+    let (w, h) = image::image_dimensions(path).map_err(|e| e.to_string())?;
+    if w > MAX_SKY_MAP_WIDTH || h > MAX_SKY_MAP_WIDTH / 2 + 1 {
+        return Err(format!("{w} × {h} texels: at most {MAX_SKY_MAP_WIDTH} × {}", MAX_SKY_MAP_WIDTH / 2));
+    }
+    let image = image::open(path).map_err(|e| e.to_string())?.to_rgb32f();
+    let texels = image.pixels().map(|p| Rgb::new(p[0].into(), p[1].into(), p[2].into())).collect();
+    SkyMap::try_new(w, h, texels)
+}
 
 /// How much light a sun or a sky gives, as written: lux with a colour, or W/unit².
 struct Amount<'a> {
@@ -583,7 +667,7 @@ pub(crate) fn lighting(
         grids.push(Grid { name, origin, u, v, divisions, normal, height });
     }
     let sun = desc.sun.as_ref().map(|d| sun(loc, d, unit, up)).transpose()?;
-    let sky = desc.sky.as_ref().map(|d| sky(loc, d, unit, file_up, sun.as_ref())).transpose()?;
+    let sky = desc.sky.as_ref().map(|d| sky(loc, d, unit, (up, folder), sun.as_ref())).transpose()?;
     Ok(Lighting { units, luminaires, grids, sun, sky })
 }
 

@@ -47,6 +47,7 @@ mod refinement;
 mod sealed;
 mod shadows;
 mod smoothing;
+mod triangles;
 mod union_find;
 
 #[cfg(test)]
@@ -61,3 +62,4 @@ pub use planar::distance_to_polygon;
 pub use refinement::Refinement;
 pub use sealed::{MAX_HOLE_SHARE, Sealed, seal_closed_objects};
 pub use smoothing::Smoothing;
+pub use triangles::{fan_triangles, strip_triangles};

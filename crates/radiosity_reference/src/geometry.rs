@@ -231,7 +231,7 @@ impl Geometry {
         let (lo, hi) = scene.bounds();
         g.offset = 1e-6 * (hi - lo).length().max(f64::MIN_POSITIVE);
         g.sun = scene.lighting.sun.map(|s| (s, 2.0 * (hi - lo).length().max(f64::MIN_POSITIVE)));
-        g.sky = scene.lighting.sky;
+        g.sky = scene.lighting.sky.clone();
         g
     }
 

@@ -107,7 +107,7 @@ impl Geometry {
     /// drew it: π L_sky(dir) (0 without a sky). The sky has no next-event estimate: the
     /// bounces find it, as a path tracer without light sampling finds an area light.
     fn sky_towards(&self, dir: DVec3) -> Rgb {
-        self.sky.map_or(Rgb::ZERO, |sky| sky.radiosity_towards(dir))
+        self.sky.as_ref().map_or(Rgb::ZERO, |sky| sky.radiosity_towards(dir))
     }
 
     /// Irradiance at `x` straight from the emitters, one next-event sample weighted by the

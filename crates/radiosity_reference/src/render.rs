@@ -34,9 +34,10 @@ pub(crate) fn render(
                     }
                     Some(_) => Rgb::ZERO,
                     // The sky where the view leaves the scene, as the solve's picture shows it.
-                    None => {
-                        g.sky.map_or(Rgb::ZERO, |s| s.radiosity_towards(dir) * std::f64::consts::FRAC_1_PI)
-                    }
+                    None => g
+                        .sky
+                        .as_ref()
+                        .map_or(Rgb::ZERO, |s| s.radiosity_towards(dir) * std::f64::consts::FRAC_1_PI),
                 };
                 sum += l;
                 sum_sq += l * l;

@@ -263,7 +263,7 @@ impl Problem {
             self.ray_queries.clone(),
             params,
             &self.luminaires,
-            self.daylight,
+            self.daylight.clone(),
         )
     }
 }

@@ -109,7 +109,7 @@ impl Renderer {
 
     /// The radiance a view ray along `dir` that leaves the scene meets: the sky's, or none.
     fn background(&self, dir: DVec3) -> Rgb {
-        self.sky.map_or(Rgb::ZERO, |s| s.radiosity_towards(dir) * (1.0 / std::f64::consts::PI))
+        self.sky.as_ref().map_or(Rgb::ZERO, |s| s.radiosity_towards(dir) * (1.0 / std::f64::consts::PI))
     }
 
     /// The renderer showing the colour textures of `scene`'s materials, which must be the

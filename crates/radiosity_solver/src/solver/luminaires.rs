@@ -187,8 +187,10 @@ const SKY_STREAM: u64 = 0x0073_6b79;
 /// Directions at or below the horizon bring nothing.
 fn skylight(mesh: &Mesh, e: usize, sky: &Sky, leaves: impl Fn(DVec3, DVec3) -> bool) -> Rgb {
     let el = &mesh.elements[e];
-    // No part of the sky above this element's horizon: a floor's underside.
-    if el.normal.dot(sky.zenith) <= -1.0 + 1e-12 {
+    // No part of the sky above this element's horizon: a floor's underside (a map's lower
+    // half, the ground at infinity, still lights it).
+    let map = matches!(sky.model, radiosity_core::SkyModel::Map { .. });
+    if !map && el.normal.dot(sky.zenith) <= -1.0 + 1e-12 {
         return Rgb::ZERO;
     }
     let corners: Vec<DVec3> = mesh.element_corners(e).take(4).collect();

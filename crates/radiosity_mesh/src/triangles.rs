@@ -1,5 +1,5 @@
 //! Triangle lists from the strips and fans of mesh formats (glTF's modes 5 and 6), for the
-//! loader and for the exports that read a model again.
+//! model loader and for the exports that read a model again (both mesh its faces).
 
 /// The triangles of a strip: each index after the first two closes one with the two before
 /// it, every other one wound back so that all face the same way (glTF 2.0, §3.7.2.1).
