@@ -414,3 +414,40 @@ element_size = 0.125
         assert!(b > 1.5 * d, "{rotation}: {brighter} {b} against {darker} {d}");
     }
 }
+
+/// A scene file with another up axis is turned upright with everything in it: a clear sky's
+/// sun and a map's middle column turn with the `[sun]` and the zenith (in a z-up file the
+/// clear sky's brightest place stays where the `[sun]` is; a map's middle faces the file's
+/// north, +y there).
+#[test]
+fn a_z_up_sky_turns_with_the_scene() {
+    let extra = "up = \"z\"\n[sun]\ndirection = [0.3, 0.2, 1]\nilluminance = 100000";
+    let scene =
+        crate::sun::load_with_table(extra, "sky", "model = \"cie-clear\"\nilluminance = 10000").unwrap();
+    let towards = scene.lighting.sun.as_ref().unwrap().towards;
+    let sky = scene.lighting.sky.as_ref().unwrap();
+    assert!((sky.zenith - radiosity_core::glam::DVec3::Y).length() < 1e-12, "{}", sky.zenith);
+    match &sky.model {
+        radiosity_core::SkyModel::CieClear { sun } => {
+            assert!((*sun - towards).length() < 1e-12, "{sun} vs {towards}")
+        }
+        other => panic!("{other:?}"),
+    }
+    let dir = tempfile::tempdir().unwrap();
+    write_hdr(&dir.path().join("m.hdr"), 8, 4, |_, _| [1.0; 3]);
+    let path = dir.path().join("scene.toml");
+    std::fs::write(
+        &path,
+        "up = \"z\"\n[sky]\nmap = \"m.hdr\"\n[[material]]\nname = \"g\"\nreflectance = [0.5, 0.5, 0.5]\n\
+         [[object]]\nname = \"f\"\ntype = \"polygon\"\nmaterial = \"g\"\nvertices = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]\n",
+    )
+    .unwrap();
+    let scene = radiosity_io::load_scene(&path).unwrap().scene;
+    match &scene.lighting.sky.as_ref().unwrap().model {
+        // The file's +y (its north) is −z once turned upright.
+        radiosity_core::SkyModel::Map { forward, .. } => {
+            assert!((*forward - radiosity_core::glam::DVec3::NEG_Z).length() < 1e-12, "{forward}")
+        }
+        other => panic!("{other:?}"),
+    }
+}
