@@ -255,6 +255,7 @@ fn a_sky_with_a_bad_key_is_refused_by_key() {
         ("illuminance = 1000\nturbidity = 3", "turbidity"),
         ("map = \"missing.hdr\"", "sky.map"),
         ("map = \"sky.png\"", "expected a linear HDR image"),
+        ("map = \"sky.exr\"", "Radiance's .hdr format"),
         ("model = \"uniform\"\nmap = \"sky.hdr\"", "sky.model"),
         ("illuminance = 1000\nscale = 2", "sky.scale"),
         ("illuminance = 1000\nrotation = 90", "sky.rotation"),

@@ -113,7 +113,7 @@ pub(crate) struct SkyDesc {
     pub(crate) cct: Option<Spanned<f64>>,
     /// Shadow rays per element towards the sky.
     pub(crate) rays: Option<Spanned<i64>>,
-    /// An equirectangular environment map (`.hdr` or `.exr`, linear radiance) as the sky,
+    /// An equirectangular environment map (Radiance `.hdr`, linear radiance) as the sky,
     /// relative to the scene file.
     pub(crate) map: Option<Spanned<String>>,
     /// What the map's texels are multiplied by (default 1).

@@ -397,11 +397,12 @@ fn sky_of_map(
     Ok(Sky::from_map(map, zenith, forward, Rgb::splat(scale), rays))
 }
 
-/// An equirectangular map of linear radiance from a Radiance `.hdr` or OpenEXR `.exr` file.
+/// An equirectangular map of linear radiance from a Radiance `.hdr` file (the loader reads no
+/// OpenEXR: that codec belongs to the picture crates; an `.exr` map converts losslessly).
 fn read_sky_map(path: &Path) -> Result<SkyMap, String> {
     let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-    if !matches!(ext.as_deref(), Some("hdr" | "exr")) {
-        return Err("expected a linear HDR image, .hdr (Radiance) or .exr".into());
+    if ext.as_deref() != Some("hdr") {
+        return Err("expected a linear HDR image in Radiance's .hdr format".into());
     }
     let (w, h) = image::image_dimensions(path).map_err(|e| e.to_string())?;
     if w > MAX_SKY_MAP_WIDTH || h > MAX_SKY_MAP_WIDTH / 2 + 1 {
