@@ -86,7 +86,8 @@ fn packing(inputs: &[(Vec<[f32; 3]>, Vec<u32>)]) -> uvunwrap::Packing {
 /// One object's faces on one side, unwrapped: the glTF primitive it becomes.
 #[derive(Clone, Debug)]
 pub struct AtlasMesh {
-    /// Scene object index (the same as the mesh's object index).
+    /// Scene object index (the same as the mesh's object index), or `usize::MAX` for a
+    /// glTF primitive kept as it is (its texels take the element under them, of any object).
     pub object: usize,
     /// The back side of a two-sided object: its faces turned over.
     pub back: bool,
