@@ -13,13 +13,13 @@
 
 use std::path::{Path, PathBuf};
 
-use radiosity_core::Scene;
-use radiosity_image::{HdrImage, SrgbImage, ToneParams, encode_png, tone_map_image};
+use radiosity_core::{Scene, Wrap};
+use radiosity_image::{HdrImage, ToneParams, encode_png, tone_map_image};
 use serde_json::{Value, json};
 
 use crate::atlas::{Atlas, AtlasOptions};
 use crate::base64;
-use crate::textured::{push_view, wrap_code};
+use crate::textured::{TextureTable, push_view};
 
 /// The file names written into the lightmap folder.
 pub const ATLAS_FILES: [&str; 3] = ["lightmapped.gltf", "lightmap.exr", "lightmap.png"];
@@ -102,17 +102,11 @@ pub fn atlas_gltf(
     const ELEMENT_ARRAY_BUFFER: u32 = 34963;
     const FLOAT: u32 = 5126;
     const UNSIGNED_INT: u32 = 5125;
-    const LINEAR: u32 = 9729;
-    const LINEAR_MIPMAP_LINEAR: u32 = 9987;
-    const CLAMP_TO_EDGE: u32 = 33071;
     let mut blob = Vec::new();
     let (mut views, mut accessors, mut meshes, mut nodes) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    // Texture 0: the lightmap, its PNG first in the buffer.
-    views.push(push_view(&mut blob, png, None));
-    let mut images = vec![json!({ "name": "lightmap", "bufferView": 0, "mimeType": "image/png" })];
-    let mut samplers = vec![json!({ "magFilter": LINEAR, "minFilter": LINEAR_MIPMAP_LINEAR,
-        "wrapS": CLAMP_TO_EDGE, "wrapT": CLAMP_TO_EDGE })];
-    let mut textures = vec![json!({ "name": "lightmap", "sampler": 0, "source": 0 })];
+    // Texture 0: the lightmap, its PNG first in the buffer; the model's textures after it.
+    let mut table = TextureTable::default();
+    table.png("lightmap", png, [Wrap::ClampToEdge; 2], &mut blob, &mut views);
     // One glTF material per scene material used.
     let mut materials: Vec<Value> = Vec::new();
     let mut material_of = std::collections::HashMap::new();
@@ -127,23 +121,10 @@ pub fn atlas_gltf(
             let mut pbr = json!({ "baseColorFactor": [rho[0], rho[1], rho[2], 1.0],
                 "metallicFactor": 0.0, "roughnessFactor": 1.0 });
             if let (Some(texture), true) = (&material.texture, m.uv0.is_some()) {
-                let picture = SrgbImage {
-                    width: texture.width,
-                    height: texture.height,
-                    pixels: texture.texels.clone(),
-                };
-                // A texture has at least one texel and is encoded into memory: it cannot fail.
-                let bytes = encode_png(&picture, Path::new("texture.png")).expect("a texture encodes as PNG");
-                views.push(push_view(&mut blob, &bytes, None));
-                images.push(
-                    json!({ "name": material.name, "bufferView": views.len() - 1, "mimeType": "image/png" }),
-                );
-                samplers.push(json!({ "magFilter": LINEAR, "minFilter": LINEAR_MIPMAP_LINEAR,
-                    "wrapS": wrap_code(texture.wrap[0]), "wrapT": wrap_code(texture.wrap[1]) }));
-                textures.push(json!({ "sampler": samplers.len() - 1, "source": images.len() - 1 }));
+                let index = table.texture(texture, &material.name, &mut blob, &mut views);
                 let f = texture.factor.map(|c| c.clamp(0.0, 1.0));
                 pbr["baseColorFactor"] = json!([f[0], f[1], f[2], 1.0]);
-                pbr["baseColorTexture"] = json!({ "index": textures.len() - 1, "texCoord": 0 });
+                pbr["baseColorTexture"] = json!({ "index": index, "texCoord": 0 });
             }
             let name =
                 if m.emits { material.name.clone() } else { format!("{} (not emitting)", material.name) };
@@ -209,9 +190,9 @@ pub fn atlas_gltf(
         "nodes": nodes,
         "meshes": meshes,
         "materials": materials,
-        "textures": textures,
-        "samplers": samplers,
-        "images": images,
+        "textures": table.textures,
+        "samplers": table.samplers,
+        "images": table.images,
         "accessors": accessors,
         "bufferViews": views,
         "buffers": [{ "byteLength": blob.len(),

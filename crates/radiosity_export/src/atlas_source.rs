@@ -21,6 +21,7 @@ use crate::atlas::{
 };
 use crate::atlas_gltf::{ATLAS_FILES, lightmap_extras, write_pictures};
 use crate::base64;
+use crate::textured::push_view;
 
 /// A glTF model as read for its lightmap: its JSON, its buffers' bytes, its folder, and the
 /// primitives lightmapped, in the atlas's mesh order.
@@ -157,16 +158,12 @@ struct Blob {
 }
 
 impl Blob {
-    /// Appends `data` as a buffer view (with `stride` when given), 4-byte aligned; its index.
+    /// Appends `data` as a buffer view (with `stride` when given); its index.
     fn view(&mut self, data: &[u8], stride: Option<usize>) -> usize {
-        while !self.bytes.len().is_multiple_of(4) {
-            self.bytes.push(0);
-        }
-        let mut view = json!({ "buffer": 0, "byteOffset": self.bytes.len(), "byteLength": data.len() });
+        let mut view = push_view(&mut self.bytes, data, None);
         if let Some(stride) = stride {
             view["byteStride"] = stride.into();
         }
-        self.bytes.extend_from_slice(data);
         self.views.push(view);
         self.views.len() - 1
     }
@@ -191,6 +188,10 @@ fn source_gltf(
         }
         starts.push(blob.bytes.len());
         blob.bytes.extend_from_slice(b);
+    }
+    // What is added after them starts 4-byte aligned, as every view `push_view` adds ends so.
+    while !blob.bytes.len().is_multiple_of(4) {
+        blob.bytes.push(0);
     }
     let old_views = doc["bufferViews"].as_array().cloned().unwrap_or_default();
     for v in &old_views {

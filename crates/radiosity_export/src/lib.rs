@@ -267,9 +267,11 @@ fn gltf_document(
         "buffers": [{ "byteLength": blob.len() }],
     });
     // glTF forbids empty arrays: these appear only when something is textured.
-    for (key, list) in
-        [("textures", textured.textures), ("samplers", textured.samplers), ("images", textured.images)]
-    {
+    for (key, list) in [
+        ("textures", textured.table.textures),
+        ("samplers", textured.table.samplers),
+        ("images", textured.table.images),
+    ] {
         if !list.is_empty() {
             doc[key] = Value::Array(list);
         }

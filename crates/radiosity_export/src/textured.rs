@@ -72,24 +72,79 @@ pub(crate) fn wrap_code(wrap: Wrap) -> u32 {
     }
 }
 
-/// The textured materials of a glTF document, with their textures, samplers and images, each
-/// written once however many objects share it.
+/// The textures of a glTF document with their samplers and images, each written once however
+/// many materials use it.
+#[derive(Default)]
+pub(crate) struct TextureTable {
+    /// glTF textures: one per (image, sampler) pair.
+    pub(crate) textures: Vec<Value>,
+    /// glTF samplers: one per pair of wrap modes.
+    pub(crate) samplers: Vec<Value>,
+    /// glTF images: one per texture image, its PNG in a buffer view.
+    pub(crate) images: Vec<Value>,
+    /// Texture (by address: loaders share one `Arc` among materials) → glTF texture index.
+    by_texture: Vec<(Arc<Texture>, usize)>,
+    /// Wrap modes → glTF sampler index.
+    by_wrap: Vec<([Wrap; 2], usize)>,
+}
+
+impl TextureTable {
+    /// The glTF texture of `texture` (named `name`), adding its image (a PNG appended to
+    /// `blob` as a buffer view) and sampler when new.
+    pub(crate) fn texture(
+        &mut self,
+        texture: &Arc<Texture>,
+        name: &str,
+        blob: &mut Vec<u8>,
+        views: &mut Vec<Value>,
+    ) -> usize {
+        if let Some(&(_, i)) = self.by_texture.iter().find(|(t, _)| Arc::ptr_eq(t, texture)) {
+            return i;
+        }
+        let picture =
+            SrgbImage { width: texture.width, height: texture.height, pixels: texture.texels.clone() };
+        // A texture has at least one texel, and the encoder writes into memory: it cannot fail.
+        let png = encode_png(&picture, Path::new("texture.png")).expect("a texture encodes as PNG");
+        let i = self.png(name, &png, texture.wrap, blob, views);
+        self.by_texture.push((texture.clone(), i));
+        i
+    }
+
+    /// A glTF texture of the PNG `bytes` (named `name`, appended to `blob` as a buffer view),
+    /// sampled with `wrap` and linear filtering (pictures filter texels bilinearly).
+    pub(crate) fn png(
+        &mut self,
+        name: &str,
+        bytes: &[u8],
+        wrap: [Wrap; 2],
+        blob: &mut Vec<u8>,
+        views: &mut Vec<Value>,
+    ) -> usize {
+        views.push(push_view(blob, bytes, None));
+        self.images.push(json!({ "name": name, "bufferView": views.len() - 1, "mimeType": "image/png" }));
+        let sampler = match self.by_wrap.iter().find(|(w, _)| *w == wrap) {
+            Some(&(_, i)) => i,
+            None => {
+                self.samplers.push(json!({ "magFilter": 9729, "minFilter": 9987,
+                    "wrapS": wrap_code(wrap[0]), "wrapT": wrap_code(wrap[1]) }));
+                self.by_wrap.push((wrap, self.samplers.len() - 1));
+                self.samplers.len() - 1
+            }
+        };
+        self.textures.push(json!({ "sampler": sampler, "source": self.images.len() - 1 }));
+        self.textures.len() - 1
+    }
+}
+
+/// The textured materials of a glTF document, with their textures ([`TextureTable`]).
 #[derive(Default)]
 pub(crate) struct TexturedMaterials {
     /// glTF materials after the untextured `baked` one (index 0).
     pub(crate) materials: Vec<Value>,
-    /// glTF textures: one per textured material (image and sampler).
-    pub(crate) textures: Vec<Value>,
-    /// glTF samplers: one per pair of wrap modes.
-    pub(crate) samplers: Vec<Value>,
-    /// glTF images: one per texture, its PNG in a buffer view.
-    pub(crate) images: Vec<Value>,
+    /// Their textures, samplers and images.
+    pub(crate) table: TextureTable,
     /// Mesh material index → glTF material index.
     by_material: HashMap<usize, usize>,
-    /// Texture (by address: loaders share one `Arc` among materials) → glTF image index.
-    by_texture: Vec<(Arc<Texture>, usize)>,
-    /// Wrap modes → glTF sampler index.
-    by_wrap: Vec<([Wrap; 2], usize)>,
 }
 
 impl TexturedMaterials {
@@ -107,38 +162,10 @@ impl TexturedMaterials {
         }
         let material = &mesh.materials[m];
         let texture = material.texture.as_ref().expect("only textured materials come here");
-        let image = match self.by_texture.iter().find(|(t, _)| Arc::ptr_eq(t, texture)) {
-            Some(&(_, i)) => i,
-            None => {
-                let picture = SrgbImage {
-                    width: texture.width,
-                    height: texture.height,
-                    pixels: texture.texels.clone(),
-                };
-                // A texture has at least one texel, and the encoder writes into memory: it
-                // cannot fail.
-                let png = encode_png(&picture, Path::new("texture.png")).expect("a texture encodes as PNG");
-                views.push(push_view(blob, &png, None));
-                self.images.push(json!({ "name": material.name, "bufferView": views.len() - 1,
-                    "mimeType": "image/png" }));
-                self.by_texture.push((texture.clone(), self.images.len() - 1));
-                self.images.len() - 1
-            }
-        };
-        let sampler = match self.by_wrap.iter().find(|(w, _)| *w == texture.wrap) {
-            Some(&(_, i)) => i,
-            None => {
-                // Linear filtering, as pictures filter texels bilinearly.
-                self.samplers.push(json!({ "magFilter": 9729, "minFilter": 9987,
-                    "wrapS": wrap_code(texture.wrap[0]), "wrapT": wrap_code(texture.wrap[1]) }));
-                self.by_wrap.push((texture.wrap, self.samplers.len() - 1));
-                self.samplers.len() - 1
-            }
-        };
-        self.textures.push(json!({ "sampler": sampler, "source": image }));
+        let index = self.table.texture(texture, &material.name, blob, views);
         let f = texture.factor.map(|c| c.clamp(0.0, 1.0));
         self.materials.push(json!({ "name": material.name, "pbrMetallicRoughness": {
-            "baseColorTexture": { "index": self.textures.len() - 1 },
+            "baseColorTexture": { "index": index },
             "baseColorFactor": [f[0], f[1], f[2], 1.0], "metallicFactor": 0.0, "roughnessFactor": 1.0 },
             "extensions": { "KHR_materials_unlit": {} } }));
         let index = self.materials.len(); // after `baked`
