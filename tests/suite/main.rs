@@ -2,6 +2,7 @@
 //! a cold `cargo test`, and the files' tests run side by side instead of one binary after
 //! another. Each file is a module of its own.
 
+mod alpha_masks;
 mod bad_input;
 mod bench_real;
 mod cli;

@@ -1,7 +1,8 @@
 //! Ray queries for the radiosity renderer: segment occlusion (visibility between a receiver
 //! point and a point on a shooting patch) and closest hit (the image renderer).
 //!
-//! One small trait, [`RayQuery`], with two implementations: [`Bvh`], a sixteen-wide BVH of
+//! One small trait, [`RayQuery`], with three implementations: [`MaskedBvh`] (two [`Bvh`] trees,
+//! one of alpha-masked triangles whose clear texels rays pass), [`Bvh`], a sixteen-wide BVH of
 //! our own traced one ray at a time with four-lane SIMD (`wide`: boxes and leaf triangles
 //! stored axis by axis, collapsed by least surface-area cost from obvhs's binary BVH built
 //! with PLOC and reinsertion), and [`BruteForce`], the obviously-correct reference the tests
@@ -23,9 +24,11 @@
 use glam::{Vec3, Vec3A};
 mod candidates;
 mod lanes;
+mod masked;
 mod wide;
 
 pub use candidates::{CandidateTriangles, Segments4};
+pub use masked::{ClearTest, MaskedBvh};
 
 use obvhs::{BvhBuildParams, ray::Ray, rt_triangle::RtTriangle, triangle::Triangle};
 use wide::WideBvh;

@@ -1,7 +1,6 @@
-//! Vocabulary of the `radiosity` renderer: linear colour ([`Rgb`]), validated scenes
-//! ([`Scene`], [`Material`], [`Object`]), how finely to mesh them ([`MeshParams`]; the mesher
-//! is the `radiosity_mesh` crate), camera rays and seeded random streams. The canonical test scenes are the
-//! `radiosity_scenes` crate.
+//! Vocabulary of the `radiosity` renderer: linear colour ([`Rgb`]), validated scenes ([`Scene`],
+//! [`Material`], [`Object`], [`Texture`]), how finely to mesh them ([`MeshParams`]; the mesher is
+//! `radiosity_mesh`), camera rays, seeded random streams. The test scenes are `radiosity_scenes`.
 //!
 //! Units: positions in scene units (any length unit, used consistently), radiosity and
 //! emission in W per unit², power in W.

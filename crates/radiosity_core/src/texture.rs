@@ -1,5 +1,4 @@
-//! A diffuse colour texture as the loaders hand it to the renderer: the solve uses only its
-//! material's mean reflectance, a picture shows the texel's colour (`radiosity_image`).
+//! A model's colour texture and alpha mask: pictures show its texels, the solve its mean and mask.
 
 /// How a texture coordinate outside [0, 1] comes back into the image (glTF's sampler modes).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -29,4 +28,7 @@ pub struct Texture {
     pub factor: [f64; 3],
     /// Wrap along u, then along v.
     pub wrap: [Wrap; 2],
+    /// Per texel, whether the surface is there (an alpha mask after its cutoff: glTF's
+    /// `alphaMode MASK`, MTL's `map_d`); `None`: everywhere. Light and rays pass elsewhere.
+    pub mask: Option<Vec<bool>>,
 }

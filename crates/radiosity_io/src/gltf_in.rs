@@ -16,7 +16,7 @@ use radiosity_mesh::{fan_triangles, strip_triangles};
 
 use crate::LoadError;
 use crate::model::{
-    DEFAULT_GREY, DecodedImage, Model, ModelPart, PartBuilder, Transform, alpha_warning, clamp_reflectance,
+    DEFAULT_GREY, DecodedImage, Model, ModelPart, PartBuilder, Transform, blend_warning, clamp_reflectance,
     model_error, model_material, specular_warning,
 };
 use crate::texture_map::UvTransform;
@@ -297,19 +297,42 @@ pub(crate) fn parse_gltf(
                 let pbr = m.pbr_metallic_roughness();
                 let f = pbr.base_color_factor();
                 let mut reflectance = [f[0] as f64, f[1] as f64, f[2] as f64];
-                if let Some(tex) = pbr.base_color_texture() {
-                    match images.get(tex.texture().source().index()).and_then(decoded) {
-                        Some(image) => {
-                            let sampler = tex.texture().sampler();
-                            kept = Some(image.texture(reflectance, [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())]));
-                            placed = Some(placement(&tex));
-                            reflectance = [0, 1, 2].map(|c| reflectance[c] * image.mean[c]);
-                        }
-                        None if !images.is_empty() => warnings.push(format!(
-                            "{origin}: material '{name}': base colour texture format not averaged; factor used alone"
-                        )),
-                        None => {}
+                // An alpha mask: texels whose alpha × the factor's is at least the cutoff are
+                // there; BLEND has no diffuse meaning and is cut at one half.
+                let cutoff = match m.alpha_mode() {
+                    gltf::material::AlphaMode::Opaque => None,
+                    gltf::material::AlphaMode::Mask => Some(f64::from(m.alpha_cutoff().unwrap_or(0.5))),
+                    gltf::material::AlphaMode::Blend => {
+                        warnings.push(blend_warning(origin, &name));
+                        Some(0.5)
                     }
+                };
+                let alpha = f64::from(f[3]);
+                let base = pbr.base_color_texture();
+                let image = base
+                    .as_ref()
+                    .and_then(|tex| images.get(tex.texture().source().index()).and_then(decoded));
+                match (&base, image) {
+                    (Some(tex), Some(image)) => {
+                        let sampler = tex.texture().sampler();
+                        let mask = cutoff.and_then(|c| image.mask(alpha, c, false));
+                        let mean = mask.as_deref().map_or(image.mean, |m| image.masked_mean(m));
+                        kept = Some(image.texture(
+                            reflectance,
+                            [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())],
+                            mask,
+                        ));
+                        placed = Some(placement(tex));
+                        reflectance = [0, 1, 2].map(|c| reflectance[c] * mean[c]);
+                    }
+                    (Some(_), None) if !images.is_empty() => warnings.push(format!(
+                        "{origin}: material '{name}': base colour texture format not averaged; factor used alone"
+                    )),
+                    // The factor's alpha alone: the whole material is there or not.
+                    _ if cutoff.is_some_and(|c| alpha < c) => {
+                        kept = Some(DecodedImage::white(1, 1).texture(reflectance, [Wrap::Repeat; 2], Some(vec![false])));
+                    }
+                    _ => {}
                 }
                 let reflectance = clamp_reflectance(origin, &name, reflectance, warnings);
                 // Metal reflects like a mirror, a transmissive material lets light through:
@@ -324,17 +347,6 @@ pub(crate) fn parse_gltf(
                         &name,
                         &format!("KHR_materials_transmission {transmission}"),
                     ));
-                }
-                match m.alpha_mode() {
-                    gltf::material::AlphaMode::Opaque => {}
-                    gltf::material::AlphaMode::Mask => warnings.push(alpha_warning(
-                        origin,
-                        &name,
-                        &format!("alphaMode MASK, alphaCutoff {}", m.alpha_cutoff().unwrap_or(0.5)),
-                    )),
-                    gltf::material::AlphaMode::Blend => {
-                        warnings.push(alpha_warning(origin, &name, "alphaMode BLEND"))
-                    }
                 }
                 let strength = m.emissive_strength().unwrap_or(1.0) as f64;
                 let emission = m.emissive_factor().map(|v| v as f64 * strength);

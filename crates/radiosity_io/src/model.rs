@@ -206,70 +206,134 @@ pub(crate) fn specular_warning(origin: &str, name: &str, why: &str) -> String {
     format!("material '{name}' ({origin}) is specular/transmissive ({why}); treated as diffuse")
 }
 
-/// The warning for a material whose alpha mask (`why`: glTF's `alphaMode`, MTL's `map_d`) is
-/// not applied: its faces are whole, opaque sheets, in the solve, the pictures and the
-/// reference alike (foliage casts rectangles).
-pub(crate) fn alpha_warning(origin: &str, name: &str, why: &str) -> String {
+/// The warning for a glTF material blended by its alpha (`alphaMode BLEND`): diffuse transfer
+/// has no partial transparency, so it is cut as a mask at one half.
+pub(crate) fn blend_warning(origin: &str, name: &str) -> String {
     format!(
-        "material '{name}' ({origin}) has an alpha mask ({why}) that is not applied: its faces are solid and block light whole"
+        "material '{name}' ({origin}) is alpha-blended (alphaMode BLEND): treated as a mask (MASK) with alphaCutoff 0.5"
     )
 }
 
-/// A colour texture read from a file: its 8-bit sRGB texels and their mean linear colour.
+/// A colour texture read from a file: its 8-bit sRGB texels, its alpha if it has one, and
+/// their mean linear colour.
 pub(crate) struct DecodedImage {
     width: u32,
     height: u32,
     texels: Vec<[u8; 3]>,
+    /// Alpha per texel (0–255) of an image with an alpha channel.
+    alpha: Option<Vec<u8>>,
     /// Mean linear colour: what the texture contributes to a flat element's reflectance, as
     /// the mean of what it reflects.
     pub(crate) mean: [f64; 3],
 }
 
 impl DecodedImage {
-    /// 8-bit sRGB pixels of `channels` bytes each, red, green and blue first (RGB, RGBA),
-    /// `width` per row, top row first; `None` without a pixel, with fewer than three
-    /// channels, or when the sizes disagree.
+    /// 8-bit sRGB pixels of `channels` bytes each, red, green and blue first (RGB, RGBA; the
+    /// fourth is alpha), `width` per row, top row first; `None` without a pixel, with fewer
+    /// than three channels, or when the sizes disagree.
     pub(crate) fn from_srgb8(pixels: &[u8], channels: usize, width: u32, height: u32) -> Option<Self> {
         let count = width as usize * height as usize;
         if channels < 3 || count == 0 || pixels.len() != count * channels {
             return None;
         }
-        let lut: Vec<f64> = (0..256).map(|v| srgb_decode(v as f64 / 255.0)).collect();
-        let mut sum = [0.0; 3];
-        let texels: Vec<[u8; 3]> = pixels
-            .chunks_exact(channels)
-            .map(|px| {
-                for c in 0..3 {
-                    sum[c] += lut[px[c] as usize];
-                }
-                [px[0], px[1], px[2]]
-            })
-            .collect();
-        Some(Self { width, height, texels, mean: sum.map(|s| s / count as f64) })
+        let texels: Vec<[u8; 3]> = pixels.chunks_exact(channels).map(|px| [px[0], px[1], px[2]]).collect();
+        let alpha = (channels >= 4).then(|| pixels.chunks_exact(channels).map(|px| px[3]).collect());
+        let mut image = Self { width, height, texels, alpha, mean: [0.0; 3] };
+        image.mean = image.mean_where(None);
+        Some(image)
     }
 
-    /// The texture the renderer samples: these texels times `factor`, wrapped by `wrap`.
-    pub(crate) fn texture(&self, factor: [f64; 3], wrap: [Wrap; 2]) -> Arc<Texture> {
+    /// The mean linear colour of the texels where `mask` is set (all when `None`; the whole
+    /// image's mean when the mask is empty everywhere).
+    fn mean_where(&self, mask: Option<&[bool]>) -> [f64; 3] {
+        let lut: Vec<f64> = (0..256).map(|v| srgb_decode(v as f64 / 255.0)).collect();
+        let (mut sum, mut count) = ([0.0; 3], 0usize);
+        for (i, px) in self.texels.iter().enumerate() {
+            if mask.is_none_or(|m| m[i]) {
+                (0..3).for_each(|c| sum[c] += lut[px[c] as usize]);
+                count += 1;
+            }
+        }
+        if count == 0 {
+            return self.mean_where(None);
+        }
+        sum.map(|s| s / count as f64)
+    }
+
+    /// Where the surface is: alpha × `scale` at or above `cutoff` (glTF's `alphaCutoff`), or,
+    /// for an image without alpha, the texel's brightness (a grey MTL `map_d`) when `grey`.
+    /// `None` for an image without alpha when not `grey`.
+    pub(crate) fn mask(&self, scale: f64, cutoff: f64, grey: bool) -> Option<Vec<bool>> {
+        let at = |a: u8| f64::from(a) / 255.0 * scale >= cutoff;
+        match &self.alpha {
+            Some(alpha) => Some(alpha.iter().map(|&a| at(a)).collect()),
+            // A scalar map is read as its first channel, as MTL's `-imfchan` defaults to
+            // luminance of a grey image.
+            None if grey => Some(self.texels.iter().map(|px| at(px[0])).collect()),
+            None => None,
+        }
+    }
+
+    /// `mask` (of an image `width` × `height`) sampled at this image's texel centres, nearest
+    /// texel, so that a `map_d` of another size than its `map_Kd` lines up with it.
+    pub(crate) fn resampled(&self, mask: &[bool], width: u32, height: u32) -> Vec<bool> {
+        let mut out = Vec::with_capacity(self.texels.len());
+        for y in 0..self.height as u64 {
+            let sy = ((2 * y + 1) * u64::from(height) / (2 * u64::from(self.height))) as usize;
+            for x in 0..self.width as u64 {
+                let sx = ((2 * x + 1) * u64::from(width) / (2 * u64::from(self.width))) as usize;
+                out.push(mask[sy * width as usize + sx]);
+            }
+        }
+        out
+    }
+
+    /// Texels per row and rows.
+    pub(crate) fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    /// The mean linear colour over the texels `mask` keeps: the reflectance of what is there.
+    pub(crate) fn masked_mean(&self, mask: &[bool]) -> [f64; 3] {
+        self.mean_where(Some(mask))
+    }
+
+    /// The texture the renderer samples: these texels times `factor`, wrapped by `wrap`,
+    /// there where `mask` says (everywhere when `None`).
+    pub(crate) fn texture(&self, factor: [f64; 3], wrap: [Wrap; 2], mask: Option<Vec<bool>>) -> Arc<Texture> {
         Arc::new(Texture {
             width: self.width,
             height: self.height,
             texels: self.texels.clone(),
             factor,
             wrap,
+            mask,
         })
+    }
+
+    /// A white image of `width` × `height`: what carries a mask for a material with no colour
+    /// texture (its factor is its colour).
+    pub(crate) fn white(width: u32, height: u32) -> Self {
+        let count = width as usize * height as usize;
+        Self { width, height, texels: vec![[255; 3]; count], alpha: None, mean: [1.0; 3] }
     }
 }
 
-/// The image file at `path` (PNG or JPEG, 8-bit sRGB after decoding).
+/// The image file at `path` (PNG or JPEG, 8-bit sRGB after decoding; an alpha channel kept).
 ///
 /// # Errors
 /// Why it cannot be read or decoded, one line without the path.
 pub(crate) fn read_texture(path: &Path) -> Result<DecodedImage, String> {
     let bytes = read_input_file(path, MAX_MODEL_BYTES)?;
     let image = image::load_from_memory(&bytes).map_err(|e| e.to_string())?;
-    let rgb = image.to_rgb8();
-    DecodedImage::from_srgb8(rgb.as_raw(), 3, rgb.width(), rgb.height())
-        .ok_or_else(|| "the image has no pixels".to_owned())
+    let decoded = if image.color().has_alpha() {
+        let rgba = image.to_rgba8();
+        DecodedImage::from_srgb8(rgba.as_raw(), 4, rgba.width(), rgba.height())
+    } else {
+        let rgb = image.to_rgb8();
+        DecodedImage::from_srgb8(rgb.as_raw(), 3, rgb.width(), rgb.height())
+    };
+    decoded.ok_or_else(|| "the image has no pixels".to_owned())
 }
 
 /// A face corner: its welded index and texture coordinates.

@@ -12,11 +12,11 @@ use std::io::Cursor;
 use std::path::Path;
 
 use radiosity_core::glam::DVec3;
-use radiosity_core::{Sides, unique_names};
+use radiosity_core::{Sides, Wrap, unique_names};
 
 use crate::LoadError;
 use crate::model::{
-    DEFAULT_GREY, MAX_TEXT_BYTES, Model, ModelPart, PartBuilder, Transform, alpha_warning, clamp_reflectance,
+    DEFAULT_GREY, DecodedImage, MAX_TEXT_BYTES, Model, ModelPart, PartBuilder, Transform, clamp_reflectance,
     model_error, model_material, read_input_file, read_texture, specular_warning,
 };
 use crate::texture_map::{UvTransform, parse_map_kd};
@@ -309,93 +309,113 @@ pub(crate) fn parse_obj(
     // Our materials: those the parts use, in order of first use, plus the grey default.
     let mut out_materials: Vec<radiosity_core::Material> = Vec::new();
     let mut material_of: HashMap<Option<usize>, (usize, UvTransform)> = HashMap::default();
-    let mut resolve =
-        |id: Option<usize>, warnings: &mut Vec<String>| -> Result<(usize, UvTransform), LoadError> {
-            if let Some(&m) = material_of.get(&id) {
-                return Ok(m);
-            }
-            let mut uv_transform = UvTransform::default();
-            let mut kept = None;
-            let material = match id.and_then(|i| materials.get(i)) {
-                Some(m) => {
-                    let found =
-                        mtl_texts.iter().find_map(|(f, t)| mtl_line(t, &m.name, "newmtl").map(|_| (f, t)));
-                    let (mtl_origin, line_of) = match found {
-                        Some((f, t)) => (f.as_str(), Some(t.as_str())),
-                        None => (origin, None),
-                    };
-                    let line = |key: &str| line_of.and_then(|t| mtl_line(t, &m.name, key));
-                    // A texture is read from the MTL's folder; its mean colour scales Kd, as glTF's
-                    // base colour texture scales its factor.
-                    // The image is kept for pictures, placed by the `map_Kd` options.
-                    let map = m.diffuse_texture.as_deref().map(parse_map_kd);
-                    let texture = map.as_ref().and_then(|map| {
-                        let file = &map.file;
-                        let folder = Path::new(mtl_origin).parent().filter(|_| line_of.is_some())?;
-                        match read_texture(&folder.join(file)) {
-                            Ok(image) => {
-                                uv_transform = map.transform;
-                                kept = Some(image.texture(m.diffuse.unwrap_or([1.0; 3]), [map.wrap; 2]));
-                                Some(image.mean)
-                            }
-                            Err(e) => {
-                                warnings.push(format!(
-                                "{mtl_origin}: material '{}': texture '{file}' not read ({e}); Kd alone used",
-                                m.name
-                            ));
-                                None
-                            }
-                        }
-                    });
-                    let reflectance = match (m.diffuse, texture) {
-                        (Some(kd), Some(mean)) => [kd[0] * mean[0], kd[1] * mean[1], kd[2] * mean[2]],
-                        (Some(kd), None) => kd,
-                        // The texture alone is what a viewer shows.
-                        (None, Some(mean)) => mean,
-                        (None, None) => {
-                            warnings.push(format!(
-                                "{mtl_origin}: material '{}' has no Kd; it is default grey ({DEFAULT_GREY})",
-                                m.name
-                            ));
-                            [DEFAULT_GREY; 3]
-                        }
-                    };
-                    let reflectance = clamp_reflectance(mtl_origin, &m.name, reflectance, warnings);
-                    if let Some(why) = specular_reason(m) {
-                        warnings.push(specular_warning(mtl_origin, &m.name, &why));
-                    }
-                    if let Some(mask) = &m.dissolve_texture {
-                        warnings.push(alpha_warning(mtl_origin, &m.name, &format!("map_d {mask}")));
-                    }
-                    let emission = m.emissive.unwrap_or([0.0; 3]);
-                    // Name the line of the value at fault: Kd unless only the emission is wrong.
-                    let bad_kd = !reflectance.iter().all(|v| v.is_finite() && (0.0..1.0).contains(v));
-                    let key_line = if bad_kd { line("Kd") } else { line("Ke") };
-                    let key_line = if key_line.is_some() { key_line } else { line("newmtl") };
-                    let mut material = model_material(mtl_origin, key_line, &m.name, reflectance, emission)?;
-                    material.texture = kept;
-                    material
-                }
-                None => {
-                    if let Some(i) = id {
+    let mut resolve = |id: Option<usize>,
+                       warnings: &mut Vec<String>|
+     -> Result<(usize, UvTransform), LoadError> {
+        if let Some(&m) = material_of.get(&id) {
+            return Ok(m);
+        }
+        let mut uv_transform = UvTransform::default();
+        let mut kept = None;
+        let material = match id.and_then(|i| materials.get(i)) {
+            Some(m) => {
+                let found =
+                    mtl_texts.iter().find_map(|(f, t)| mtl_line(t, &m.name, "newmtl").map(|_| (f, t)));
+                let (mtl_origin, line_of) = match found {
+                    Some((f, t)) => (f.as_str(), Some(t.as_str())),
+                    None => (origin, None),
+                };
+                let line = |key: &str| line_of.and_then(|t| mtl_line(t, &m.name, key));
+                // A texture is read from the MTL's folder; its mean colour scales Kd, as glTF's
+                // base colour texture scales its factor.
+                // The image is kept for pictures, placed by the `map_Kd` options.
+                let folder = Path::new(mtl_origin).parent().filter(|_| line_of.is_some());
+                let mut read = |kind: &str, file: &str| match folder.map(|f| read_texture(&f.join(file))) {
+                    Some(Ok(image)) => Some(image),
+                    Some(Err(e)) => {
                         warnings.push(format!(
+                            "{mtl_origin}: material '{}': {kind} '{file}' not read ({e}); {}",
+                            m.name,
+                            if kind == "map_d" { "its faces are solid" } else { "Kd alone used" }
+                        ));
+                        None
+                    }
+                    None => None,
+                };
+                let map = m.diffuse_texture.as_deref().map(parse_map_kd);
+                let colour = map.as_ref().and_then(|map| read("texture", &map.file));
+                // `map_d`: a scalar map (its alpha, or a grey image's value) cut at one half,
+                // placed as `map_Kd` is (its own options are not read).
+                let mask_map = m.dissolve_texture.as_deref().map(parse_map_kd);
+                let mask = mask_map.as_ref().and_then(|d| read("map_d", &d.file)).and_then(|d| {
+                    let (w, h) = d.size();
+                    let mask = d.mask(1.0, 0.5, true)?;
+                    Some(match &colour {
+                        Some(c) if c.size() != (w, h) => (c.resampled(&mask, w, h), c.size()),
+                        _ => (mask, (w, h)),
+                    })
+                });
+                let wrap = map.as_ref().or(mask_map.as_ref()).map_or(Wrap::Repeat, |m| m.wrap);
+                uv_transform = map.as_ref().or(mask_map.as_ref()).map_or(uv_transform, |m| m.transform);
+                let factor = m.diffuse.unwrap_or([1.0; 3]);
+                // With a mask, the reflectance is the mean of what is there.
+                let image = match (colour, &mask) {
+                    (Some(image), _) => Some(image),
+                    (None, Some((_, (w, h)))) => Some(DecodedImage::white(*w, *h)),
+                    (None, None) => None,
+                };
+                let texture = image.map(|image| {
+                    let mask = mask.map(|(k, _)| k);
+                    let mean = mask.as_deref().map_or(image.mean, |k| image.masked_mean(k));
+                    kept = Some(image.texture(factor, [wrap; 2], mask));
+                    mean
+                });
+                let reflectance = match (m.diffuse, texture) {
+                    (Some(kd), Some(mean)) => [kd[0] * mean[0], kd[1] * mean[1], kd[2] * mean[2]],
+                    (Some(kd), None) => kd,
+                    // The texture alone is what a viewer shows.
+                    (None, Some(mean)) => mean,
+                    (None, None) => {
+                        warnings.push(format!(
+                            "{mtl_origin}: material '{}' has no Kd; it is default grey ({DEFAULT_GREY})",
+                            m.name
+                        ));
+                        [DEFAULT_GREY; 3]
+                    }
+                };
+                let reflectance = clamp_reflectance(mtl_origin, &m.name, reflectance, warnings);
+                if let Some(why) = specular_reason(m) {
+                    warnings.push(specular_warning(mtl_origin, &m.name, &why));
+                }
+                let emission = m.emissive.unwrap_or([0.0; 3]);
+                // Name the line of the value at fault: Kd unless only the emission is wrong.
+                let bad_kd = !reflectance.iter().all(|v| v.is_finite() && (0.0..1.0).contains(v));
+                let key_line = if bad_kd { line("Kd") } else { line("Ke") };
+                let key_line = if key_line.is_some() { key_line } else { line("newmtl") };
+                let mut material = model_material(mtl_origin, key_line, &m.name, reflectance, emission)?;
+                material.texture = kept;
+                material
+            }
+            None => {
+                if let Some(i) = id {
+                    warnings.push(format!(
                         "{origin}: material #{i} is not in any material library; its faces are default grey"
                     ));
-                    }
-                    model_material(origin, None, "default", [DEFAULT_GREY; 3], [0.0; 3])?
                 }
-            };
-            let name = material.name.clone();
-            // Two MTL files may define the same name; the second one becomes `name#2`.
-            let mut names: Vec<String> = out_materials.iter().map(|m| m.name.clone()).collect();
-            names.push(name);
-            unique_names(&mut names);
-            let mut material = material;
-            material.name = names.pop().unwrap_or_default();
-            out_materials.push(material);
-            material_of.insert(id, (out_materials.len() - 1, uv_transform));
-            Ok((out_materials.len() - 1, uv_transform))
+                model_material(origin, None, "default", [DEFAULT_GREY; 3], [0.0; 3])?
+            }
         };
+        let name = material.name.clone();
+        // Two MTL files may define the same name; the second one becomes `name#2`.
+        let mut names: Vec<String> = out_materials.iter().map(|m| m.name.clone()).collect();
+        names.push(name);
+        unique_names(&mut names);
+        let mut material = material;
+        material.name = names.pop().unwrap_or_default();
+        out_materials.push(material);
+        material_of.insert(id, (out_materials.len() - 1, uv_transform));
+        Ok((out_materials.len() - 1, uv_transform))
+    };
 
     let total_faces: usize = models
         .iter()

@@ -8,7 +8,7 @@
 use rustc_hash::FxHashMap as HashMap;
 
 use glam::DVec3;
-use radiosity_core::{Material, MeshParams, Polygon, Rgb, Scene, Shape, Sides};
+use radiosity_core::{Material, MeshParams, Object, Polygon, Rgb, Scene, Shape, Sides};
 
 use crate::bisection::mesh_triangles;
 use crate::builder::{SurfaceBuilder, is_large, is_large_area, polygon_area_normal};
@@ -21,7 +21,7 @@ use crate::model_faces::{group_mesh_faces, group_triangles, pair_as_quad};
 use crate::outline::{Outline, outline};
 use crate::refinement::{Refinement, centre_key};
 use crate::shadows::ShadowOutlines;
-use crate::{Element, Mesh, Patch, Smoothing, Surface};
+use crate::{Element, MaskedOccluder, Mesh, Patch, Smoothing, Surface};
 
 /// Whether a surface's inside corners are needed: to grade towards them, or to leave them to
 /// the grading when refining near other geometry (with the grading off too, they are left
@@ -104,11 +104,12 @@ impl Mesh {
         for (oi, o) in scene.objects.iter().enumerate() {
             let first_surface = mesh.surfaces.len() as u32;
             let two_sided = matches!(o.sides, Sides::Two { .. });
+            let material = mesh.masked_material(scene, o);
             // A polygon of this object, cut around what stands on it, graded and refined.
             let cut = |mesh: &mut Mesh, p: &Polygon, id: Option<PolygonId>| {
                 let cutters =
                     Cutters { contacts: contacts.as_ref(), shadows: shadows.as_ref(), both_sides: two_sided };
-                mesh.mesh_cut_polygon(cutters, p, id, oi, o.material, params, refinement);
+                mesh.mesh_cut_polygon(cutters, p, id, oi, material, params, refinement);
             };
             match &o.shape {
                 Shape::Polygons(ps) => {
@@ -129,7 +130,7 @@ impl Mesh {
                     for pts in &b.patches {
                         mesh.occluders.extend((1..pts.len() - 1).map(|i| [pts[0], pts[i], pts[i + 1]]));
                     }
-                    mesh.push_surface(b, oi, o.material, refinement);
+                    mesh.push_surface(b, oi, material, refinement);
                 }
                 Shape::Mesh(m) => {
                     for group in group_mesh_faces(m) {
@@ -202,23 +203,33 @@ impl Mesh {
                                 let normal = m.polygons()[first].normal();
                                 refine_near(&mut b, normal, &edges, c, params);
                             }
-                            mesh.push_surface(b, oi, o.material, refinement);
+                            mesh.push_surface(b, oi, material, refinement);
                         }
                     }
-                    for p in m.polygons() {
+                    // Masks of emitting materials are not applied: a lamp is whole.
+                    let own = &scene.materials[o.material];
+                    let mask = own.texture.as_ref().filter(|t| t.mask.is_some() && !own.is_emitter());
+                    for (f, p) in m.polygons().iter().enumerate() {
                         let v = p.vertices();
+                        if let (Some(texture), Some(uv)) = (mask, m.uvs().get(f)) {
+                            mesh.masked_occluders.extend((1..v.len() - 1).map(|i| MaskedOccluder {
+                                occluder: (mesh.occluders.len() + i - 1) as u32,
+                                uv: [uv[0], uv[i], uv[i + 1]],
+                                texture: texture.clone(),
+                            }));
+                        }
                         mesh.occluders.extend((1..v.len() - 1).map(|i| [v[0], v[i], v[i + 1]]));
                     }
                 }
             }
             if let Sides::Two { emits_back } = o.sides {
-                let material = scene.materials[o.material].clone();
-                let back_material = if emits_back || !material.is_emitter() {
-                    o.material as u32
+                let front_material = mesh.materials[material].clone();
+                let back_material = if emits_back || !front_material.is_emitter() {
+                    material as u32
                 } else {
-                    *dark_back.entry(o.material).or_insert_with(|| {
-                        let name = format!("{} (back)", material.name);
-                        mesh.materials.push(Material { name, emission: Rgb::ZERO, ..material });
+                    *dark_back.entry(material).or_insert_with(|| {
+                        let name = format!("{} (back)", front_material.name);
+                        mesh.materials.push(Material { name, emission: Rgb::ZERO, ..front_material });
                         (mesh.materials.len() - 1) as u32
                     })
                 };
@@ -364,6 +375,30 @@ impl Mesh {
 
     /// Gives back the tables' spare capacity: grown push by push, they hold up to twice
     /// what a million-facet model needs, for as long as the mesh lives.
+    /// The material index object `o`'s surfaces take: its own, or, for a mesh whose material
+    /// has an alpha mask (and does not emit), a copy whose reflectance is scaled by the share
+    /// of the object's faces that is there (see `masks`), pushed onto the mesh's materials.
+    fn masked_material(&mut self, scene: &Scene, o: &Object) -> usize {
+        let material = &scene.materials[o.material];
+        let (Shape::Mesh(m), Some(texture)) = (&o.shape, &material.texture) else { return o.material };
+        if texture.mask.is_none() || material.is_emitter() || m.uvs().is_empty() {
+            return o.material;
+        }
+        let (mut there, mut area) = (0.0, 0.0);
+        for (p, uv) in m.polygons().iter().zip(m.uvs()) {
+            let v = p.vertices();
+            for i in 1..v.len() - 1 {
+                let a = 0.5 * (v[i] - v[0]).cross(v[i + 1] - v[0]).length();
+                there += a * crate::coverage(texture, &[uv[0], uv[i], uv[i + 1]]);
+                area += a;
+            }
+        }
+        let share = if area > 0.0 { there / area } else { 1.0 };
+        let name = format!("{} (masked, {:.1} % there)", material.name, 100.0 * share);
+        self.materials.push(Material { name, reflectance: material.reflectance * share, ..material.clone() });
+        self.materials.len() - 1
+    }
+
     fn shrink_to_fit(&mut self) {
         self.positions.shrink_to_fit();
         self.shading_normals.shrink_to_fit();
@@ -371,6 +406,7 @@ impl Mesh {
         self.patches.shrink_to_fit();
         self.surfaces.shrink_to_fit();
         self.occluders.shrink_to_fit();
+        self.masked_occluders.shrink_to_fit();
     }
 
     /// Adds the back face of surface `s`: its vertices (normals negated), patches and elements

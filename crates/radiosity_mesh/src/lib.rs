@@ -24,7 +24,7 @@
 //! `pooling` builds it; `build` puts it all
 //! together into a [`Mesh`] (`mesh`), within the `limits`; `sealed` makes closed models
 //! one-sided before meshing, and `enclosed_luminaires` (above `sealed`, whose hole caps it
-//! uses) finds luminaires shut inside solids.
+//! uses) finds luminaires shut inside solids; `masks` lets light through alpha-masked faces.
 //!
 //! [`PolygonMesh`]: radiosity_core::PolygonMesh
 #![warn(missing_docs)]
@@ -38,6 +38,7 @@ mod enclosed_luminaires;
 mod grading;
 mod lattice;
 mod limits;
+mod masks;
 mod mesh;
 mod model_faces;
 mod outline;
@@ -57,6 +58,7 @@ pub use enclosed_luminaires::{
     EnclosedLuminaire, LuminaireEnclosures, MAX_WINDING_TRIANGLES, luminaires_in_solids,
 };
 pub use limits::{MAX_ELEMENTS, MeshError, estimate_elements, first_object_over_limit};
+pub use masks::{MaskedOccluder, coverage, opaque_at, uv_at, wrapped};
 pub use mesh::{Element, Mesh, Patch, Surface};
 pub use planar::distance_to_polygon;
 pub use refinement::Refinement;

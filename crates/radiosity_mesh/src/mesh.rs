@@ -97,6 +97,8 @@ pub struct Mesh {
     /// The scene's geometry as triangles (input polygons fan-triangulated, sphere facets), for
     /// visibility: far fewer than the element triangles, hence faster rays.
     pub occluders: Vec<[DVec3; 3]>,
+    /// The occluders of alpha-masked materials, in occluder order: rays pass their clear texels.
+    pub masked_occluders: Vec<crate::MaskedOccluder>,
     /// Vertices of other surfaces that smooth shading pools with each vertex.
     pub smoothing: Smoothing,
     /// Per object, the area left out of the mesh because a solid stands on it or it lies

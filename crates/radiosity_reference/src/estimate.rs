@@ -162,7 +162,12 @@ fn batch(g: &Geometry, target: &Target, seed: u64, task: u64, index: u64, max_re
         .map(|_| {
             let x = match target {
                 Target::Object(o) => {
-                    g.sample_object(*o, [rng.next_f64(), rng.next_f64(), rng.next_f64(), rng.next_f64()])
+                    let u = [rng.next_f64(), rng.next_f64(), rng.next_f64(), rng.next_f64()];
+                    if g.sample_is_clear(*o, u) {
+                        // No surface at this point of a masked face: it counts as dark.
+                        return Rgb::ZERO;
+                    }
+                    g.sample_object(*o, u)
                 }
                 Target::Region(r) => r.sample([rng.next_f64(), rng.next_f64(), rng.next_f64()]),
                 Target::Point(p, n) => return g.irradiance_at(*p, *n, &mut rng),

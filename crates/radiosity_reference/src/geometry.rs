@@ -2,11 +2,13 @@
 //! for the BVH, sampled by area), every sphere (exact, intersected analytically), one list of
 //! primitives per object, and the emitters with their powers.
 //!
-//! Nothing here comes from the mesh: the reference must not share the solver's subdivision.
+//! Nothing here comes from the mesh: the reference must not share the solver's subdivision
+//! (only the mesher's texel lookup of an alpha mask, which is the scene's definition).
 
-use radiosity_accel::{Bvh, RayQuery};
+use radiosity_accel::{Bvh, ClearTest, MaskedBvh, RayQuery};
 use radiosity_core::glam::{DVec3, Vec3};
 use radiosity_core::{Facing, Polygon, Rgb, Scene, Shape, Sides};
+use radiosity_mesh::MaskedOccluder;
 
 /// One piece of an object's surface.
 #[derive(Clone, Debug)]
@@ -86,7 +88,10 @@ pub(crate) struct Geometry {
     /// Cumulative areas of each polygon's fan triangles (indexed like `triangles`), relative
     /// to the polygon's first triangle.
     pub triangle_cdf: Vec<f64>,
-    pub bvh: Bvh,
+    pub bvh: Box<dyn RayQuery>,
+    /// The fan triangles of alpha-masked faces: rays pass where the mask is clear, and a
+    /// point drawn there is no surface.
+    pub masked: Vec<MaskedOccluder>,
     /// Pieces that are spheres (tested analytically on every ray).
     pub spheres: Vec<u32>,
     pub objects: Vec<ObjectGeometry>,
@@ -129,7 +134,8 @@ impl Geometry {
             triangles: Vec::new(),
             triangle_piece: Vec::new(),
             triangle_cdf: Vec::new(),
-            bvh: Bvh::new(&[]),
+            bvh: Box::new(Bvh::new(&[])),
+            masked: Vec::new(),
             spheres: Vec::new(),
             objects: Vec::new(),
             back_objects: vec![None; scene.objects.len()],
@@ -164,7 +170,18 @@ impl Geometry {
                     }
                 }
                 Shape::Mesh(m) => {
-                    for p in m.polygons() {
+                    // Masks of emitting materials are not applied (as in the mesh).
+                    let mask =
+                        material.texture.as_ref().filter(|t| t.mask.is_some() && !material.is_emitter());
+                    for (f, p) in m.polygons().iter().enumerate() {
+                        if let (Some(texture), Some(uv)) = (mask, m.uvs().get(f)) {
+                            let first = g.triangles.len() as u32;
+                            g.masked.extend((1..p.vertices().len() - 1).map(|i| MaskedOccluder {
+                                occluder: first + i as u32 - 1,
+                                uv: [uv[0], uv[i], uv[i + 1]],
+                                texture: texture.clone(),
+                            }));
+                        }
                         let piece = g.polygon(oi, p);
                         add(&mut g, piece);
                     }
@@ -227,7 +244,14 @@ impl Geometry {
             }
         }
         let f32_triangles: Vec<[Vec3; 3]> = g.triangles.iter().map(|t| t.map(|v| v.as_vec3())).collect();
-        g.bvh = Bvh::new(&f32_triangles);
+        g.bvh = if g.masked.is_empty() {
+            Box::new(Bvh::new(&f32_triangles))
+        } else {
+            let masks = g.masked.clone();
+            let clear: ClearTest = Box::new(move |k, u, v| masks[k].clear_at(f64::from(u), f64::from(v)));
+            let positions: Vec<u32> = g.masked.iter().map(|m| m.occluder).collect();
+            Box::new(MaskedBvh::new(&f32_triangles, &positions, clear))
+        };
         let (lo, hi) = scene.bounds();
         g.offset = 1e-6 * (hi - lo).length().max(f64::MIN_POSITIVE);
         g.sun = scene.lighting.sun.map(|s| (s, 2.0 * (hi - lo).length().max(f64::MIN_POSITIVE)));
@@ -280,6 +304,24 @@ impl Geometry {
         let o = &self.objects[object as usize];
         let piece = o.pieces[pick(&o.cdf, u[0])];
         self.sample_piece(piece, [u[1], u[2], u[3]])
+    }
+
+    /// Whether the point that [`Geometry::sample_object`] draws from `u` on `object` falls
+    /// on a clear texel of an alpha-masked face: no surface there, so it has no radiosity.
+    pub fn sample_is_clear(&self, object: u32, u: [f64; 4]) -> bool {
+        if self.masked.is_empty() {
+            return false;
+        }
+        let o = &self.objects[object as usize];
+        let piece = &self.pieces[o.pieces[pick(&o.cdf, u[0])] as usize];
+        // A back piece draws its twin's points.
+        let Primitive::Polygon { first_triangle, triangle_count, .. } = piece.shape else { return false };
+        let cdf = &self.triangle_cdf[first_triangle..first_triangle + triangle_count];
+        let t = (first_triangle + pick(cdf, u[1])) as u32;
+        let Ok(k) = self.masked.binary_search_by_key(&t, |m| m.occluder) else { return false };
+        // `uniform_in_triangle`'s weights of the second and third corners.
+        let s = u[2].sqrt();
+        self.masked[k].clear_at(s * (1.0 - u[3]), s * u[3])
     }
 
     /// The point `p` on piece `piece` (lit-side normal `n`) as a ray along `dir` sees it: on

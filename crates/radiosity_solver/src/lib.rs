@@ -27,7 +27,7 @@ mod shaft;
 mod solution;
 mod solver;
 
-pub use occluders::{hull_triangles, occluder_triangles};
+pub use occluders::{hull_triangles, occluder_queries, occluder_triangles};
 pub use problem::Problem;
 pub use solution::{ObjectRadiosity, Solution};
 pub use solver::{

@@ -7,7 +7,10 @@
 //! BVH with the furniture only (the Cornell box: 10 of 38 triangles), and a scene with nothing
 //! else (furnace, two plates) needs no rays at all.
 
+use std::sync::Arc;
+
 use glam::{DVec3, Vec3};
+use radiosity_accel::{Bvh, ClearTest, MaskedBvh, RayQuery};
 use radiosity_mesh::Mesh;
 
 /// Above this many (triangle × vertex) pairs the exact half-space scan is skipped for
@@ -19,18 +22,20 @@ const MAX_BOXES: usize = 64;
 
 /// The occluder triangles of `mesh` that can block a ray between two points of its surfaces.
 pub(crate) fn blocking_triangles(mesh: &Mesh) -> Vec<[DVec3; 3]> {
-    split_triangles(mesh).0
+    split_triangles(mesh).0.iter().map(|&i| mesh.occluders[i]).collect()
 }
 
 /// The occluder triangles that [`occluder_triangles`] leaves out: those with every surface
 /// point in front of them (a box room's walls). No ray between two surface points crosses
 /// them, but a ray leaving the scene from inside a closed room (towards the sun) meets them.
 pub fn hull_triangles(mesh: &Mesh) -> Vec<[Vec3; 3]> {
-    split_triangles(mesh).1.iter().map(|t| t.map(|p| p.as_vec3())).collect()
+    split_triangles(mesh).1.iter().map(|&i| mesh.occluders[i].map(|p| p.as_vec3())).collect()
 }
 
-/// The occluder triangles that can block a ray between two surface points, and the rest.
-fn split_triangles(mesh: &Mesh) -> (Vec<[DVec3; 3]>, Vec<[DVec3; 3]>) {
+/// The indices of the occluder triangles that can block a ray between two surface points,
+/// and of the rest. An alpha-masked triangle is always among the first: the hull's tree
+/// knows no masks.
+fn split_triangles(mesh: &Mesh) -> (Vec<usize>, Vec<usize>) {
     let (lo, hi) = mesh.bounds();
     let tolerance = 1e-7 * (hi - lo).length().max(f64::MIN_POSITIVE);
     let corners: Vec<DVec3> = (0..8)
@@ -38,9 +43,14 @@ fn split_triangles(mesh: &Mesh) -> (Vec<[DVec3; 3]>, Vec<[DVec3; 3]>) {
         .collect();
     let points: Vec<DVec3> = mesh.occluders.iter().flatten().copied().collect();
     let scan = mesh.occluders.len().saturating_mul(points.len()) <= SCAN_BUDGET;
-    mesh.occluders.iter().partition(|t| {
+    let mut masked = vec![false; mesh.occluders.len()];
+    for m in &mesh.masked_occluders {
+        masked[m.occluder as usize] = true;
+    }
+    (0..mesh.occluders.len()).partition(|&i| {
+        let t = &mesh.occluders[i];
         let n = (t[1] - t[0]).cross(t[2] - t[0]);
-        if n.length_squared() == 0.0 {
+        if n.length_squared() == 0.0 || masked[i] {
             return true;
         }
         let n = n.normalize();
@@ -57,6 +67,29 @@ fn split_triangles(mesh: &Mesh) -> (Vec<[DVec3; 3]>, Vec<[DVec3; 3]>) {
 /// surface points (see the module notes) are left out.
 pub fn occluder_triangles(mesh: &Mesh) -> Vec<[Vec3; 3]> {
     blocking_triangles(mesh).iter().map(|t| t.map(|p| p.as_vec3())).collect()
+}
+
+/// The ray structure over [`occluder_triangles`]: a [`Bvh`], or, when some are alpha-masked,
+/// a [`MaskedBvh`] whose rays pass their clear texels.
+pub fn occluder_queries(mesh: &Mesh) -> Arc<dyn RayQuery> {
+    let (blocking, _) = split_triangles(mesh);
+    let triangles: Vec<[Vec3; 3]> =
+        blocking.iter().map(|&i| mesh.occluders[i].map(|p| p.as_vec3())).collect();
+    if mesh.masked_occluders.is_empty() {
+        return Arc::new(Bvh::new(&triangles));
+    }
+    // Masked occluders come in occluder order, as the blocking indices do.
+    let mut masks = Vec::with_capacity(mesh.masked_occluders.len());
+    let mut positions = Vec::with_capacity(mesh.masked_occluders.len());
+    let mut next = mesh.masked_occluders.iter().peekable();
+    for (k, &i) in blocking.iter().enumerate() {
+        if let Some(m) = next.next_if(|m| m.occluder as usize == i) {
+            masks.push(m.clone());
+            positions.push(k as u32);
+        }
+    }
+    let clear: ClearTest = Box::new(move |k, u, v| masks[k].clear_at(f64::from(u), f64::from(v)));
+    Arc::new(MaskedBvh::new(&triangles, &positions, clear))
 }
 
 /// Bounding boxes around runs of blocking triangles: a segment whose bounding box meets none

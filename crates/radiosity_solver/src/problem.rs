@@ -7,12 +7,12 @@
 
 use std::sync::Arc;
 
-use radiosity_accel::{Bvh, RayQuery};
+use radiosity_accel::RayQuery;
 use radiosity_core::{Daylight, Luminaire, MeshParams, Rgb, Scene};
 use radiosity_mesh::{MAX_ELEMENTS, Mesh, MeshError, Refinement};
 
 use crate::solution::VertexElements;
-use crate::{Solver, SolverError, SolverParams, occluder_triangles};
+use crate::{Solver, SolverError, SolverParams, occluder_queries};
 
 /// Unshot share at which [`Problem::new`]'s probe solves stop: the shadows and the light's
 /// falloff are in place long before convergence.
@@ -127,7 +127,7 @@ pub struct Problem {
 
 impl Problem {
     /// Meshes `scene` with `mesh_params` and builds a [`Bvh`] over the mesh's blocking occluder
-    /// triangles ([`occluder_triangles`]).
+    /// triangles ([`occluder_queries`]).
     ///
     /// Emission is taken from the scene as it is: a caller that scales the lights does so on
     /// the scene before calling this.
@@ -197,10 +197,10 @@ impl Problem {
         problem
     }
 
-    /// A problem over a mesh built elsewhere: builds the [`Bvh`] over its blocking occluder
-    /// triangles, exactly as [`Problem::new`] does.
+    /// A problem over a mesh built elsewhere: builds the ray structure over its blocking
+    /// occluder triangles ([`occluder_queries`]), exactly as [`Problem::new`] does.
     pub fn from_mesh(mesh: Arc<Mesh>) -> Self {
-        let ray_queries = Arc::new(Bvh::new(&occluder_triangles(&mesh)));
+        let ray_queries = occluder_queries(&mesh);
         Self::with_ray_queries(mesh, ray_queries)
     }
 
@@ -292,7 +292,7 @@ mod tests {
         let mut via_problem =
             Problem::new(&scene, &scene.mesh_params()).unwrap().solver(params.clone()).unwrap();
         let mesh = Arc::new(Mesh::build(&scene, &scene.mesh_params()).unwrap());
-        let accel = Arc::new(Bvh::new(&occluder_triangles(&mesh)));
+        let accel = occluder_queries(&mesh);
         let mut by_hand = Solver::new(mesh, accel, params).unwrap();
         via_problem.solve();
         by_hand.solve();

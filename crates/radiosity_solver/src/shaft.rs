@@ -59,6 +59,9 @@ pub(crate) struct Blockers {
     triangles: CandidateTriangles,
     /// Absolute slack for the single-precision rounding of ray ends and triangles.
     slack: f64,
+    /// Some triangles are alpha-masked: the candidate lists' tests know no masks, so every
+    /// pair goes to the ray structure, which does.
+    masked: bool,
 }
 
 impl Blockers {
@@ -67,7 +70,7 @@ impl Blockers {
         let tris: Vec<[Vec3; 3]> = tris.iter().map(|t| t.map(|p| p.as_vec3())).collect();
         let (lo, hi) = mesh.bounds();
         let scale = lo.abs().max(hi.abs()).max_element().max(f64::MIN_POSITIVE);
-        Self::from_triangles(&tris, 1e-6 * scale)
+        Self { masked: !mesh.masked_occluders.is_empty(), ..Self::from_triangles(&tris, 1e-6 * scale) }
     }
 
     /// Blockers over single-precision triangles, with `slack` for their rounding.
@@ -84,12 +87,12 @@ impl Blockers {
             .chunks(CLUSTER)
             .map(|c| c.iter().fold(c[0], |(lo, hi), (a, b)| (lo.min(*a), hi.max(*b))))
             .collect();
-        Self { boxes, clusters, triangles: CandidateTriangles::new(tris), slack }
+        Self { boxes, clusters, triangles: CandidateTriangles::new(tris), slack, masked: false }
     }
 
     /// True when the per-patch scan is affordable.
     pub(crate) fn scannable(&self) -> bool {
-        self.boxes.len() <= SCAN_LIMIT
+        !self.masked && self.boxes.len() <= SCAN_LIMIT
     }
 
     /// Gathers into `out` the triangles that may block a segment between polygon `a` (plane

@@ -406,6 +406,7 @@ fn checker_floor() -> radiosity_core::Scene {
         texels: vec![red, blue, blue, red],
         factor: [0.8; 3],
         wrap: [Wrap::ClampToEdge; 2],
+        mask: None,
     };
     let mean = Rgb::new(0.4, 0.0, 0.4);
     let mut textured = Material::try_new("checker", mean, Rgb::ZERO).unwrap();
@@ -626,6 +627,7 @@ fn the_cornell_box_with_a_checkered_floor() {
         texels,
         factor: [1.0; 3],
         wrap: [Wrap::Repeat; 2],
+        mask: None,
     }));
     material.name = "checkered floor".into();
     scene.materials.push(material);

@@ -4,7 +4,7 @@
 use std::f64::consts::PI;
 
 use glam::DVec3;
-use radiosity_accel::{Hit, RayQuery};
+use radiosity_accel::Hit;
 use radiosity_core::random::Rng;
 use radiosity_core::{Camera, CameraRays, Rgb};
 use radiosity_solver::Solution;
@@ -71,8 +71,7 @@ impl Renderer {
             let emits = self.mesh.element_material(e).emission.max_channel() > 0.0;
             (self.mesh.element_object(e) as u32, emits)
         };
-        let first_hit =
-            |dir: DVec3| self.accel.closest_hit(camera.position.as_vec3(), dir.as_vec3(), f32::MAX);
+        let first_hit = |dir: DVec3| self.closest_seen(camera.position, dir);
         let seen = |px: f64, py: f64| first_hit(rays.direction(px, py)).as_ref().map(what);
         // Pixel corners: (w + 1) × (h + 1), shared by the four pixels around each.
         let corners: Vec<Option<(u32, bool)>> = (0..=h)

@@ -3,7 +3,7 @@
 //! gathered by rays into an irradiance cache's records.
 
 use glam::DVec3;
-use radiosity_accel::{Hit, RayQuery};
+use radiosity_accel::Hit;
 use radiosity_core::Rgb;
 use radiosity_core::random::Rng;
 use radiosity_solver::Solution;
@@ -116,7 +116,7 @@ impl Renderer {
     /// What point `p` of element `e` sees of the emitters, by probe set `set`.
     pub(super) fn probe_at(&self, e: usize, p: DVec3, set: usize) -> Seen {
         let (n, origin) = self.shading_frame(e, p);
-        self.emitters.probe(&self.blockers, p, n, origin, set)
+        self.emitters.probe(&*self.blockers, p, n, origin, set)
     }
 
     /// What the samples of a point take, from what probe rays apart from theirs saw there
@@ -165,7 +165,7 @@ impl Renderer {
         let strata = params.samples_per_pixel * lights;
         let mut direct = gather::emitter_samples(
             &self.emitters,
-            &self.blockers,
+            &*self.blockers,
             x,
             n,
             origin,
@@ -251,7 +251,7 @@ impl Renderer {
     /// the distance, and the cosine between the ray and that element's normal, reversed
     /// (positive on its front side, where light leaves it). `None` when it leaves the scene.
     pub(super) fn land(&self, origin: DVec3, dir: DVec3) -> Option<(usize, f64, f64)> {
-        let hit = self.accel.closest_hit(origin.as_vec3(), dir.as_vec3(), f32::MAX)?;
+        let hit = self.closest_seen(origin, dir)?;
         let e = self.facing_element(hit.triangle, dir);
         let el = &self.mesh.elements[e];
         let cos_y = -el.normal.dot(dir);
@@ -295,7 +295,7 @@ impl Renderer {
         let rotation = rng.next_f64();
         let mut direct = gather::emitter_samples(
             &self.emitters,
-            &self.blockers,
+            &*self.blockers,
             y,
             n,
             origin,

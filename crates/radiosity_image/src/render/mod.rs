@@ -83,7 +83,7 @@ pub struct Renderer {
     /// The scene's blocking polygons (as the solver sees them), for shadow rays: a shadow ray
     /// needs only whether something is in the way, and the input polygons are far fewer than
     /// the element triangles (the Cornell box: 10 triangles against 20 000).
-    blockers: Bvh,
+    blockers: std::sync::Arc<dyn radiosity_accel::RayQuery>,
     /// The emitting elements, for shadow rays.
     emitters: Emitters,
     /// How far a secondary ray's origin is lifted off its surface: 1e-6 of the scene's

@@ -25,7 +25,7 @@ impl Renderer {
             .map(|(e, t)| (e, t.map(|i| mesh.positions[i as usize].as_vec3())))
             .unzip();
         let accel = Bvh::new(&triangles);
-        let blockers = Bvh::new(&radiosity_solver::occluder_triangles(&mesh));
+        let blockers = radiosity_solver::occluder_queries(&mesh);
         let emitters = Emitters::new(&mesh);
         let (lo, hi) = mesh.bounds();
         let lift = 1e-6 * (hi - lo).length().max(f64::MIN_POSITIVE);
@@ -80,6 +80,34 @@ impl Renderer {
         (e, origin + dir * distance, distance, denom < 0.0)
     }
 
+    /// The first element triangle along `origin + t·dir` (`dir` unit) that is there: hits on
+    /// the clear texels of an alpha-masked face (known once [`Renderer::with_textures`] gave
+    /// the faces' texture coordinates) are passed, the ray going on a lift beyond each.
+    pub(super) fn closest_seen(&self, origin: DVec3, dir: DVec3) -> Option<Hit> {
+        let mut from = 0.0;
+        // A bound on faces passed, far above any real stack of leaves along one ray.
+        for _ in 0..256 {
+            let start = origin + dir * from;
+            let hit = self.accel.closest_hit(start.as_vec3(), dir.as_vec3(), f32::MAX)?;
+            let passed = self.textures.as_ref().is_some_and(|textures| {
+                let (e, _, distance, _) = self.surface_point(start, dir, &hit);
+                let material = self.mesh.element_material(e);
+                let Some(texture) = material.texture.as_ref().filter(|t| t.mask.is_some()) else {
+                    return false;
+                };
+                let object = self.mesh.element_object(e) as u32;
+                textures
+                    .uv(object, start, dir, distance)
+                    .is_some_and(|uv| !radiosity_mesh::opaque_at(texture, uv))
+            });
+            if !passed {
+                return Some(Hit { t: hit.t + from as f32, ..hit });
+            }
+            from += f64::from(hit.t) + self.lift;
+        }
+        None
+    }
+
     /// `trace` for a solution already checked and a unit direction.
     pub(super) fn trace_unchecked(
         &self,
@@ -88,7 +116,7 @@ impl Renderer {
         dir: DVec3,
         shading: Shading,
     ) -> Option<SurfaceHit> {
-        let hit = self.accel.closest_hit(origin.as_vec3(), dir.as_vec3(), f32::MAX)?;
+        let hit = self.closest_seen(origin, dir)?;
         let (e, p_world, distance, front_facing) = self.surface_point(origin, dir, &hit);
         let radiance = if front_facing {
             let b = match shading {

@@ -6,7 +6,6 @@ use super::*;
 use crate::cache::Site;
 use crate::gather::{DirectMis, Gather};
 use glam::{DVec2, DVec3};
-use radiosity_accel::RayQuery;
 use radiosity_core::random::Rng;
 use radiosity_core::{Camera, CameraRays, Rgb};
 use radiosity_mesh::Mesh;

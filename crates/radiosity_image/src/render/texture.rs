@@ -230,6 +230,7 @@ mod tests {
             texels: vec![[0; 3], [255; 3]],
             factor: [1.0, 0.5, 1.0],
             wrap: [Wrap::ClampToEdge; 2],
+            mask: None,
         };
         let at = |u: f64| albedo(&t, [u, 0.5]).to_array();
         assert_eq!(at(0.25), [0.0; 3]);
@@ -251,6 +252,7 @@ mod tests {
             texels: vec![[255; 3]],
             factor: [0.9, 0.9, 0.5],
             wrap: [Wrap::Repeat; 2],
+            mask: None,
         });
         m.texture = Some(t.clone());
         let r = ratio(&m, &t, [0.5, 0.5]).to_array();
@@ -281,6 +283,7 @@ mod tests {
             texels: vec![[188; 3]],
             factor: [1.0; 3],
             wrap: [Wrap::Repeat; 2],
+            mask: None,
         }));
         let light = Material::try_new("light", Rgb::ZERO, Rgb::splat(1.0)).unwrap();
         let lamp = radiosity_core::Polygon::try_new(vec![

@@ -246,38 +246,63 @@ fn specular_and_transmissive_materials_are_diffuse_with_a_warning() {
     assert!(m.warnings[0].contains("KHR_materials_transmission 0.9"), "{:?}", m.warnings);
 }
 
-/// An alpha mask (MTL `map_d`, glTF `alphaMode` MASK or BLEND) is not applied yet: the
-/// material loads whole, with a warning that says so; an opaque glTF material says nothing.
+/// Alpha masks load as the material texture's mask: an MTL `map_d` as its grey value cut at
+/// one half (a missing one is a warning and the faces stay solid); glTF's `alphaMode` MASK by
+/// `alphaCutoff` (the factor's alpha alone when there is no texture), BLEND as a mask at one
+/// half with a warning; an opaque glTF material says nothing and has no mask.
 #[test]
-fn alpha_masked_materials_load_whole_with_a_warning() {
+fn alpha_masks_load_as_the_textures_mask() {
     let dir = tempfile::tempdir().unwrap();
-    write(dir.path(), "m.mtl", "newmtl leaves\nKd 0.3 0.5 0.2\nmap_d leaves_mask.png\n");
-    write(dir.path(), "m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl leaves\nf 1 2 3\n");
+    image::GrayImage::from_raw(2, 1, vec![255, 20]).unwrap().save(dir.path().join("mask.png")).unwrap();
+    write(
+        dir.path(),
+        "m.mtl",
+        "newmtl leaves\nKd 0.3 0.5 0.2\nmap_d mask.png\nnewmtl lost\nKd 0.3 0.5 0.2\nmap_d gone.png\n",
+    );
+    write(
+        dir.path(),
+        "m.obj",
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl leaves\nf 1 2 3\nusemtl lost\nf 1 3 2\n",
+    );
     let m = load_model(&dir.path().join("m.obj"), &Transform::default()).unwrap();
     let path = dir.path().join("m.mtl").display().to_string();
-    assert_eq!(
-        m.warnings,
-        [format!(
-            "material 'leaves' ({path}) has an alpha mask (map_d leaves_mask.png) that is not applied: its faces are solid and block light whole"
-        )]
+    assert_eq!(m.warnings.len(), 1, "{:?}", m.warnings);
+    assert!(
+        m.warnings[0].starts_with(&format!("{path}: material 'lost': map_d 'gone.png' not read"))
+            && m.warnings[0].ends_with("its faces are solid"),
+        "{:?}",
+        m.warnings
     );
+    let leaves = m.materials.iter().find(|x| x.name == "leaves").unwrap();
+    let texture = leaves.texture.as_ref().expect("a mask is carried by a texture");
+    assert_eq!(texture.mask.as_deref(), Some(&[true, false][..]));
+    // A white carrier: the reflectance is Kd, the texels show Kd.
+    assert_eq!(leaves.reflectance, Rgb::new(0.3, 0.5, 0.2));
+    assert!(m.materials.iter().find(|x| x.name == "lost").unwrap().texture.is_none());
+    let chain = |alpha: f64| {
+        gltf_model(&format!(
+            r#"{{"name":"chain","alphaMode":"MASK","alphaCutoff":0.3,"pbrMetallicRoughness":{{"metallicFactor":0,"baseColorFactor":[0.5,0.5,0.5,{alpha}]}}}}"#
+        ))
+    };
+    let m = chain(1.0);
+    assert!(m.warnings.is_empty() && m.materials[0].texture.is_none(), "{:?}", m.warnings);
+    let m = chain(0.2);
+    assert!(m.warnings.is_empty(), "{:?}", m.warnings);
+    let mask = m.materials[0].texture.as_ref().and_then(|t| t.mask.clone());
+    assert_eq!(mask, Some(vec![false]), "the factor's alpha under the cutoff: nothing there");
     let m = gltf_model(
-        r#"{"name":"chain","alphaMode":"MASK","alphaCutoff":0.3,"pbrMetallicRoughness":{"metallicFactor":0,"baseColorFactor":[0.5,0.5,0.5,1]}}"#,
+        r#"{"name":"veil","alphaMode":"BLEND","pbrMetallicRoughness":{"metallicFactor":0,"baseColorFactor":[0.5,0.5,0.5,1]}}"#,
     );
     assert_eq!(
         m.warnings,
         [
-            "material 'chain' (m.gltf) has an alpha mask (alphaMode MASK, alphaCutoff 0.3) that is not applied: its faces are solid and block light whole"
+            "material 'veil' (m.gltf) is alpha-blended (alphaMode BLEND): treated as a mask (MASK) with alphaCutoff 0.5"
         ]
     );
     let m = gltf_model(
-        r#"{"name":"veil","alphaMode":"BLEND","pbrMetallicRoughness":{"metallicFactor":0,"baseColorFactor":[0.5,0.5,0.5,1]}}"#,
-    );
-    assert!(m.warnings.len() == 1 && m.warnings[0].contains("(alphaMode BLEND)"), "{:?}", m.warnings);
-    let m = gltf_model(
         r#"{"name":"wall","alphaMode":"OPAQUE","pbrMetallicRoughness":{"metallicFactor":0,"baseColorFactor":[0.5,0.5,0.5,1]}}"#,
     );
-    assert!(m.warnings.is_empty(), "{:?}", m.warnings);
+    assert!(m.warnings.is_empty() && m.materials[0].texture.is_none(), "{:?}", m.warnings);
 }
 
 #[test]

@@ -135,6 +135,15 @@ impl Solver {
             return known;
         }
         let mesh = &*self.mesh;
+        // With alpha-masked faces a row is no measure of what stays in the scene: a masked
+        // receiver takes its whole form factor (reflecting only from the part that is there,
+        // `radiosity_mesh::masks`) while the rest of that light goes on through it to what lies
+        // behind. Probes, which pass the clear texels, then scaled rows down (a masked sheet's
+        // underside −22 % against the path tracer); every row is taken as it is.
+        if !mesh.masked_occluders.is_empty() {
+            self.delivers[key] = Some(None);
+            return None;
+        }
         let hull = self
             .hull
             .get_or_insert_with(|| radiosity_accel::Bvh::new(&crate::occluders::hull_triangles(mesh)));

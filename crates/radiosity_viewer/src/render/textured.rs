@@ -240,33 +240,41 @@ struct Level {
 /// filter of the one above in linear light (an sRGB average would darken a fine pattern as it
 /// recedes). Odd sizes round down, each texel averaging the whole run of texels it covers.
 /// Only one level is held in linear light at a time, and level 0 never is: a 4096² texture
-/// would take 200 MB as floats.
+/// would take 200 MB as floats. Alpha is the mask (255 where the surface is, 0 where an alpha
+/// mask is clear), averaged down the chain as the share that is there: the fragment shader
+/// discards below one half.
 fn mip_chain(texture: &Texture) -> Vec<Level> {
     let decode: Vec<f32> = (0..=255u8).map(|v| srgb_decode(f64::from(v) / 255.0) as f32).collect();
     let encode = |v: f32| (srgb_encode(f64::from(v)) * 255.0).round().clamp(0.0, 255.0) as u8;
+    let there = |i: usize| texture.mask.as_ref().is_none_or(|m| m.get(i).copied().unwrap_or(true));
     let (mut w, mut h) = (texture.width.max(1), texture.height.max(1));
-    let rgba = texture.texels.iter().flat_map(|t| [t[0], t[1], t[2], 255]).collect();
+    let rgba = (texture.texels.iter().enumerate())
+        .flat_map(|(i, t)| [t[0], t[1], t[2], if there(i) { 255 } else { 0 }])
+        .collect();
     let mut levels = vec![Level { width: w, height: h, rgba }];
-    let mut above: Option<Vec<[f32; 3]>> = None;
+    let mut above: Option<Vec<[f32; 4]>> = None;
     while w > 1 || h > 1 {
         let (w2, h2) = ((w / 2).max(1), (h / 2).max(1));
         let texel = |x: u32, y: u32| {
             let i = (y * w + x) as usize;
             match &above {
                 Some(linear) => linear[i],
-                None => texture.texels[i].map(|v| decode[v as usize]),
+                None => {
+                    let [r, g, b] = texture.texels[i].map(|v| decode[v as usize]);
+                    [r, g, b, if there(i) { 1.0 } else { 0.0 }]
+                }
             }
         };
         let span = |i: u32, n: u32, from: u32| (i * from / n)..((i + 1) * from / n);
         let mut linear = Vec::with_capacity((w2 * h2) as usize);
         for y in 0..h2 {
             for x in 0..w2 {
-                let mut sum = [0.0f32; 3];
+                let mut sum = [0.0f32; 4];
                 let mut count = 0.0f32;
                 for sy in span(y, h2, h) {
                     for sx in span(x, w2, w) {
                         let t = texel(sx, sy);
-                        for c in 0..3 {
+                        for c in 0..4 {
                             sum[c] += t[c];
                         }
                         count += 1.0;
@@ -275,7 +283,9 @@ fn mip_chain(texture: &Texture) -> Vec<Level> {
                 linear.push(sum.map(|s| s / count));
             }
         }
-        let rgba = linear.iter().flat_map(|t| [encode(t[0]), encode(t[1]), encode(t[2]), 255]).collect();
+        let rgba = (linear.iter())
+            .flat_map(|t| [encode(t[0]), encode(t[1]), encode(t[2]), (t[3] * 255.0).round() as u8])
+            .collect();
         levels.push(Level { width: w2, height: h2, rgba });
         (w, h, above) = (w2, h2, Some(linear));
     }
@@ -324,7 +334,7 @@ mod tests {
     use super::*;
 
     fn texture(width: u32, height: u32, texels: Vec<[u8; 3]>) -> Texture {
-        Texture { width, height, texels, factor: [1.0; 3], wrap: [Wrap::Repeat; 2] }
+        Texture { width, height, texels, factor: [1.0; 3], wrap: [Wrap::Repeat; 2], mask: None }
     }
 
     /// The 8-bit code of linear value `v`, as the chain encodes it.

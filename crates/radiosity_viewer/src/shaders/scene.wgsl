@@ -166,7 +166,13 @@ fn vs_textured(in: TexturedIn) -> TexturedOut {
 fn fs_textured(in: TexturedOut) -> @location(0) vec4<f32> {
     // Sampled before any branch: mip selection takes derivatives, which need uniform control
     // flow.
-    let albedo = textureSample(albedo_texture, albedo_sampler, in.uv).rgb;
+    let texel = textureSample(albedo_texture, albedo_sampler, in.uv);
+    // Alpha is an alpha mask's share that is there (1 without one): a clear texel shows
+    // what lies behind it.
+    if texel.a < 0.5 {
+        discard;
+    }
+    let albedo = texel.rgb;
     let k = material.factor_over_mean.rgb;
     let ratio = select(albedo * k, vec3<f32>(1.0), k < vec3<f32>(0.0));
     let e = material.emission.rgb;
