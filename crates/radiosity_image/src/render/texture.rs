@@ -12,8 +12,8 @@ use std::sync::Arc;
 
 use glam::DVec3;
 use radiosity_accel::{Bvh, RayQuery};
-use radiosity_core::{Material, Rgb, Scene, Shape, Texture, Wrap, srgb_decode};
-use radiosity_mesh::Mesh;
+use radiosity_core::{Material, Rgb, Scene, Shape, Texture, srgb_decode};
+use radiosity_mesh::{Mesh, wrapped};
 
 /// The textured faces of a scene, as triangles a ray can meet.
 pub(super) struct Textures {
@@ -111,20 +111,6 @@ impl Textures {
     }
 }
 
-/// Texel `i` of a row or column of `n` after wrapping by `wrap`.
-pub(super) fn wrapped(i: i64, n: u32, wrap: Wrap) -> usize {
-    let n = i64::from(n.max(1));
-    let i = match wrap {
-        Wrap::Repeat => i.rem_euclid(n),
-        Wrap::ClampToEdge => i.clamp(0, n - 1),
-        Wrap::MirroredRepeat => {
-            let m = i.rem_euclid(2 * n);
-            if m < n { m } else { 2 * n - 1 - m }
-        }
-    };
-    i as usize
-}
-
 /// The albedo of `texture` at `uv`: the four nearest texels decoded from sRGB, weighted
 /// bilinearly, times the texture's factor.
 pub(super) fn albedo(texture: &Texture, uv: [f64; 2]) -> Rgb {
@@ -210,6 +196,7 @@ pub fn element_uvs(scene: &Scene, mesh: &Mesh) -> Vec<Option<ElementUvs>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use radiosity_core::Wrap;
 
     #[test]
     fn wrap_modes_bring_texels_back_into_the_image() {
