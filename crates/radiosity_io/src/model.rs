@@ -277,15 +277,18 @@ impl DecodedImage {
     /// `mask` (of an image `width` × `height`) sampled at this image's texel centres, nearest
     /// texel, so that a `map_d` of another size than its `map_Kd` lines up with it.
     pub(crate) fn resampled(&self, mask: &[bool], width: u32, height: u32) -> Vec<bool> {
-        let mut out = Vec::with_capacity(self.texels.len());
-        for y in 0..self.height as u64 {
-            let sy = ((2 * y + 1) * u64::from(height) / (2 * u64::from(self.height))) as usize;
-            for x in 0..self.width as u64 {
-                let sx = ((2 * x + 1) * u64::from(width) / (2 * u64::from(self.width))) as usize;
-                out.push(mask[sy * width as usize + sx]);
-            }
-        }
-        out
+        nearest(width, height, self.width, self.height).map(|i| mask[i]).collect()
+    }
+
+    /// This image sampled at the texel centres of one `width` × `height`, nearest texel: a
+    /// colour texture brought to a finer mask's size, which a coarser one would alias.
+    pub(crate) fn scaled(&self, width: u32, height: u32) -> Self {
+        let texels = nearest(self.width, self.height, width, height).map(|i| self.texels[i]).collect();
+        let alpha = self
+            .alpha
+            .as_ref()
+            .map(|a| nearest(self.width, self.height, width, height).map(|i| a[i]).collect());
+        Self { width, height, texels, alpha, mean: self.mean }
     }
 
     /// Texels per row and rows.
@@ -317,6 +320,16 @@ impl DecodedImage {
         let count = width as usize * height as usize;
         Self { width, height, texels: vec![[255; 3]; count], alpha: None, mean: [1.0; 3] }
     }
+}
+
+/// For each texel centre of a `to_w` × `to_h` image, row after row, the index of the texel of
+/// a `from_w` × `from_h` image under it.
+fn nearest(from_w: u32, from_h: u32, to_w: u32, to_h: u32) -> impl Iterator<Item = usize> {
+    let (fw, fh, tw, th) = (u64::from(from_w), u64::from(from_h), u64::from(to_w), u64::from(to_h));
+    (0..th).flat_map(move |y| {
+        let sy = (2 * y + 1) * fh / (2 * th);
+        (0..tw).map(move |x| (sy * fw + (2 * x + 1) * fw / (2 * tw)) as usize)
+    })
 }
 
 /// The image file at `path` (PNG or JPEG, 8-bit sRGB after decoding; an alpha channel kept).

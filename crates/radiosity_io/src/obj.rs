@@ -343,15 +343,23 @@ pub(crate) fn parse_obj(
                     None => None,
                 };
                 let map = m.diffuse_texture.as_deref().map(parse_map_kd);
-                let colour = map.as_ref().and_then(|map| read("texture", &map.file));
+                let mut colour = map.as_ref().and_then(|map| read("texture", &map.file));
                 // `map_d`: a scalar map (its alpha, or a grey image's value) cut at one half,
-                // placed as `map_Kd` is (its own options are not read).
+                // placed as `map_Kd` is (its own options are not read). Of two sizes, the
+                // colour and the mask meet at the finer: the coarser would alias the other.
                 let mask_map = m.dissolve_texture.as_deref().map(parse_map_kd);
                 let mask = mask_map.as_ref().and_then(|d| read("map_d", &d.file)).and_then(|d| {
                     let (w, h) = d.size();
                     let mask = d.mask(1.0, 0.5, true)?;
-                    Some(match &colour {
-                        Some(c) if c.size() != (w, h) => (c.resampled(&mask, w, h), c.size()),
+                    let texels = |(a, b): (u32, u32)| u64::from(a) * u64::from(b);
+                    Some(match &mut colour {
+                        Some(c) if c.size() != (w, h) && texels(c.size()) >= texels((w, h)) => {
+                            (c.resampled(&mask, w, h), c.size())
+                        }
+                        Some(c) if c.size() != (w, h) => {
+                            *c = c.scaled(w, h);
+                            (mask, (w, h))
+                        }
                         _ => (mask, (w, h)),
                     })
                 });

@@ -279,6 +279,27 @@ fn alpha_masks_load_as_the_textures_mask() {
     // A white carrier: the reflectance is Kd, the texels show Kd.
     assert_eq!(leaves.reflectance, Rgb::new(0.3, 0.5, 0.2));
     assert!(m.materials.iter().find(|x| x.name == "lost").unwrap().texture.is_none());
+    // A colour texture and a mask of other sizes meet at the finer, nearest texel.
+    image::RgbImage::from_raw(1, 1, vec![200, 100, 50]).unwrap().save(dir.path().join("one.png")).unwrap();
+    image::RgbImage::from_raw(4, 2, vec![90; 24]).unwrap().save(dir.path().join("four.png")).unwrap();
+    write(
+        dir.path(),
+        "m.mtl",
+        "newmtl coarse\nKd 1 1 1\nmap_Kd one.png\nmap_d mask.png\nnewmtl fine\nKd 1 1 1\nmap_Kd four.png\nmap_d mask.png\n",
+    );
+    write(
+        dir.path(),
+        "m.obj",
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl coarse\nf 1 2 3\nusemtl fine\nf 1 3 2\n",
+    );
+    let m = load_model(&dir.path().join("m.obj"), &Transform::default()).unwrap();
+    let texture = |name: &str| m.materials.iter().find(|x| x.name == name).unwrap().texture.clone().unwrap();
+    let coarse = texture("coarse");
+    assert_eq!((coarse.width, coarse.height, coarse.mask.as_deref()), (2, 1, Some(&[true, false][..])));
+    assert_eq!(coarse.texels, [[200, 100, 50]; 2]);
+    let fine = texture("fine");
+    let halves = [true, true, false, false, true, true, false, false];
+    assert_eq!((fine.width, fine.height, fine.mask.as_deref()), (4, 2, Some(&halves[..])));
     let chain = |alpha: f64| {
         gltf_model(&format!(
             r#"{{"name":"chain","alphaMode":"MASK","alphaCutoff":0.3,"pbrMetallicRoughness":{{"metallicFactor":0,"baseColorFactor":[0.5,0.5,0.5,{alpha}]}}}}"#
