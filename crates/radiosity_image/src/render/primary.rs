@@ -89,17 +89,21 @@ impl Renderer {
         for _ in 0..256 {
             let start = origin + dir * from;
             let hit = self.accel.closest_hit(start.as_vec3(), dir.as_vec3(), f32::MAX)?;
-            let passed = self.textures.as_ref().is_some_and(|textures| {
-                let (e, _, distance, _) = self.surface_point(start, dir, &hit);
-                let material = self.mesh.element_material(e);
-                let Some(texture) = material.texture.as_ref().filter(|t| t.mask.is_some()) else {
-                    return false;
-                };
-                let object = self.mesh.element_object(e) as u32;
-                textures
-                    .uv(object, start, dir, distance)
-                    .is_some_and(|uv| !radiosity_mesh::opaque_at(texture, uv))
-            });
+            // Only a mesh with masked faces has holes (and it has them only where the scene's
+            // texture coordinates say).
+            let masked = !self.mesh.masked_occluders.is_empty();
+            let passed = masked
+                && self.textures.as_ref().is_some_and(|textures| {
+                    let (e, _, distance, _) = self.surface_point(start, dir, &hit);
+                    let material = self.mesh.element_material(e);
+                    let Some(texture) = material.texture.as_ref().filter(|t| t.mask.is_some()) else {
+                        return false;
+                    };
+                    let object = self.mesh.element_object(e) as u32;
+                    textures
+                        .uv(object, start, dir, distance)
+                        .is_some_and(|uv| !radiosity_mesh::opaque_at(texture, uv))
+                });
             if !passed {
                 return Some(Hit { t: hit.t + from as f32, ..hit });
             }
