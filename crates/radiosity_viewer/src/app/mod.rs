@@ -107,6 +107,24 @@ impl ViewerApp {
             .wgpu_render_state
             .clone()
             .ok_or_else(|| anyhow::anyhow!("the viewer needs eframe's wgpu renderer"))?;
+        let ctx = cc.egui_ctx.clone();
+        Ok(Self::with_render_state(
+            render_state,
+            Some(Arc::new(move || ctx.request_repaint())),
+            options,
+            outcome,
+        ))
+    }
+
+    /// Sets up GPU resources on `render_state` (egui's renderer, whose render pass the scene
+    /// draws in) and starts the solve worker, which calls `repaint` after each publication.
+    /// Apart from eframe so that tests can drive the app on a renderer of their own.
+    pub(crate) fn with_render_state(
+        render_state: egui_wgpu::RenderState,
+        repaint: Option<Arc<dyn Fn() + Send + Sync>>,
+        options: ViewerOptions,
+        outcome: Outcome,
+    ) -> Self {
         let info = render_state.adapter.get_info();
         let software = info.device_type == wgpu::DeviceType::Cpu;
         log::info!("drawing with {} ({:?}, {:?})", info.name, info.backend, info.device_type);
@@ -124,20 +142,19 @@ impl ViewerApp {
             mesh_params,
             solver_params: options.solver_params,
         };
-        let ctx = cc.egui_ctx.clone();
         let worker = SolveWorker::spawn(
             job.clone(),
             WorkerOptions {
                 threads: options.threads,
                 start_paused: false,
                 pause_at_shots: options.after_shots.filter(|_| options.screenshot.is_some()),
-                notify: Some(Arc::new(move || ctx.request_repaint())),
+                notify: repaint,
             },
         );
         let (lo, hi) = scene.bounds();
         let extent = SceneExtent::new(lo, hi);
         let camera = FlyCamera::from_scene_camera(&radiosity_image::camera_or_framing(&scene), &extent);
-        Ok(Self {
+        Self {
             view: ViewState {
                 camera,
                 auto_exposure: options.exposure_ev.is_none(),
@@ -185,12 +202,11 @@ impl ViewerApp {
             software,
             last_motion: None,
             coarse: false,
-        })
+        }
     }
-}
 
-impl eframe::App for ViewerApp {
-    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+    /// One frame of the window: input, the worker's news, the panel and the view.
+    pub(crate) fn frame(&mut self, ui: &mut egui::Ui) {
         let ctx = ui.ctx().clone();
         self.fps.tick(Instant::now());
         let dropped: Vec<PathBuf> =
@@ -270,5 +286,11 @@ impl eframe::App for ViewerApp {
             // clocks in case a shot takes long.
             ctx.request_repaint_after(Duration::from_millis(250));
         }
+    }
+}
+
+impl eframe::App for ViewerApp {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        self.frame(ui);
     }
 }

@@ -18,10 +18,23 @@ fn harness(scene: &str, shots: Option<u64>, dir: &std::path::Path) -> Harness<'s
     options.threads = Some(1);
     options.screenshot_dir = dir.to_owned();
     options.solver_params = SolverParams { max_shots: shots, ..SolverParams::preview() };
+    window(options)
+}
+
+/// The app in a 1000 × 640 harness on a wgpu renderer of its own. Driven through
+/// [`ViewerApp::frame`] rather than as an eframe app: eframe under the harness turns on the
+/// desktop accessibility bridge (a D-Bus stack that was a sixth of a cold test build), which
+/// no test here reads.
+fn window(options: ViewerOptions) -> Harness<'static, ViewerApp> {
+    let render_state = egui_kittest::wgpu::create_render_state(
+        egui_kittest::wgpu::default_wgpu_setup(),
+        egui_wgpu::RendererOptions::PREDICTABLE,
+    );
+    let app = ViewerApp::with_render_state(render_state.clone(), None, options, Arc::default());
     Harness::builder()
         .with_size(Vec2::new(1000.0, 640.0))
-        .wgpu()
-        .build_eframe(|cc| ViewerApp::new(cc, options, Arc::default()).unwrap())
+        .renderer(egui_kittest::wgpu::WgpuTestRenderer::from_render_state(render_state))
+        .build_ui_state(|ui, app: &mut ViewerApp| app.frame(ui), app)
 }
 
 /// Steps frames (sleeping between them, since the worker and loader run in real time)
@@ -129,10 +142,7 @@ fn subdivision_sliders_keep_the_other_mesh_settings() {
         .and_then(|m| m.with_adaptive_levels(1))
         .unwrap();
     options.mesh_params = Some(chosen);
-    let mut h = Harness::builder()
-        .with_size(Vec2::new(1000.0, 640.0))
-        .wgpu()
-        .build_eframe(|cc| ViewerApp::new(cc, options, Arc::default()).unwrap());
+    let mut h = window(options);
     assert_eq!(h.state().subdivision.adaptive_levels, 1);
     h.state_mut().subdivision.element_size = 35.0;
     h.state_mut().subdivision.adaptive_levels = 0;
