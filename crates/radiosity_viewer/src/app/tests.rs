@@ -23,7 +23,7 @@ fn harness(scene: &str, shots: Option<u64>, dir: &std::path::Path) -> Harness<'s
 
 /// The app in a 1000 × 640 harness on a wgpu renderer of its own. Driven through
 /// [`ViewerApp::frame`] rather than as an eframe app: eframe under the harness turns on the
-/// desktop accessibility bridge (a D-Bus stack that was a sixth of a cold test build), which
+/// desktop accessibility bridge (a D-Bus stack that was a quarter of a cold test build), which
 /// no test here reads.
 fn window(options: ViewerOptions) -> Harness<'static, ViewerApp> {
     let render_state = egui_kittest::wgpu::create_render_state(
